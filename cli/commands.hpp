@@ -1,0 +1,14 @@
+// Subcommand registration. Each subcommand lives in its own file (cli/<name>.cpp) and registers
+// itself on the top-level CLI::App; main.cpp calls every register_* function.
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+namespace roughscope::cli {
+
+void register_model(CLI::App& app);     // cli/model.cpp    — evaluate models (issue: foundation)
+void register_estimate(CLI::App& app);  // cli/estimate.cpp — roughness estimation (§4)
+void register_paper(CLI::App& app);     // cli/paper.cpp    — paper tables recomputed
+void register_curet(CLI::App& app);     // cli/curet.cpp    — CUReT comparison (§5.3)
+
+}  // namespace roughscope::cli

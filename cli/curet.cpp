@@ -1,0 +1,480 @@
+// `roughscope curet`: models against measured BRDFs (paper §5.3, Tables 3–4, Fig. 10) for one
+// CUReT sample, every sample, or any BRDF table in CSV. See docs/curet.md.
+//
+// Figures (--plot) are drawn by the Python package (roughscope.curet_figures, matplotlib): the
+// command writes the comparison as JSON to a temporary file and runs
+// `$ROUGHSCOPE_PYTHON -m roughscope.curet_figures` (default /usr/bin/python3), with the package
+// beside the executable (<bin>/../python) put first on PYTHONPATH.
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <memory>
+#include <optional>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "commands.hpp"
+#include "common.hpp"
+#include "roughscope/brdf_table.hpp"
+#include "roughscope/comparison.hpp"
+#include "roughscope/curet.hpp"
+#include "roughscope/errors.hpp"
+
+namespace roughscope::cli {
+namespace {
+
+namespace fs = std::filesystem;
+
+enum class Format { Text, Json, Csv, Markdown };
+
+Format parse_format(std::string_view name) {
+    if (name == "text") return Format::Text;
+    if (name == "json") return Format::Json;
+    if (name == "csv") return Format::Csv;
+    if (name == "markdown" || name == "md") return Format::Markdown;
+    throw roughscope::InvalidArgument("format '" + std::string(name) +
+                                      "' is not one of: text, json, csv, markdown");
+}
+
+struct Args {
+    int sample = 0;
+    bool all = false;
+    std::string table_path;
+    std::string table_channel;
+    std::string data_dir;
+    CuretChannel channel = CuretChannel::Mean;
+    Format format = Format::Text;
+    bool json_flag = false;
+    bool series = false;
+    std::string plot_path;
+    std::string output_path;
+    double theta1_deg = 45.0, theta2_deg = 67.5;
+    std::vector<int> pair;
+    double on_sigma_rad = 0.0, on_albedo = 0.0;
+    bool no_fits = false;
+    Radiometry radiometry = Radiometry::Radiance;
+    double max_overflow = 1.0;
+    int threads = 0;
+
+    CLI::Option *o_sample{}, *o_all{}, *o_table{}, *o_format{}, *o_theta1{}, *o_theta2{},
+        *o_on_sigma{}, *o_on_albedo{}, *o_max_overflow{}, *o_data{}, *o_channel{},
+        *o_table_channel{}, *o_threads{}, *o_pair{};
+};
+
+bool given(const CLI::Option* o) { return o && o->count() > 0; }
+
+// ASCII labels for the aligned text table (print_table counts bytes).
+std::string ascii(std::string_view s) {
+    std::string out;
+    for (std::size_t k = 0; k < s.size(); ++k) {
+        if (k + 2 < s.size() && static_cast<unsigned char>(s[k]) == 0xE2 &&
+            static_cast<unsigned char>(s[k + 1]) == 0x80 &&
+            static_cast<unsigned char>(s[k + 2]) == 0x93) {
+            out += '-';
+            k += 2;
+        } else {
+            out += s[k];
+        }
+    }
+    return out;
+}
+
+std::string short_number(double v, std::string_view name) {
+    format_result(v, name);  // throws on NaN/inf
+    char buf[64];
+    std::snprintf(buf, sizeof buf, "%.6g", v);
+    return buf;
+}
+
+// Rounds every floating-point number of a JSON document to kPrintDigits significant digits.
+void round_json(json& j) {
+    if (j.is_number_float()) {
+        j = finite_number(j.get<double>());
+    } else if (j.is_structured()) {
+        for (auto& item : j) round_json(item);
+    }
+}
+
+std::string json_text(const std::string& library_json) {
+    json j = json::parse(library_json);
+    round_json(j);
+    return dump_json(j);
+}
+
+std::string text_report(const Comparison& c) {
+    std::ostringstream out;
+    out << (c.sample ? "CUReT sample " + std::to_string(c.sample) : c.name);
+    if (c.sample && !curet_sample_name(c.sample).empty()) out << " (" << c.name << ")";
+    out << ", channel " << (c.channel.empty() ? "-" : c.channel) << ": " << c.measurement.size()
+        << " of " << c.total_measurements << " measurements used\n\n";
+    const TwoPointEstimate& t = c.two_point;
+    out << "Two-point estimate (Table 3; measurements " << t.measurement1 << " and "
+        << t.measurement2 << ", F_VH, viewer on the normal):\n";
+    if (t.available) {
+        std::vector<std::pair<std::string, std::string>> kv;
+        kv.emplace_back("theta1, theta2 (deg)",
+                        short_number(rad_to_deg(t.theta1_rad), "theta1") + ", " +
+                            short_number(rad_to_deg(t.theta2_rad), "theta2"));
+        kv.emplace_back("E1/E2", format_result(*t.E1_over_E2, "E1/E2"));
+        kv.emplace_back("sigma/T (Gaussian, Eq. 17)",
+                        t.sigma_over_T_gaussian
+                            ? format_result(*t.sigma_over_T_gaussian, "sigma/T")
+                            : "unavailable: " + t.gaussian_reason);
+        kv.emplace_back("sigma/T (exponential, Eq. 19)",
+                        t.sigma_over_T_exponential
+                            ? format_result(*t.sigma_over_T_exponential, "sigma/T")
+                            : "unavailable: " + t.exponential_reason);
+        print_key_values(out, kv);
+    } else {
+        out << "  unavailable: " << t.reason << "\n";
+    }
+    out << "\nErrors (Table 4 = sum of squared differences of max-normalised brightness; RMSE = "
+           "sqrt(Table 4 / N); gain SSE = after the optimal gain):\n";
+    std::vector<std::vector<std::string>> rows;
+    auto skipped = [](const ModelResult& r) { return is_fit(r.model) && r.reason == "fits not requested"; };
+    for (const ModelResult& r : c.models) {
+        if (skipped(r)) continue;
+        std::vector<std::string> row{ascii(display_name(r.model))};
+        if (!r.available) {
+            row.insert(row.end(), {"-", "-", "-", "-", "unavailable"});
+            rows.push_back(row);
+            continue;
+        }
+        std::string params;
+        for (const ModelParameter& p : r.parameters) {
+            if (p.name == "gain") continue;
+            params += (params.empty() ? "" : " ") + p.name + "=" + short_number(p.value, p.name);
+            if (p.standard_error && std::isfinite(*p.standard_error))
+                params += "(+-" + short_number(*p.standard_error, p.name) + ")";
+        }
+        row.push_back(params);
+        row.push_back(short_number(r.errors.paper_sse, "Table-4 error"));
+        row.push_back(short_number(r.errors.rmse, "RMSE"));
+        row.push_back(short_number(r.errors.gain_sse, "gain SSE"));
+        row.push_back(r.fit_status ? std::string(to_string(*r.fit_status)) : "");
+        rows.push_back(row);
+    }
+    print_table(out, {"model", "parameters", "Table 4", "RMSE", "gain SSE", "status"}, rows);
+    out << "\nWinner by gain SSE (fits included): "
+        << (c.winner ? ascii(display_name(*c.winner)) : std::string("-"))
+        << "\nWinner by the Table-4 metric (paper's methods): "
+        << (c.winner_paper_metric ? ascii(display_name(*c.winner_paper_metric))
+                                  : std::string("-"))
+        << "\n";
+    for (const ModelResult& r : c.models)
+        if (!r.available && !skipped(r))
+            out << "  " << ascii(display_name(r.model)) << ": " << r.reason << "\n";
+    if (!c.data_issues.empty()) {
+        out << "\nData issues (" << c.data_issues.size() << "):\n";
+        for (const DataIssue& d : c.data_issues)
+            out << "  measurement " << d.measurement << ": f = " << short_number(d.value, "f")
+                << ", " << d.issue << " - " << d.note << "\n";
+    }
+    return out.str();
+}
+
+std::string text_report_all(const std::vector<Comparison>& all) {
+    std::vector<std::vector<std::string>> rows;
+    for (const Comparison& c : all) {
+        std::vector<std::string> row{std::to_string(c.sample)};
+        const TwoPointEstimate& t = c.two_point;
+        row.push_back(t.E1_over_E2 ? short_number(*t.E1_over_E2, "E1/E2") : "-");
+        row.push_back(t.sigma_over_T_gaussian ? short_number(*t.sigma_over_T_gaussian, "s/T") : "-");
+        row.push_back(t.sigma_over_T_exponential ? short_number(*t.sigma_over_T_exponential, "s/T")
+                                                 : "-");
+        for (ComparisonModel m : kPaperComparisonModels) {
+            const ModelResult& r = c.result(m);
+            row.push_back(r.available ? short_number(r.errors.paper_sse, "error") : "-");
+        }
+        row.push_back(c.winner ? ascii(display_name(*c.winner)) : "-");
+        row.push_back(std::to_string(c.data_issues.size()));
+        rows.push_back(row);
+    }
+    std::ostringstream out;
+    std::vector<std::string> header{"sample", "E1/E2", "s/T_G", "s/T_E"};
+    for (ComparisonModel m : kPaperComparisonModels) header.push_back(ascii(display_name(m)));
+    header.push_back("best (gain SSE)");
+    header.push_back("issues");
+    print_table(out, header, rows);
+    return out.str();
+}
+
+// Quotes a path for /bin/sh.
+std::string shell_quote(const std::string& s) {
+    std::string out = "'";
+    for (char ch : s) {
+        if (ch == '\'') out += "'\\''";
+        else out += ch;
+    }
+    return out + "'";
+}
+
+std::string python_interpreter() {
+    if (const char* p = std::getenv("ROUGHSCOPE_PYTHON"); p && *p) return p;
+    std::error_code ec;
+    if (fs::exists("/usr/bin/python3", ec)) return "/usr/bin/python3";
+    return "python3";
+}
+
+std::optional<fs::path> package_dir_beside_executable() {
+    std::error_code ec;
+    const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
+    if (ec) return std::nullopt;
+    for (const fs::path& candidate :
+         {exe.parent_path().parent_path() / "python",
+          exe.parent_path().parent_path() / "lib" / "roughscope" / "python"}) {
+        if (fs::exists(candidate / "roughscope" / "curet_figures.py", ec)) return candidate;
+    }
+    return std::nullopt;
+}
+
+// A temporary file that is removed when it goes out of scope.
+struct TempFile {
+    fs::path path;
+    explicit TempFile(const std::string& suffix) {
+        std::string tmpl = (fs::temp_directory_path() / ("roughscope-curet-XXXXXX" + suffix)).string();
+        std::vector<char> buf(tmpl.begin(), tmpl.end());
+        buf.push_back('\0');
+        const int fd = mkstemps(buf.data(), static_cast<int>(suffix.size()));
+        if (fd < 0) throw roughscope::DataError("cannot create a temporary file in " +
+                                                fs::temp_directory_path().string());
+        ::close(fd);
+        path = buf.data();
+    }
+    ~TempFile() {
+        std::error_code ec;
+        fs::remove(path, ec);
+    }
+    TempFile(const TempFile&) = delete;
+    TempFile& operator=(const TempFile&) = delete;
+};
+
+void draw_plot(const std::string& comparison_json, const std::string& kind,
+               const fs::path& out_png) {
+    if (out_png.extension() != ".png")
+        throw roughscope::InvalidArgument("--plot: '" + out_png.string() +
+                                          "' must end in .png (the figure is a PNG)");
+    TempFile input(".json");
+    TempFile log(".log");
+    {
+        std::ofstream f(input.path);
+        f << comparison_json;
+        if (!f) throw roughscope::DataError("cannot write " + input.path.string());
+    }
+    if (const auto pkg = package_dir_beside_executable()) {
+        const char* old = std::getenv("PYTHONPATH");
+        const std::string value =
+            pkg->string() + (old && *old ? ":" + std::string(old) : std::string());
+        ::setenv("PYTHONPATH", value.c_str(), 1);
+    }
+    const std::string cmd = shell_quote(python_interpreter()) + " -m roughscope.curet_figures " +
+                            kind + " --input " + shell_quote(input.path.string()) + " --out " +
+                            shell_quote(fs::absolute(out_png).string()) + " >" +
+                            shell_quote(log.path.string()) + " 2>&1";
+    std::cout.flush();
+    const int status = std::system(cmd.c_str());
+    if (status != 0) {
+        std::ifstream f(log.path);
+        std::string line, last;
+        while (std::getline(f, line))
+            if (!line.empty()) last = line;
+        throw roughscope::DataError(
+            "--plot: drawing the figure failed (" + (last.empty() ? "no message" : last) +
+            "); it needs Python 3 with matplotlib and the roughscope package (set "
+            "ROUGHSCOPE_PYTHON and PYTHONPATH)");
+    }
+}
+
+void run(Args& a) {
+    const int modes = (given(a.o_sample) ? 1 : 0) + (a.all ? 1 : 0) + (given(a.o_table) ? 1 : 0);
+    if (modes != 1)
+        throw UsageError("give exactly one of --sample N, --all or --table FILE.csv");
+    if (a.json_flag) {
+        if (given(a.o_format) && a.format != Format::Json)
+            throw UsageError("--json conflicts with --format");
+        a.format = Format::Json;
+    }
+    if (!given(a.o_format) && !a.json_flag && a.all) a.format = Format::Markdown;
+    if (given(a.o_theta1) != given(a.o_theta2))
+        throw UsageError("give both --theta1 and --theta2 (degrees) or neither");
+    if (given(a.o_on_sigma) != given(a.o_on_albedo))
+        throw UsageError("give both --on-sigma RAD and --on-albedo RHO or neither");
+    if (given(a.o_on_sigma) && a.all)
+        throw UsageError("--on-sigma/--on-albedo apply to one sample or table, not to --all");
+    if (given(a.o_table) && (given(a.o_data) || given(a.o_channel)))
+        throw UsageError("--data and --channel apply to CUReT; with --table use --table-channel");
+    if (given(a.o_table_channel) && !given(a.o_table))
+        throw UsageError("--table-channel applies to --table only");
+    if (given(a.o_threads) && !a.all) throw UsageError("--threads applies to --all only");
+    if (a.series && a.format != Format::Json) throw UsageError("--series needs --json");
+
+    ComparisonOptions o;
+    o.radiometry = a.radiometry;
+    o.fits = !a.no_fits;
+    if (given(a.o_theta1)) {
+        o.theta1_rad = deg_to_rad(a.theta1_deg);
+        o.theta2_rad = deg_to_rad(a.theta2_deg);
+    }
+    if (given(a.o_pair)) {
+        if (a.pair.size() != 2 || a.pair[0] < 1 || a.pair[1] < 1)
+            throw roughscope::InvalidArgument("--pair: expected two measurement numbers I,J >= 1");
+        o.measurement1 = a.pair[0];
+        o.measurement2 = a.pair[1];
+    }
+    if (given(a.o_on_sigma)) {
+        o.oren_nayar = OrenNayarParams{a.on_sigma_rad, a.on_albedo};
+        o.oren_nayar_source = "given on the command line";
+    }
+    if (given(a.o_max_overflow)) o.max_overflow_fraction = a.max_overflow;
+    validate(o);
+
+    std::string text;
+    std::string plot_json;
+    std::string plot_kind = "fig10";
+    if (a.all) {
+        const fs::path dir = find_curet_directory(
+            given(a.o_data) ? std::optional<fs::path>(a.data_dir) : std::nullopt);
+        const CuretDatabase db = load_curet(dir, a.channel);
+        const std::vector<Comparison> all = compare_curet_all(db, o, a.threads);
+        switch (a.format) {
+            case Format::Json: text = json_text(to_json(all, a.series)); break;
+            case Format::Csv: text = to_csv(all); break;
+            case Format::Markdown: text = to_markdown(all); break;
+            case Format::Text: text = text_report_all(all); break;
+        }
+        if (!a.plot_path.empty()) {
+            plot_json = to_json(all, false, -1);
+            plot_kind = "summary";
+        }
+    } else {
+        Comparison c;
+        if (given(a.o_table)) {
+            BrdfCsvOptions co;
+            if (given(a.o_table_channel)) co.channel = a.table_channel;
+            c = compare_brdf(read_brdf_csv(a.table_path, co), o);
+        } else {
+            const fs::path dir = find_curet_directory(
+                given(a.o_data) ? std::optional<fs::path>(a.data_dir) : std::nullopt);
+            const CuretDatabase db = load_curet(dir, a.channel);
+            c = compare_curet_sample(db, a.sample, o);
+        }
+        switch (a.format) {
+            case Format::Json: text = json_text(to_json(c, a.series)); break;
+            case Format::Csv: text = to_csv({c}); break;
+            case Format::Markdown: text = to_markdown({c}); break;
+            case Format::Text: text = text_report(c); break;
+        }
+        if (!a.plot_path.empty()) plot_json = to_json(c, true, -1);
+    }
+    // The figure first: if it fails, nothing has been written.
+    if (!a.plot_path.empty()) draw_plot(plot_json, plot_kind, a.plot_path);
+    write_output(a.output_path.empty() ? std::nullopt : std::optional<fs::path>(a.output_path),
+                 text);
+}
+
+}  // namespace
+
+void register_curet(CLI::App& app) {
+    auto args = std::make_shared<Args>();
+    Args& a = *args;
+    CLI::App* cmd = app.add_subcommand(
+        "curet",
+        "Compare reflectance models with measured BRDFs (paper 5.3, Tables 3-4, Fig. 10): one "
+        "CUReT sample (--sample N), the whole database (--all), or any BRDF table (--table "
+        "FILE.csv). See docs/curet.md.");
+    const std::string what = "What to compare";
+    cmd->add_option("--sample", a.sample, "CUReT sample number (1..61)")->group(what);
+    cmd->add_flag("--all", a.all, "Every sample of the database")->group(what);
+    cmd->add_option("--table", a.table_path,
+                    "A BRDF table in CSV: theta_i,phi_i,theta_s,phi_s,value (degrees, 1/sr; "
+                    "theta_s/phi_s = viewing direction, azimuths in one sample frame); optional "
+                    "weight, channel, measurement")
+        ->group(what);
+    cmd->add_option("--table-channel", a.table_channel,
+                    "Channel to use when the CSV has a channel column with several values")
+        ->group(what);
+
+    const std::string data = "CUReT data";
+    cmd->add_option("--data", a.data_dir,
+                    "Directory with table.txt and abrdf.dat (default: ../shared/data/curet when "
+                    "it exists, else $ROUGHSCOPE_CURET)")
+        ->group(data);
+    add_enum_option(*cmd, "--channel", a.channel, parse_curet_channel,
+                    "mean (abrdf.dat, default), red, green or blue")
+        ->group(data);
+    add_range_option(*cmd, "--max-overflow", a.max_overflow, 0.0, 1.0,
+                     "Exclude measurements whose published overflow (saturation) fraction "
+                     "exceeds this (needs rover.dat etc.; default: keep all)")
+        ->group(data);
+
+    const std::string models = "Models";
+    add_angle_option(*cmd, "--theta1", a.theta1_deg,
+                     "Incidence angle of the first two-point measurement (deg; default: from "
+                     "the angle table, 45 for CUReT)")
+        ->group(models);
+    add_angle_option(*cmd, "--theta2", a.theta2_deg,
+                     "Incidence angle of the second two-point measurement (deg; default: from "
+                     "the angle table, 67.5 for CUReT)")
+        ->group(models);
+    cmd->add_option("--pair", a.pair,
+                    "Two-point measurement numbers I,J (default 81,112; both with the viewer "
+                    "on the normal)")
+        ->delimiter(',')
+        ->expected(2)
+        ->group(models);
+    add_non_negative_option(*cmd, "--on-sigma", a.on_sigma_rad,
+                            "Given Oren-Nayar facet slope sigma (rad; default for samples 25, "
+                            "34, 41: the paper's Table 3)",
+                            "rad")
+        ->group(models);
+    add_range_option(*cmd, "--on-albedo", a.on_albedo, 0.0, 1.0,
+                     "Given Oren-Nayar albedo rho in [0, 1]")
+        ->group(models);
+    add_enum_option(*cmd, "--radiometry", a.radiometry, parse_radiometry,
+                    "B-K interpretation: radiance (default, reproduces Table 4) or intensity")
+        ->group(models);
+    cmd->add_flag("--no-fits", a.no_fits, "Only the paper's methods (no least-squares fits)")
+        ->group(models);
+    cmd->add_option("--threads", a.threads, "Threads for --all (default: all cores)")
+        ->check(CLI::Range(1, 1024))
+        ->group(models);
+
+    const std::string outg = "Output";
+    add_enum_option(*cmd, "--format", a.format, parse_format,
+                    "text (default for one sample), json, csv, markdown (default for --all)")
+        ->group(outg);
+    cmd->add_flag("--json", a.json_flag, "Same as --format json")->group(outg);
+    cmd->add_flag("--series", a.series,
+                  "With --json: add per-measurement data and model brightness (normalised)")
+        ->group(outg);
+    cmd->add_option("--plot", a.plot_path,
+                    "Write a PNG: Fig. 10 for one sample, the database summary for --all")
+        ->group(outg);
+    cmd->add_option("--output", a.output_path, "Write the results to FILE atomically")
+        ->group(outg);
+
+    a.o_sample = cmd->get_option("--sample");
+    a.o_all = cmd->get_option("--all");
+    a.o_table = cmd->get_option("--table");
+    a.o_table_channel = cmd->get_option("--table-channel");
+    a.o_data = cmd->get_option("--data");
+    a.o_channel = cmd->get_option("--channel");
+    a.o_max_overflow = cmd->get_option("--max-overflow");
+    a.o_theta1 = cmd->get_option("--theta1");
+    a.o_theta2 = cmd->get_option("--theta2");
+    a.o_pair = cmd->get_option("--pair");
+    a.o_on_sigma = cmd->get_option("--on-sigma");
+    a.o_on_albedo = cmd->get_option("--on-albedo");
+    a.o_format = cmd->get_option("--format");
+    a.o_threads = cmd->get_option("--threads");
+
+    cmd->callback([args]() { run(*args); });
+}
+
+}  // namespace roughscope::cli

@@ -1,0 +1,62 @@
+// Typed errors of the public API (the "invalid input" tier of DEVELOPERS.md).
+//
+// Every exception message names the offending input, its value and the valid range, so that a
+// front end can show it to the user verbatim. The CLI turns any roughscope::Error into a one-line
+// message and a non-zero exit status; the Python module raises ValueError subclasses.
+#pragma once
+
+#include <stdexcept>
+#include <string>
+#include <string_view>
+
+namespace roughscope {
+
+// Base of every error the library throws on purpose.
+class Error : public std::runtime_error {
+  public:
+    using std::runtime_error::runtime_error;
+};
+
+// An argument is outside its valid range, NaN, or inconsistent with another argument.
+class InvalidArgument : public Error {
+  public:
+    using Error::Error;
+};
+
+// The inputs are valid one by one but the equation being inverted has no solution for them
+// (e.g. a brightness ratio outside the range a model can produce). The message gives the range
+// of inputs that would have a solution.
+class NoSolution : public Error {
+  public:
+    using Error::Error;
+};
+
+// A file or table is malformed or missing (the message names the file and, when known, the line).
+class DataError : public Error {
+  public:
+    using Error::Error;
+};
+
+namespace check {
+
+// Throws InvalidArgument unless `value` is finite.
+void finite(std::string_view name, double value);
+
+// Throws InvalidArgument unless `value` is finite and > 0. `unit` is appended to the message.
+void positive(std::string_view name, double value, std::string_view unit = "");
+
+// Throws InvalidArgument unless `value` is finite and >= 0.
+void non_negative(std::string_view name, double value, std::string_view unit = "");
+
+// Throws InvalidArgument unless 0 <= theta_rad < pi/2. The message shows degrees.
+void polar_angle(std::string_view name, double theta_rad);
+
+// Throws InvalidArgument unless `value` is finite (azimuths may be any real number; they are
+// wrapped by the functions that use them).
+void azimuth(std::string_view name, double phi_rad);
+
+// Formats a double for messages: shortest round-trip form, "nan"/"inf" spelled out.
+std::string format_number(double value);
+
+}  // namespace check
+}  // namespace roughscope

@@ -1,0 +1,10 @@
+// Umbrella header: the whole public API of the roughscope library.
+#pragma once
+
+#include "roughscope/beckmann.hpp"
+#include "roughscope/errors.hpp"
+#include "roughscope/geometry.hpp"
+#include "roughscope/models.hpp"
+#include "roughscope/retro.hpp"
+#include "roughscope/scattering.hpp"
+#include "roughscope/validity.hpp"

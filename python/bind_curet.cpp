@@ -1,0 +1,331 @@
+// Bindings for measured BRDFs (CUReT and any BRDF table) and the model comparison of §5.3.
+// Angles cross this boundary in degrees. Comparisons are returned as JSON text (the same document
+// as `roughscope curet --json --series`); the pure-Python roughscope.curet parses it.
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+#include <pybind11/stl/filesystem.h>
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "bindings.hpp"
+#include "roughscope/brdf_table.hpp"
+#include "roughscope/comparison.hpp"
+#include "roughscope/curet.hpp"
+#include "roughscope/errors.hpp"
+
+namespace py = pybind11;
+
+namespace roughscope::python {
+namespace {
+
+py::array_t<double> vector_array(const std::vector<double>& v) {
+    return py::array_t<double>(static_cast<py::ssize_t>(v.size()), v.data());
+}
+
+py::array_t<double> matrix_array(const std::vector<std::vector<double>>& rows) {
+    const py::ssize_t n = static_cast<py::ssize_t>(rows.size());
+    const py::ssize_t m = n ? static_cast<py::ssize_t>(rows[0].size()) : 0;
+    py::array_t<double> out({n, m});
+    auto r = out.mutable_unchecked<2>();
+    for (py::ssize_t i = 0; i < n; ++i)
+        for (py::ssize_t j = 0; j < m; ++j) r(i, j) = rows[static_cast<std::size_t>(i)][static_cast<std::size_t>(j)];
+    return out;
+}
+
+ComparisonOptions make_options(std::optional<double> theta1_deg, std::optional<double> theta2_deg,
+                               std::optional<std::vector<int>> pair,
+                               std::optional<double> on_sigma_rad,
+                               std::optional<double> on_albedo, bool fits,
+                               const std::string& radiometry,
+                               std::optional<double> max_overflow) {
+    ComparisonOptions o;
+    if (theta1_deg.has_value() != theta2_deg.has_value())
+        throw InvalidArgument("give both theta1_deg and theta2_deg or neither");
+    if (theta1_deg) {
+        o.theta1_rad = deg_to_rad(*theta1_deg);
+        o.theta2_rad = deg_to_rad(*theta2_deg);
+    }
+    if (pair) {
+        if (pair->size() != 2)
+            throw InvalidArgument("pair must hold two measurement numbers, got " +
+                                  std::to_string(pair->size()));
+        o.measurement1 = (*pair)[0];
+        o.measurement2 = (*pair)[1];
+    }
+    if (on_sigma_rad.has_value() != on_albedo.has_value())
+        throw InvalidArgument("give both on_sigma_rad and on_albedo or neither");
+    if (on_sigma_rad) {
+        o.oren_nayar = OrenNayarParams{*on_sigma_rad, *on_albedo};
+        o.oren_nayar_source = "given";
+    }
+    o.fits = fits;
+    o.radiometry = parse_radiometry(radiometry);
+    o.max_overflow_fraction = max_overflow;
+    validate(o);
+    return o;
+}
+
+py::dict table_dict(const BrdfTable& t) {
+    std::vector<double> idx, ti, pi, tv, pv, f, w, ts, ps;
+    for (const BrdfMeasurement& m : t.measurements) {
+        idx.push_back(m.index);
+        ti.push_back(rad_to_deg(m.theta_i_rad));
+        pi.push_back(rad_to_deg(m.phi_i_rad));
+        tv.push_back(rad_to_deg(m.theta_v_rad));
+        pv.push_back(rad_to_deg(m.phi_v_rad));
+        f.push_back(m.value);
+        w.push_back(m.weight);
+        ts.push_back(rad_to_deg(m.geometry.theta_s_rad));
+        ps.push_back(rad_to_deg(m.geometry.phi_s_rad));
+    }
+    py::dict d;
+    d["name"] = t.name;
+    d["channel"] = t.channel;
+    d["measurement"] = vector_array(idx).attr("astype")("int64");
+    d["theta_i_deg"] = vector_array(ti);
+    d["phi_i_deg"] = vector_array(pi);
+    d["theta_v_deg"] = vector_array(tv);
+    d["phi_v_deg"] = vector_array(pv);
+    d["value"] = vector_array(f);
+    d["weight"] = vector_array(w);
+    d["theta_s_deg"] = vector_array(ts);  // paper's frame
+    d["phi_s_deg"] = vector_array(ps);
+    return d;
+}
+
+BrdfTable table_from_arrays(py::array_t<double, py::array::c_style | py::array::forcecast> ti,
+                            py::array_t<double, py::array::c_style | py::array::forcecast> pi,
+                            py::array_t<double, py::array::c_style | py::array::forcecast> ts,
+                            py::array_t<double, py::array::c_style | py::array::forcecast> ps,
+                            py::array_t<double, py::array::c_style | py::array::forcecast> value,
+                            std::optional<py::array_t<double, py::array::c_style |
+                                                                  py::array::forcecast>>
+                                weight,
+                            const std::string& name) {
+    const py::ssize_t n = value.size();
+    for (auto [label, arr] : {std::pair{"theta_i_deg", &ti}, std::pair{"phi_i_deg", &pi},
+                              std::pair{"theta_s_deg", &ts}, std::pair{"phi_s_deg", &ps}})
+        if (arr->ndim() != 1 || arr->size() != n)
+            throw InvalidArgument(std::string(label) + " must be a 1-D array as long as value (" +
+                                  std::to_string(n) + "), got size " +
+                                  std::to_string(arr->size()));
+    if (value.ndim() != 1) throw InvalidArgument("value must be a 1-D array");
+    if (weight && (weight->ndim() != 1 || weight->size() != n))
+        throw InvalidArgument("weight must be a 1-D array as long as value (" +
+                              std::to_string(n) + ")");
+    BrdfTable t;
+    t.name = name;
+    for (py::ssize_t j = 0; j < n; ++j)
+        t.measurements.push_back(make_brdf_measurement(
+            static_cast<int>(j + 1), deg_to_rad(ti.at(j)), deg_to_rad(pi.at(j)),
+            deg_to_rad(ts.at(j)), deg_to_rad(ps.at(j)), value.at(j),
+            weight ? weight->at(j) : 1.0));
+    return t;
+}
+
+}  // namespace
+
+void bind_curet(py::module_& m) {
+    py::class_<CuretDatabase>(m, "CuretDatabase",
+                              "The CUReT BRDF database for one channel (load with curet_load).")
+        .def_property_readonly("directory",
+                               [](const CuretDatabase& db) { return db.directory.string(); })
+        .def_property_readonly("channel",
+                               [](const CuretDatabase& db) { return std::string(to_string(db.channel)); })
+        .def_property_readonly(
+            "samples",
+            [](const CuretDatabase& db) {
+                py::array_t<long long> out(static_cast<py::ssize_t>(db.samples.size()));
+                for (std::size_t k = 0; k < db.samples.size(); ++k) out.mutable_at(static_cast<py::ssize_t>(k)) = db.samples[k];
+                return out;
+            },
+            "Sample numbers in file order (int64, shape (61,))")
+        .def_property_readonly(
+            "brdf", [](const CuretDatabase& db) { return matrix_array(db.brdf); },
+            "BRDF values f in 1/sr, shape (samples, 205); row k is samples[k], column j is "
+            "measurement j+1. Non-positive values (noise) are kept.")
+        .def_property_readonly(
+            "overflow",
+            [](const CuretDatabase& db) -> py::object {
+                if (db.overflow.empty()) return py::none();
+                return matrix_array(db.overflow);
+            },
+            "Saturated-pixel fractions (same shape as brdf) or None when not published")
+        .def_property_readonly(
+            "angles_deg",
+            [](const CuretDatabase& db) {
+                std::vector<double> meas, tv, pv, ti, pi, ts, ps;
+                for (const CuretAngles& a : db.angles) {
+                    meas.push_back(a.measurement);
+                    tv.push_back(rad_to_deg(a.theta_v_rad));
+                    pv.push_back(rad_to_deg(a.phi_v_rad));
+                    ti.push_back(rad_to_deg(a.theta_i_rad));
+                    pi.push_back(rad_to_deg(a.phi_i_rad));
+                    const Geometry g = geometry_from_two_azimuths(a.theta_i_rad, a.phi_i_rad,
+                                                                  a.theta_v_rad, a.phi_v_rad);
+                    ts.push_back(rad_to_deg(g.theta_s_rad));
+                    ps.push_back(rad_to_deg(g.phi_s_rad));
+                }
+                py::dict d;
+                d["measurement"] = vector_array(meas).attr("astype")("int64");
+                d["theta_v_deg"] = vector_array(tv);
+                d["phi_v_deg"] = vector_array(pv);
+                d["theta_i_deg"] = vector_array(ti);
+                d["phi_i_deg"] = vector_array(pi);
+                d["theta_s_deg"] = vector_array(ts);
+                d["phi_s_deg"] = vector_array(ps);
+                return d;
+            },
+            "table.txt in degrees (sample frame) plus theta_s_deg, phi_s_deg in the paper's frame "
+            "(theta_s = theta_v, phi_s = phi_v - phi_i + 180)")
+        .def(
+            "sample_table", [](const CuretDatabase& db, int sample) { return table_dict(db.sample_table(sample)); },
+            py::arg("sample"), "One sample's measurements as a dict of numpy arrays (degrees)")
+        .def(
+            "compare",
+            [](const CuretDatabase& db, int sample, std::optional<double> theta1_deg,
+               std::optional<double> theta2_deg, std::optional<std::vector<int>> pair,
+               std::optional<double> on_sigma_rad, std::optional<double> on_albedo, bool fits,
+               const std::string& radiometry, std::optional<double> max_overflow, bool series) {
+                const ComparisonOptions o =
+                    make_options(theta1_deg, theta2_deg, pair, on_sigma_rad, on_albedo, fits,
+                                 radiometry, max_overflow);
+                py::gil_scoped_release release;
+                return to_json(compare_curet_sample(db, sample, o), series, -1);
+            },
+            py::arg("sample"), py::kw_only(), py::arg("theta1_deg") = py::none(),
+            py::arg("theta2_deg") = py::none(), py::arg("pair") = py::none(),
+            py::arg("on_sigma_rad") = py::none(), py::arg("on_albedo") = py::none(),
+            py::arg("fits") = true, py::arg("radiometry") = "radiance",
+            py::arg("max_overflow") = py::none(), py::arg("series") = true,
+            "Compare every model with one sample (JSON text; see roughscope.curet.compare)")
+        .def(
+            "compare_all",
+            [](const CuretDatabase& db, bool fits, const std::string& radiometry,
+               std::optional<double> max_overflow, int threads, const std::string& format,
+               bool series) {
+                const ComparisonOptions o = make_options(std::nullopt, std::nullopt, std::nullopt,
+                                                         std::nullopt, std::nullopt, fits,
+                                                         radiometry, max_overflow);
+                if (format != "json" && format != "csv" && format != "markdown")
+                    throw InvalidArgument("format '" + format +
+                                          "' is not one of: json, csv, markdown");
+                py::gil_scoped_release release;
+                const std::vector<Comparison> all = compare_curet_all(db, o, threads);
+                if (format == "csv") return to_csv(all);
+                if (format == "markdown") return to_markdown(all);
+                return to_json(all, series, -1);
+            },
+            py::kw_only(), py::arg("fits") = true, py::arg("radiometry") = "radiance",
+            py::arg("max_overflow") = py::none(), py::arg("threads") = 0,
+            py::arg("format") = "json", py::arg("series") = false,
+            "Compare every sample (JSON, CSV or Markdown text)");
+
+    m.def(
+        "curet_find_directory",
+        [](std::optional<std::string> data_dir) {
+            return find_curet_directory(data_dir ? std::optional<std::filesystem::path>(*data_dir)
+                                                 : std::nullopt)
+                .string();
+        },
+        py::arg("data_dir") = py::none(),
+        "The CUReT directory: data_dir, else ../shared/data/curet, else $ROUGHSCOPE_CURET "
+        "(DataError saying where to get the database otherwise)");
+    m.def(
+        "curet_load",
+        [](std::optional<std::string> data_dir, const std::string& channel) {
+            const auto dir = find_curet_directory(
+                data_dir ? std::optional<std::filesystem::path>(*data_dir) : std::nullopt);
+            return load_curet(dir, parse_curet_channel(channel));
+        },
+        py::arg("data_dir") = py::none(), py::arg("channel") = "mean",
+        "Load the CUReT database (channel: mean, red, green, blue)");
+    m.def("curet_sample_name", [](int s) { return std::string(curet_sample_name(s)); },
+          py::arg("sample"), "The paper's name for samples 25, 34, 41; '' otherwise");
+    m.def(
+        "curet_paper_oren_nayar",
+        [](int s) -> py::object {
+            const auto p = paper_oren_nayar_params(s);
+            if (!p) return py::none();
+            return py::make_tuple(p->sigma_rad, p->albedo);
+        },
+        py::arg("sample"), "(sigma_rad, albedo) of the paper's Table 3, or None");
+
+    m.def(
+        "brdf_read_csv",
+        [](const std::string& path, std::optional<std::string> channel) {
+            BrdfCsvOptions o;
+            o.channel = channel;
+            return table_dict(read_brdf_csv(path, o));
+        },
+        py::arg("path"), py::arg("channel") = py::none(),
+        "Read a BRDF table (CSV: theta_i, phi_i, theta_s, phi_s in degrees, value; optional "
+        "weight, channel, measurement) into a dict of numpy arrays");
+    m.def(
+        "brdf_compare_csv",
+        [](const std::string& path, std::optional<std::string> channel,
+           std::optional<double> theta1_deg, std::optional<double> theta2_deg,
+           std::optional<std::vector<int>> pair, std::optional<double> on_sigma_rad,
+           std::optional<double> on_albedo, bool fits, const std::string& radiometry,
+           bool series) {
+            BrdfCsvOptions co;
+            co.channel = channel;
+            const ComparisonOptions o = make_options(theta1_deg, theta2_deg, pair, on_sigma_rad,
+                                                     on_albedo, fits, radiometry, std::nullopt);
+            return to_json(compare_brdf(read_brdf_csv(path, co), o), series, -1);
+        },
+        py::arg("path"), py::kw_only(), py::arg("channel") = py::none(),
+        py::arg("theta1_deg") = py::none(), py::arg("theta2_deg") = py::none(),
+        py::arg("pair") = py::none(), py::arg("on_sigma_rad") = py::none(),
+        py::arg("on_albedo") = py::none(), py::arg("fits") = true,
+        py::arg("radiometry") = "radiance", py::arg("series") = true,
+        "Compare every model with a BRDF table read from CSV (JSON text)");
+    m.def(
+        "brdf_compare_arrays",
+        [](py::array_t<double, py::array::c_style | py::array::forcecast> theta_i_deg,
+           py::array_t<double, py::array::c_style | py::array::forcecast> phi_i_deg,
+           py::array_t<double, py::array::c_style | py::array::forcecast> theta_s_deg,
+           py::array_t<double, py::array::c_style | py::array::forcecast> phi_s_deg,
+           py::array_t<double, py::array::c_style | py::array::forcecast> value,
+           std::optional<py::array_t<double, py::array::c_style | py::array::forcecast>> weight,
+           const std::string& name, std::optional<double> theta1_deg,
+           std::optional<double> theta2_deg, std::optional<std::vector<int>> pair,
+           std::optional<double> on_sigma_rad, std::optional<double> on_albedo, bool fits,
+           const std::string& radiometry, bool series) {
+            const BrdfTable t = table_from_arrays(theta_i_deg, phi_i_deg, theta_s_deg, phi_s_deg,
+                                                  value, weight, name);
+            const ComparisonOptions o = make_options(theta1_deg, theta2_deg, pair, on_sigma_rad,
+                                                     on_albedo, fits, radiometry, std::nullopt);
+            return to_json(compare_brdf(t, o), series, -1);
+        },
+        py::arg("theta_i_deg"), py::arg("phi_i_deg"), py::arg("theta_s_deg"),
+        py::arg("phi_s_deg"), py::arg("value"), py::kw_only(), py::arg("weight") = py::none(),
+        py::arg("name") = "table", py::arg("theta1_deg") = py::none(),
+        py::arg("theta2_deg") = py::none(), py::arg("pair") = py::none(),
+        py::arg("on_sigma_rad") = py::none(), py::arg("on_albedo") = py::none(),
+        py::arg("fits") = true, py::arg("radiometry") = "radiance", py::arg("series") = true,
+        "Compare every model with a BRDF table given as arrays (degrees; measurement j+1 is "
+        "element j). JSON text.");
+    m.def(
+        "comparison_error_measures",
+        [](std::vector<double> model, std::vector<double> data,
+           std::optional<std::vector<double>> weights) {
+            const ErrorMeasures e =
+                error_measures(model, data, weights ? std::span<const double>(*weights)
+                                                    : std::span<const double>());
+            py::dict d;
+            d["sse"] = e.paper_sse;
+            d["rmse"] = e.rmse;
+            d["sse_gain"] = e.gain_sse;
+            d["gain"] = e.gain;
+            return d;
+        },
+        py::arg("model"), py::arg("data"), py::arg("weights") = py::none(),
+        "The paper's Table-4 error (sum of (M/max M - d/max d)^2), RMSE and the SSE after the "
+        "optimal gain");
+}
+
+}  // namespace roughscope::python
