@@ -295,9 +295,10 @@ constexpr std::array<RoughnessClass, 3> kRoughnessClasses = {
 // =============================================================================================
 //
 // Same physics as roughscope::very_rough_brightness (Eq. 4 / Eq. 5 shapes of beckmann.hpp times
-// the radiometric factor), evaluated in blocks: the angles are converted, their sines and
-// cosines taken by glibc's vector math library (AVX2, 4 lanes, ≤ 4 ulp) when the CPU has it,
-// and the rest is plain arithmetic with
+// the radiometric factor), evaluated in blocks of kBlock elements: each block is loaded and
+// validated (branch-free), the sines and cosines are taken by glibc's vector math library
+// (AVX-512 8 lanes or AVX2 4 lanes, ≤ 4 ulp) when the CPU has it, std:: otherwise, and the rest
+// is arithmetic that GCC auto-vectorises for the same instruction set, with
 //   q_xy² = (sin θi − sin θs)² + 4 sin θi sin θs sin²(φs/2)   (= sin²θi + sin²θs − 2 sinθi sinθs
 //   cos φs, written without cancellation), q_z² = (cos θi + cos θs)².
 

@@ -187,7 +187,9 @@ double very_rough_brightness(const Geometry& geom, double sigma_over_T, Correlat
 // The diffuse Kirchhoff integral evaluated by direct numerical quadrature (adaptive
 // Gauss–Kronrod), independent of the series:
 //   D = (2π/A) F² e^{−g} ∫₀^∞ [exp(g C(τ)) − 1] J0(v_xy τ) τ dτ
-// Used to verify the series; slow (milliseconds), intended for g ≲ 50 and T·v_xy ≲ 50.
+// Used to verify the series; slow (~0.1–10 ms), intended for g ≲ 50 and T·v_xy ≲ 50. Its error
+// is absolute (~1e−16 of the integrand's scale), so relative accuracy is lost where D is many
+// decades below that scale (far tails of the Gaussian lobe, e.g. T·v_xy = 20 at g < 1).
 double diffuse_power_quadrature(Correlation correlation, double F2, double T_um, double area_um2,
                                 double g, double vxy2);
 

@@ -10,8 +10,9 @@ namespace roughscope {
 
 // §3.1: surfaces are slightly rough for g ≪ 1, moderately rough for g ≈ 1, very rough for g ≫ 1.
 // The library draws the lines one decade either side of g = 1:
-//   g < kSlightlyRoughMaxG (0.1)  → SlightlyRough   (Eq. 3's first term carries ≥ ~95 % of Eq. 2)
-//   g > kVeryRoughMinG (10)       → VeryRough       (Eq. 4 within ~10 % of Eq. 2)
+//   g < kSlightlyRoughMaxG (0.1)  → SlightlyRough   (at v_xy = 0, Eq. 3 is within 2.5 % of Eq. 2)
+//   g > kVeryRoughMinG (10)       → VeryRough       (at v_xy = 0, Eq. 4 is within 12 % of Eq. 2,
+//                                                    and the gap shrinks like 1/g)
 //   otherwise                     → ModeratelyRough (only the full series is accurate)
 inline constexpr double kSlightlyRoughMaxG = 0.1;
 inline constexpr double kVeryRoughMinG = 10.0;
