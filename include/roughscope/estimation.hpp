@@ -97,9 +97,11 @@ double correlation_length_from_ratio(double E1_over_E2, double sigma_um, double 
 //
 // The model ratio M(x) = B(geom1; x)/B(geom2; x) of the brightness B (diffuse term × radiometric
 // factor, gain K cancels) is inverted for the unknown x (σ/T, or T with σ known) by TOMS 748
-// bracketed root finding on ln M(ln x) − ln(E1/E2). The bracket [x_min, x_max] is checked first:
-// if the measured ratio is not between M(x_min) and M(x_max) NoSolution is thrown with that
-// range. Agrees with Eq. 15, 17, 19 where those apply (normal view, same regime).
+// bracketed root finding on ln M(x) − ln(E1/E2) in ln x. The bracket is found by expanding
+// geometrically from the middle of [lower, upper] until the residual changes sign (no grid);
+// when it never does, the ratio is outside what the model produces and NoSolution gives the range
+// M spans over [lower, upper]. Agrees with Eq. 15, 17, 19 where those apply (normal view, same
+// regime).
 struct TwoGeometryOptions {
     GeometricFactor factor = GeometricFactor::VernoldHarvey;  // §4.2's recommendation
     Radiometry radiometry = Radiometry::Radiance;             // Harvey (§3.3)

@@ -74,8 +74,9 @@ struct FitOptions {
     double sigma_min_um = 1e-4, sigma_max_um = 100.0;
     double T_min_um = 1e-4, T_max_um = 1e4;
 
-    // Starting values; automatic when not given (see docs/estimation.md: a log-linear least
-    // squares for the Gaussian forms, refined by a coarse profile scan over σ/T).
+    // Starting values; automatic when not given (docs/estimation.md): the very-rough model scans
+    // 25 log-spaced σ/T over the bounds with K profiled out; the slightly-rough model starts from
+    // the linear least squares of Eq. 3 in logs (a coarse scan when that fails).
     std::optional<double> initial_sigma_over_T;
     std::optional<double> initial_sigma_um;
     std::optional<double> initial_T_um;

@@ -268,7 +268,8 @@ TEST(Comparison, FitStandardErrorsCoverTheTruthUnderNoise) {
         ComparisonOptions o;
         o.measurement1 = 1;
         o.measurement2 = 2;
-        const ModelResult& r = compare_brdf(t, o).result(ComparisonModel::VhGaussianFit);
+        const Comparison c = compare_brdf(t, o);
+        const ModelResult& r = c.result(ComparisonModel::VhGaussianFit);
         const ModelParameter& p = r.parameters.at(0);
         ASSERT_TRUE(p.standard_error.has_value());
         EXPECT_GT(*p.standard_error, 1e-5);
