@@ -939,10 +939,20 @@ json comparison_json(const Comparison& c, bool series) {
         s["theta_s_deg"] = ts;
         s["phi_s_deg"] = ps;
         s["data"] = normalised(c.brightness);
-        json ms;
-        for (const ModelResult& r : c.models)
+        json ms, mg;
+        for (const ModelResult& r : c.models) {
             ms[info(r.model).key] = r.available ? json(normalised(r.prediction)) : json(nullptr);
-        s["models"] = ms;
+            if (!r.available) {
+                mg[info(r.model).key] = nullptr;
+                continue;
+            }
+            std::vector<double> scaled(r.prediction.size());
+            for (std::size_t k = 0; k < scaled.size(); ++k)
+                scaled[k] = r.errors.gain * r.prediction[k];
+            mg[info(r.model).key] = scaled;
+        }
+        s["models"] = ms;         // each model / its maximum (the paper's Fig. 10)
+        s["models_gain"] = mg;    // K · model with the optimal gain K (compare with `data`)
         j["series"] = s;
     }
     return j;

@@ -61,22 +61,24 @@ def _title(result):
     return result.get("name") or "BRDF table"
 
 
-def sorted_series(result, model):
-    """(data, model) normalised brightness sorted by increasing measured value, or None."""
+def sorted_series(result, model, gain=False):
+    """(data, model) brightness sorted by increasing measured value, or None when the model is
+    unavailable. Both are divided by their maxima (the paper's Fig. 10), or with gain=True the
+    model is scaled by the optimal gain instead (what the least-squares fits minimise)."""
     series = result.get("series")
     if not series:
         raise ValueError("the comparison has no 'series' (compute it with series=True)")
     data = np.asarray(series["data"], float)
-    pred = series["models"].get(model)
+    pred = series["models_gain" if gain else "models"].get(model)
     if pred is None:
         return None
     order = np.argsort(data, kind="stable")
     return data[order], np.asarray(pred, float)[order]
 
 
-def draw_fig10_panel(ax, result, model, show_error=True):
+def draw_fig10_panel(ax, result, model, show_error=True, gain=False):
     """One Fig. 10 panel: data dashed, model solid, index sorted by increasing data."""
-    s = sorted_series(result, model)
+    s = sorted_series(result, model, gain)
     label = LABELS.get(model, model)
     if s is None:
         reason = result["models"][model].get("reason") or "unavailable"
@@ -89,13 +91,14 @@ def draw_fig10_panel(ax, result, model, show_error=True):
     idx = np.arange(1, data.size + 1)
     ax.plot(idx, pred, "-", color="C0", lw=1.0, label=label)
     ax.plot(idx, data, "--", color="k", lw=1.0, label="data")
-    ax.set_ylim(-0.05, 1.05)
+    ax.set_ylim(-0.05, max(1.05, float(np.max(pred)) * 1.05))
     ax.set_xlim(0, data.size + 1)
     text = label
     if show_error:
-        sse = result["sse"].get(model)
-        if sse is not None:
-            text += f"  (Table-4 error {sse:.3f})"
+        key, name = ("sse_gain", "SSE") if gain else ("sse", "Table-4 error")
+        err = result[key].get(model)
+        if err is not None:
+            text += f"  ({name} {err:.3f})"
     ax.set_title(text, fontsize=8)
     ax.tick_params(labelsize=7)
 
@@ -112,8 +115,9 @@ def _wrap(text, width):
     return "\n".join(lines[:6])
 
 
-def fig10(result, path, models=PAPER_MODELS):
-    """Fig. 10 for one comparison (dict with 'series'): one panel per model."""
+def fig10(result, path, models=PAPER_MODELS, gain=False):
+    """Fig. 10 for one comparison (dict with 'series'): one panel per model. gain=True plots each
+    model times its optimal gain instead of divided by its maximum."""
     plt = _pyplot()
     n = len(models)
     cols = 3 if n > 4 else n
@@ -121,14 +125,16 @@ def fig10(result, path, models=PAPER_MODELS):
     fig, axes = plt.subplots(rows, cols, figsize=(3.2 * cols, 2.4 * rows), squeeze=False,
                              dpi=110)
     for k, model in enumerate(models):
-        draw_fig10_panel(axes[k // cols][k % cols], result, model)
+        draw_fig10_panel(axes[k // cols][k % cols], result, model, gain=gain)
     for k in range(n, rows * cols):
         axes[k // cols][k % cols].axis("off")
     for ax in axes[-1]:
         ax.set_xlabel("data index (sorted by measured brightness)", fontsize=7)
     for row in axes:
         row[0].set_ylabel("normalised brightness", fontsize=7)
-    fig.suptitle(_title(result) + ": data (dashed) and models (solid)", fontsize=9)
+    fig.suptitle(_title(result) + ": data (dashed) and models (solid"
+                 + (", times the optimal gain)" if gain else ", divided by their maxima)"),
+                 fontsize=9)
     fig.tight_layout()
     _save(fig, path)
     plt.close(fig)
