@@ -148,6 +148,10 @@ def test_table4_error_is_the_documented_sum_recomputed_with_numpy(db):
     assert r["sse"]["vh_exponential"] == pytest.approx(expected, rel=1e-12)
     assert np.allclose(s["models"]["vh_exponential"], model / model.max(), rtol=1e-12)
     assert np.allclose(s["data"], data / data.max(), rtol=1e-12)
+    # the gain-scaled series reproduces the SSE after the optimal gain
+    gained = np.asarray(s["models_gain"]["vh_exponential"])
+    assert np.sum((gained - np.asarray(s["data"])) ** 2) == pytest.approx(
+        r["sse_gain"]["vh_exponential"], rel=1e-10)
     e = curet.error_measures(model, data)
     assert e["sse"] == pytest.approx(expected, rel=1e-12)
     assert e["rmse"] == pytest.approx(math.sqrt(expected / 205), rel=1e-12)
