@@ -9,7 +9,8 @@
 //                            rough surfaces), × radiometric factor, at wavelength λ.
 // Solved with Ceres (Levenberg–Marquardt, dense QR) on the logarithms of the parameters (which
 // keeps them positive and makes the problem better scaled), with bounds and an optional robust
-// loss. The covariance of the parameters comes from ceres::Covariance at the solution, scaled by
+// loss. The covariance of the parameters is (JᵀJ)⁻¹ from an SVD of the Jacobian at the solution
+// (rank deficiency is reported, not printed), scaled by
 // the residual variance SSE/(N − p) unless scale_covariance = false (then the weights must be
 // 1/variance of the residuals), and is mapped to natural units by the delta method.
 //
