@@ -491,6 +491,13 @@ std::string normalize_name(std::string_view name) {
     return out;
 }
 
+bool given(const CLI::Option* option) { return option != nullptr && option->count() > 0; }
+
+CLI::Option* add_factor_option(CLI::App& app, GeometricFactor& factor) {
+    return add_enum_option(app, "--factor", factor, parse_geometric_factor,
+                           "Geometric factor: vh (default), beckmann, ogilvy, kirchhoff");
+}
+
 // ---------------------------------------------------------------------------------------------
 // Human-readable output
 

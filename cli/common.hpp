@@ -23,6 +23,7 @@
 #include <vector>
 
 #include "roughscope/errors.hpp"
+#include "roughscope/scattering.hpp"
 
 namespace roughscope::cli {
 
@@ -152,6 +153,9 @@ CLI::Option* add_non_negative_option(CLI::App& app, const std::string& flag, dou
 CLI::Option* add_range_option(CLI::App& app, const std::string& flag, double& value, double lo,
                               double hi, const std::string& description);
 
+// True if the option exists and was given on the command line.
+bool given(const CLI::Option* option);
+
 // Validators usable with Option::check (they parse the string strictly).
 CLI::Validator polar_angle_validator();
 CLI::Validator finite_validator();
@@ -181,6 +185,9 @@ CLI::Option* add_enum_option(CLI::App& app, const std::string& flag, Enum& var, 
         description);
     return opt;
 }
+
+// --factor: the geometric factor (vh by default), shared by `model` and `estimate`.
+CLI::Option* add_factor_option(CLI::App& app, GeometricFactor& factor);
 
 // ---------------------------------------------------------------------------------------------
 // Human-readable output

@@ -67,8 +67,6 @@ struct Args {
         *o_table_channel{}, *o_threads{}, *o_pair{};
 };
 
-bool given(const CLI::Option* o) { return o && o->count() > 0; }
-
 // ASCII labels for the aligned text table (print_table counts bytes).
 std::string ascii(std::string_view s) {
     std::string out;

@@ -27,8 +27,6 @@
 namespace roughscope::cli {
 namespace {
 
-bool given(const CLI::Option* o) { return o != nullptr && o->count() > 0; }
-
 // Correlation choice of `estimate slope` / `estimate fit`: one, or both side by side.
 enum class CorrelationChoice { Gaussian, Exponential, Both };
 
@@ -121,6 +119,22 @@ void add_output_options(CLI::App& cmd, OutputArgs& o) {
     o.o_output = cmd.add_option("--output", o.output_path,
                                 "Write the result to FILE atomically instead of stdout")
                      ->group("Output");
+}
+
+// Options that read the same in several subcommands.
+CLI::Option* add_wavelength_option(CLI::App& cmd, double& wavelength_um) {
+    return add_positive_option(cmd, "--wavelength", wavelength_um,
+                               "Mean wavelength lambda (um; default 0.555)", "um");
+}
+
+CLI::Option* add_noise_option(CLI::App& cmd, double& noise) {
+    return add_non_negative_option(cmd, "--noise", noise,
+                                   "Relative 1-sigma noise of each brightness value");
+}
+
+CLI::Option* add_pair_radiometry_option(CLI::App& cmd, Radiometry& radiometry) {
+    return add_enum_option(cmd, "--radiometry", radiometry, parse_radiometry,
+                           "radiance (default) or intensity (matters only with theta_s > 0)");
 }
 
 void emit(const OutputArgs& o, const json& record) {
@@ -610,8 +624,7 @@ void register_estimate(CLI::App& app) {
                         ->group(g);
         a.o_theta = add_angle_option(*cmd, "--theta", a.theta_deg,
                                      "Specular angle theta = theta_i = theta_s, degrees [0,90)");
-        add_positive_option(*cmd, "--wavelength", a.wavelength_um,
-                            "Mean wavelength lambda (um; default 0.555)", "um");
+        add_wavelength_option(*cmd, a.wavelength_um);
         add_positive_option(*cmd, "--r0", a.r0,
                             "Specular reflectance R0 of the smooth surface, on the scale of "
                             "R_spec (default 1)");
@@ -637,18 +650,14 @@ void register_estimate(CLI::App& app) {
                                                    "um");
         add_ratio_options(*cmd, a.ratio);
         add_pair_options(*cmd, a.pair);
-        add_positive_option(*cmd, "--wavelength", a.wavelength_um,
-                            "Mean wavelength lambda (um; default 0.555)", "um");
-        add_enum_option(*cmd, "--factor", a.factor, parse_geometric_factor,
-                        "Geometric factor: vh (default), beckmann, ogilvy, kirchhoff");
+        add_wavelength_option(*cmd, a.wavelength_um);
+        add_factor_option(*cmd, a.factor);
         add_enum_option(*cmd, "--correlation", a.correlation, parse_correlation,
                         "gaussian (default; Eq. 15) or exponential (numeric)");
         add_enum_option(*cmd, "--regime", a.regime, parse_regime,
                         "slightly_rough (default, Eq. 3), series or auto (exact series)");
-        add_enum_option(*cmd, "--radiometry", a.radiometry, parse_radiometry,
-                        "radiance (default) or intensity (matters only with theta_s > 0)");
-        a.o_noise = add_non_negative_option(*cmd, "--noise", a.noise,
-                                            "Relative 1-sigma noise of each brightness value");
+        add_pair_radiometry_option(*cmd, a.radiometry);
+        a.o_noise = add_noise_option(*cmd, a.noise);
         add_output_options(*cmd, a.out);
         cmd->callback([args]() { run_correlation_length(*args); });
     }
@@ -663,14 +672,11 @@ void register_estimate(CLI::App& app) {
             "(Eq. 16-19; any geometry via the numeric solver)");
         add_ratio_options(*cmd, a.ratio);
         add_pair_options(*cmd, a.pair);
-        add_enum_option(*cmd, "--factor", a.factor, parse_geometric_factor,
-                        "Geometric factor: vh (default), beckmann, ogilvy, kirchhoff");
+        add_factor_option(*cmd, a.factor);
         add_enum_option(*cmd, "--correlation", a.correlation, parse_correlation_choice,
                         "both (default), gaussian (Eq. 17) or exponential (Eq. 19)");
-        add_enum_option(*cmd, "--radiometry", a.radiometry, parse_radiometry,
-                        "radiance (default) or intensity (matters only with theta_s > 0)");
-        a.o_noise = add_non_negative_option(*cmd, "--noise", a.noise,
-                                            "Relative 1-sigma noise of each brightness value");
+        add_pair_radiometry_option(*cmd, a.radiometry);
+        a.o_noise = add_noise_option(*cmd, a.noise);
         a.o_sigma = add_positive_option(*cmd, "--sigma", a.sigma_um,
                                         "RMS height if known (um): adds T, g and the class", "um");
         add_positive_option(*cmd, "--wavelength", a.wavelength_um,
@@ -695,8 +701,7 @@ void register_estimate(CLI::App& app) {
                         "very_rough (default: sigma/T) or slightly_rough (sigma and T)");
         add_enum_option(*cmd, "--correlation", a.correlation, parse_correlation_choice,
                         "both (default: fit both, compare by AIC), gaussian or exponential");
-        add_enum_option(*cmd, "--factor", a.factor, parse_geometric_factor,
-                        "Geometric factor: vh (default), beckmann, ogilvy, kirchhoff");
+        add_factor_option(*cmd, a.factor);
         add_enum_option(*cmd, "--radiometry", a.radiometry, parse_radiometry,
                         "radiance (default) or intensity");
         a.o_regime = add_enum_option(*cmd, "--regime", a.regime, parse_regime,

@@ -80,8 +80,6 @@ struct Args {
     CLI::Option *o_on_sigma{}, *o_albedo{}, *o_n{}, *o_lobe{}, *o_rho_d{}, *o_output{};
 };
 
-bool given(const CLI::Option* o) { return o != nullptr && o->count() > 0; }
-
 // One evaluation point: the geometry (absent when L or V is below the horizon) and the angles
 // to report.
 struct Point {
@@ -603,9 +601,7 @@ void register_model(CLI::App& app) {
     add_enum_option(*cmd, "--correlation", a.correlation, parse_correlation,
                     "gaussian (default) or exponential")
         ->group(bk);
-    add_enum_option(*cmd, "--factor", a.factor, parse_geometric_factor,
-                    "Geometric factor: vh (default), beckmann, ogilvy, kirchhoff")
-        ->group(bk);
+    add_factor_option(*cmd, a.factor)->group(bk);
     add_enum_option(*cmd, "--regime", a.regime, parse_regime,
                     "auto (default), series, slightly_rough, very_rough, "
                     "very_rough_series_limit ('-' or '_')")

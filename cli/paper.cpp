@@ -41,8 +41,6 @@ struct Args {
     CLI::Option* o_output{};
 };
 
-bool given_output(const Args& a) { return a.o_output != nullptr && a.o_output->count() > 0; }
-
 double half_unit(int decimals) { return 0.5 * std::pow(10.0, -decimals); }
 
 // One recomputed quantity against its printed value.
@@ -116,6 +114,27 @@ double num_at(const json& j, const char* key, const std::string& where) {
     if (!v.is_number())
         throw roughscope::DataError(where + ": key '" + key + "' is not a number");
     return v.get<double>();
+}
+
+// σ/T recomputed by Eq. 17 (Gaussian) and Eq. 19 (exponential) from the printed E1/E2 (given to
+// `ratio_decimals` decimals) at θ1, θ2, against the row's printed sigma_over_T_G / _E (4 decimals).
+struct SlopeChecks {
+    Check gaussian, exponential;
+};
+
+SlopeChecks check_slope_ratios(const json& row, const std::string& where, double ratio,
+                               int ratio_decimals, double theta1_rad, double theta2_rad) {
+    const Check cg = check(num_at(row, "sigma_over_T_G", where), 4, {ratio}, {ratio_decimals},
+                           [&](const std::vector<double>& x) {
+                               return sigma_over_T_gaussian_from_ratio(x[0], theta1_rad,
+                                                                       theta2_rad);
+                           });
+    const Check ce = check(num_at(row, "sigma_over_T_E", where), 4, {ratio}, {ratio_decimals},
+                           [&](const std::vector<double>& x) {
+                               return sigma_over_T_exponential_from_ratio(x[0], theta1_rad,
+                                                                          theta2_rad);
+                           });
+    return {cg, ce};
 }
 
 json load_reference(const fs::path& path) {
@@ -196,14 +215,8 @@ void run_tables(const Args& a) {
         for (const auto& row : need(t, "rows", where + ": table2")) {
             const std::string w = where + ": table2 row";
             const double r = num_at(row, "E1_over_E2", w);
-            const double sG = num_at(row, "sigma_over_T_G", w);
-            const Check cg = check(sG, 4, {r}, {3}, [&](const std::vector<double>& x) {
-                return sigma_over_T_gaussian_from_ratio(x[0], t1, t2);
-            });
-            const Check ce = check(num_at(row, "sigma_over_T_E", w), 4, {r}, {3},
-                                   [&](const std::vector<double>& x) {
-                                       return sigma_over_T_exponential_from_ratio(x[0], t1, t2);
-                                   });
+            const auto [cg, ce] = check_slope_ratios(row, w, r, 3, t1, t2);
+            const double sG = cg.printed;
             const Check ck = check(num_at(row, "theta_K_deg", w), 0, {sG}, {4},
                                    [&](const std::vector<double>& x) {
                                        return rad_to_deg(caron_theta_K_rad(x[0]));
@@ -245,14 +258,7 @@ void run_tables(const Args& a) {
         for (const auto& row : need(t, "rows", where + ": table3")) {
             const std::string w = where + ": table3 row";
             const double r = num_at(row, "E1_over_E2", w);
-            const Check cg = check(num_at(row, "sigma_over_T_G", w), 4, {r}, {6},
-                                   [&](const std::vector<double>& x) {
-                                       return sigma_over_T_gaussian_from_ratio(x[0], t1, t2);
-                                   });
-            const Check ce = check(num_at(row, "sigma_over_T_E", w), 4, {r}, {6},
-                                   [&](const std::vector<double>& x) {
-                                       return sigma_over_T_exponential_from_ratio(x[0], t1, t2);
-                                   });
+            const auto [cg, ce] = check_slope_ratios(row, w, r, 6, t1, t2);
             std::string name = need(row, "name", w).get<std::string>();
             if (row.contains("sample")) name += " (" + std::to_string(row["sample"].get<int>()) + ")";
             rows.push_back({{"sample", name},
@@ -271,7 +277,7 @@ void run_tables(const Args& a) {
     text << "\n* recomputed from the printed inputs.  = same at the printed digits;  ~ within the "
             "rounding of the printed inputs;  DIFFERS otherwise.\n";
 
-    write_output(given_output(a) ? std::optional<fs::path>(a.output_path) : std::nullopt,
+    write_output(given(a.o_output) ? std::optional<fs::path>(a.output_path) : std::nullopt,
                  a.json_output ? dump_json(out) : text.str());
 }
 

@@ -265,6 +265,23 @@ void set_standard_errors(ModelResult& r) {
     for (std::size_t a = 0; a < k; ++a) r.parameters[a].standard_error = std::sqrt(r.covariance[a * k + a]);
 }
 
+// The end of every fit at its minimum θ (gain K, SSE `sse`, prediction M): covariance and
+// standard errors when available, the prediction and its error measures.
+template <class Eval>
+void finish_fit(const Prepared& p, ModelResult& r, Eval&& eval, const std::vector<double>& theta,
+                const std::vector<double>& lo, const std::vector<double>& hi, double K,
+                double sse, const std::vector<double>& M) {
+    std::vector<double> cov;
+    if (covariance(p, eval, theta, lo, hi, K, sse, cov)) {
+        r.covariance = cov;
+        set_standard_errors(r);
+    } else {
+        r.fit_message += "; covariance unavailable (singular Jacobian or too few measurements)";
+    }
+    r.prediction = M;
+    r.errors = measures(p, M);
+}
+
 // One-parameter family (σ/T or n) with a positive parameter, searched in log space.
 template <class Eval>
 void fit_positive_parameter(const Prepared& p, ModelResult& r, const char* name, double lo,
@@ -290,15 +307,7 @@ void fit_positive_parameter(const Prepared& p, ModelResult& r, const char* name,
     auto eval_vec = [&](const std::vector<double>& t, std::vector<double>& out) {
         eval_param(t[0], out);
     };
-    std::vector<double> cov;
-    if (covariance(p, eval_vec, {value}, {lo}, {hi}, K, sse, cov)) {
-        r.covariance = cov;
-        set_standard_errors(r);
-    } else {
-        r.fit_message += "; covariance unavailable (singular Jacobian or too few measurements)";
-    }
-    r.prediction = M;
-    r.errors = measures(p, M);
+    finish_fit(p, r, eval_vec, {value}, {lo}, {hi}, K, sse, M);
 }
 
 // Oren–Nayar (σ, ρ) with gain. L = ρ A(σ) + ρ² B(σ) (L1 ∝ ρ, L2 ∝ ρ², models.hpp); A and B
@@ -352,15 +361,7 @@ void fit_oren_nayar(const Prepared& p, ModelResult& r, double sigma_max) {
     auto eval_vec = [&](const std::vector<double>& t, std::vector<double>& out) {
         oren_nayar_prediction(p, {t[0], t[1]}, out);
     };
-    std::vector<double> cov;
-    if (covariance(p, eval_vec, {sigma, rho}, {0.0, kRhoMin}, {sigma_max, 1.0}, K, sse, cov)) {
-        r.covariance = cov;
-        set_standard_errors(r);
-    } else {
-        r.fit_message += "; covariance unavailable (singular Jacobian or too few measurements)";
-    }
-    r.prediction = M;
-    r.errors = measures(p, M);
+    finish_fit(p, r, eval_vec, {sigma, rho}, {0.0, kRhoMin}, {sigma_max, 1.0}, K, sse, M);
 }
 
 // ---------------------------------------------------------------------------------------------

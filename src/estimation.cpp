@@ -253,26 +253,41 @@ double d_sigma_over_T_exponential_d_log_ratio(double E1_over_E2, double theta1_r
     return (p.a1 - p.a2) * K / (3.0 * s * (K - 1.0) * (K - 1.0));
 }
 
+namespace {
+
+// Eq. 15 at the solution: T, its terms and the numerator N = (T²/4)(v_xy2² − v_xy1²).
+struct Eq15Solution {
+    double T;
+    Eq15 e;
+    double N;
+};
+
+Eq15Solution eq15_solution(double E1_over_E2, double sigma_um, double theta1_rad,
+                           double theta2_rad, double wavelength_um, GeometricFactor factor) {
+    const double T = correlation_length_from_ratio(E1_over_E2, sigma_um, theta1_rad, theta2_rad,
+                                                   wavelength_um, factor);
+    const Eq15 e = eq15_terms(sigma_um, theta1_rad, theta2_rad, wavelength_um, factor);
+    return {T, e, T * T / 4.0 * (e.t2.vxy2 - e.t1.vxy2)};
+}
+
+}  // namespace
+
 // Eq. 15: T = 2 (N/D)^{1/2}, dN/d ln r = 1 ⇒ dT/d ln r = T/(2N).
 double d_correlation_length_d_log_ratio(double E1_over_E2, double sigma_um, double theta1_rad,
                                         double theta2_rad, double wavelength_um,
                                         GeometricFactor factor) {
-    const double T = correlation_length_from_ratio(E1_over_E2, sigma_um, theta1_rad, theta2_rad,
-                                                   wavelength_um, factor);
-    const Eq15 e = eq15_terms(sigma_um, theta1_rad, theta2_rad, wavelength_um, factor);
-    const double N = T * T / 4.0 * (e.t2.vxy2 - e.t1.vxy2);
-    return T / (2.0 * N);
+    const Eq15Solution s =
+        eq15_solution(E1_over_E2, sigma_um, theta1_rad, theta2_rad, wavelength_um, factor);
+    return s.T / (2.0 * s.N);
 }
 
 // Eq. 15: dN/dσ = 2σ(v_z1² − v_z2²) (ζ does not depend on σ) ⇒ dT/dσ = Tσ(v_z1² − v_z2²)/N.
 double d_correlation_length_d_sigma(double E1_over_E2, double sigma_um, double theta1_rad,
                                     double theta2_rad, double wavelength_um,
                                     GeometricFactor factor) {
-    const double T = correlation_length_from_ratio(E1_over_E2, sigma_um, theta1_rad, theta2_rad,
-                                                   wavelength_um, factor);
-    const Eq15 e = eq15_terms(sigma_um, theta1_rad, theta2_rad, wavelength_um, factor);
-    const double N = T * T / 4.0 * (e.t2.vxy2 - e.t1.vxy2);
-    return T * sigma_um * (e.t1.vz2 - e.t2.vz2) / N;
+    const Eq15Solution s =
+        eq15_solution(E1_over_E2, sigma_um, theta1_rad, theta2_rad, wavelength_um, factor);
+    return s.T * sigma_um * (s.e.t1.vz2 - s.e.t2.vz2) / s.N;
 }
 
 // Eq. 13: σ = c [ln(R0/R)]^{1/2} ⇒ dσ/dR = −σ/(2 R ln(R0/R)).
