@@ -18,6 +18,7 @@
 #include <algorithm>
 #include <array>
 #include <atomic>
+#include <bit>
 #include <cmath>
 #include <cstdint>
 #include <exception>
@@ -295,16 +296,17 @@ constexpr std::array<RoughnessClass, 3> kRoughnessClasses = {
 // =============================================================================================
 //
 // Same physics as roughscope::very_rough_brightness (Eq. 4 / Eq. 5 shapes of beckmann.hpp times
-// the radiometric factor), evaluated in blocks of kBlock elements: each block is loaded and
-// validated (branch-free), the sines and cosines are taken by glibc's vector math library
-// (AVX-512 8 lanes or AVX2 4 lanes, ≤ 4 ulp) when the CPU has it, std:: otherwise, and the rest
-// is arithmetic that GCC auto-vectorises for the same instruction set, with
+// the radiometric factor), evaluated in blocks of kBlock elements: each block is validated
+// (branch-free) in the same pass that computes it; sines and cosines come from short polynomials
+// on the validated ranges (below), the exponential from glibc's vector math library (AVX-512 8
+// lanes or AVX2 4 lanes) when the CPU has it, std:: otherwise, and the rest is arithmetic that
+// GCC auto-vectorises for the same instruction set, with
 //   q_xy² = (sin θi − sin θs)² + 4 sin θi sin θs sin²(φs/2)   (= sin²θi + sin²θs − 2 sinθi sinθs
 //   cos φs, written without cancellation), q_z² = (cos θi + cos θs)².
 
 // Instruction sets the kernel is compiled for; the best one the CPU has is picked at run time.
 enum class Isa { Generic, Avx2, Avx512 };
-enum class MathFn { Sin, Cos, Exp, Sqrt };
+enum class MathFn { Exp, InvPow32 };  // e^x; x^(−3/2) for x > 0
 
 template <class Fn>
 inline void apply_scalar(Fn fn, const double* x, double* y, ssize_t n) {
@@ -313,21 +315,21 @@ inline void apply_scalar(Fn fn, const double* x, double* y, ssize_t n) {
 
 void apply_generic(MathFn fn, const double* x, double* y, ssize_t n) {
     switch (fn) {
-        case MathFn::Sin: return apply_scalar([](double v) { return std::sin(v); }, x, y, n);
-        case MathFn::Cos: return apply_scalar([](double v) { return std::cos(v); }, x, y, n);
         case MathFn::Exp: return apply_scalar([](double v) { return std::exp(v); }, x, y, n);
-        case MathFn::Sqrt: return apply_scalar([](double v) { return std::sqrt(v); }, x, y, n);
+        case MathFn::InvPow32:
+            return apply_scalar([](double v) { return 1.0 / (v * std::sqrt(v)); }, x, y, n);
     }
 }
 
 #if ROUGHSCOPE_HAVE_LIBMVEC
-// glibc's libmvec (linked through libm): AVX2 4-lane and AVX-512 8-lane sin, cos, exp, ≤ 4 ulp.
+// glibc's libmvec (linked through libm): AVX2 4-lane and AVX-512 8-lane exp, ≤ 4 ulp.
 #pragma GCC push_options
 #pragma GCC target("avx2,fma")
-extern "C" __m256d _ZGVdN4v_sin(__m256d);
-extern "C" __m256d _ZGVdN4v_cos(__m256d);
 extern "C" __m256d _ZGVdN4v_exp(__m256d);
-__m256d sqrt_avx2(__m256d x) { return _mm256_sqrt_pd(x); }  // IEEE, correctly rounded
+// x^(−3/2) = 1/(x √x), IEEE sqrt and division.
+__m256d inv_pow32_avx2(__m256d x) {
+    return _mm256_div_pd(_mm256_set1_pd(1.0), _mm256_mul_pd(x, _mm256_sqrt_pd(x)));
+}
 
 template <__m256d (*Fn)(__m256d)>
 void apply_avx2_fn(const double* x, double* y, ssize_t n) {
@@ -343,20 +345,28 @@ void apply_avx2_fn(const double* x, double* y, ssize_t n) {
 
 void apply_avx2(MathFn fn, const double* x, double* y, ssize_t n) {
     switch (fn) {
-        case MathFn::Sin: return apply_avx2_fn<_ZGVdN4v_sin>(x, y, n);
-        case MathFn::Cos: return apply_avx2_fn<_ZGVdN4v_cos>(x, y, n);
         case MathFn::Exp: return apply_avx2_fn<_ZGVdN4v_exp>(x, y, n);
-        case MathFn::Sqrt: return apply_avx2_fn<sqrt_avx2>(x, y, n);
+        case MathFn::InvPow32: return apply_avx2_fn<inv_pow32_avx2>(x, y, n);
     }
 }
 #pragma GCC pop_options
 
 #pragma GCC push_options
 #pragma GCC target("avx512f")
-extern "C" __m512d _ZGVeN8v_sin(__m512d);
-extern "C" __m512d _ZGVeN8v_cos(__m512d);
 extern "C" __m512d _ZGVeN8v_exp(__m512d);
-__m512d sqrt_avx512(__m512d x) { return _mm512_maskz_sqrt_pd(0xFF, x); }  // IEEE, correctly rounded
+// x^(−3/2) without the divider (its sqrt + div cost ~10% of the Eq. 5 kernel): y ≈ 1/√x from
+// vrsqrt14pd (relative error < 2^−14), two Newton steps y += y (1 − x y²)/2 (error ~1.5 e² each,
+// then rounding: a few ulp), then y³. x = +inf gives 0 (as 1/(x √x) does), NaN stays NaN.
+__m512d inv_pow32_avx512(__m512d x) {
+    const __m512d one = _mm512_set1_pd(1.0), half = _mm512_set1_pd(0.5);
+    __m512d y = _mm512_maskz_rsqrt14_pd(0xFF, x);  // (maskz: no uninitialised-operand warning)
+    for (int step = 0; step < 2; ++step) {
+        const __m512d r = _mm512_fnmadd_pd(_mm512_mul_pd(x, y), y, one);  // 1 − x y²
+        y = _mm512_fmadd_pd(_mm512_mul_pd(half, y), r, y);
+    }
+    y = _mm512_maskz_mov_pd(_mm512_cmp_pd_mask(x, _mm512_set1_pd(HUGE_VAL), _CMP_NEQ_UQ), y);
+    return _mm512_mul_pd(_mm512_mul_pd(y, y), y);
+}
 
 template <__m512d (*Fn)(__m512d)>
 void apply_avx512_fn(const double* x, double* y, ssize_t n) {
@@ -370,10 +380,8 @@ void apply_avx512_fn(const double* x, double* y, ssize_t n) {
 
 void apply_avx512(MathFn fn, const double* x, double* y, ssize_t n) {
     switch (fn) {
-        case MathFn::Sin: return apply_avx512_fn<_ZGVeN8v_sin>(x, y, n);
-        case MathFn::Cos: return apply_avx512_fn<_ZGVeN8v_cos>(x, y, n);
         case MathFn::Exp: return apply_avx512_fn<_ZGVeN8v_exp>(x, y, n);
-        case MathFn::Sqrt: return apply_avx512_fn<sqrt_avx512>(x, y, n);
+        case MathFn::InvPow32: return apply_avx512_fn<inv_pow32_avx512>(x, y, n);
     }
 }
 #pragma GCC pop_options
@@ -448,21 +456,66 @@ void validate_very_rough(const VeryRoughInputs& in, ssize_t begin, ssize_t end, 
     }
 }
 
-// dst[j] = src[(start + j) * step] * scale for j < n, step 0 (one value) or 1 (contiguous).
-[[gnu::always_inline]] inline void load_block(const double* __restrict src, ssize_t step,
-                                              ssize_t start, ssize_t n, double scale,
-                                              double* __restrict dst) {
-    if (step == 0) {
-        const double v = src[0] * scale;
-        for (ssize_t j = 0; j < n; ++j) dst[j] = v;
-    } else {
-        src += start;
-        for (ssize_t j = 0; j < n; ++j) dst[j] = src[j] * scale;
-    }
+// sin x and cos x for |x| <= π/4 (fdlibm's __kernel_sin / __kernel_cos minimax polynomials, ~1 ulp).
+[[gnu::always_inline]] inline double kernel_sin(double x) {
+    constexpr double S1 = -1.66666666666666324348e-01, S2 = 8.33333333332248946124e-03,
+                     S3 = -1.98412698298579493134e-04, S4 = 2.75573137070700676789e-06,
+                     S5 = -2.50507602534068634195e-08, S6 = 1.58969099521155010221e-10;
+    const double z = x * x;
+    const double r = S2 + z * (S3 + z * (S4 + z * (S5 + z * S6)));
+    return x + (z * x) * (S1 + z * r);
+}
+[[gnu::always_inline]] inline double kernel_cos(double x) {
+    constexpr double C1 = 4.16666666666666019037e-02, C2 = -1.38888888888741095749e-03,
+                     C3 = 2.48015872894767294178e-05, C4 = -2.75573143513906633035e-07,
+                     C5 = 2.08757232129817482790e-09, C6 = -1.13596475577881948265e-11;
+    const double z = x * x;
+    // 1 + z q with q = −1/2 + z (C1 + ...): the last step (an FMA where the ISA has one) adds
+    // |z q| <= 0.31 to 1, so the result (>= 0.7) is within ~1 ulp.
+    const double q = -0.5 + z * (C1 + z * (C2 + z * (C3 + z * (C4 + z * (C5 + z * C6)))));
+    return 1.0 + z * q;
+}
+// c ? a : b for doubles as a bitwise select: both sides are evaluated, so GCC cannot sink them
+// into a branch (which, under -ftrapping-math, it would then not if-convert and the loop would
+// stay scalar on AVX2 and SSE2).
+[[gnu::always_inline]] inline double select(bool c, double a, double b) {
+    const std::uint64_t mask = -static_cast<std::uint64_t>(c);
+    return std::bit_cast<double>((std::bit_cast<std::uint64_t>(a) & mask) |
+                                 (std::bit_cast<std::uint64_t>(b) & ~mask));
+}
+// π/2 = kPio2Hi + kPio2Lo; kPio2Hi − x is exact for x in [π/4, π/2] (Sterbenz).
+constexpr double kPio2Hi = 1.57079632679489655800e+00, kPio2Lo = 6.12323399573676603587e-17;
+
+// sin θ and cos θ for a polar angle θ in [0, π/2] (what validation admits): one reduction to
+// |y| <= π/4 and both kernels, branch-free (vectorises), no general range reduction.
+[[gnu::always_inline]] inline void polar_sincos(double theta, double& s, double& c) {
+    const bool upper = theta > 0.25 * kPi;
+    const double y = select(upper, (kPio2Hi - theta) + kPio2Lo, theta);
+    const double sy = kernel_sin(y), cy = kernel_cos(y);
+    s = select(upper, cy, sy);
+    c = select(upper, sy, cy);
 }
 
-// Brightness for elements [begin, end), one block at a time (each block validated first). Inlined into
-// one wrapper per instruction set so that the arithmetic loops are auto-vectorised for it.
+// sin²(φ/2) for φ in degrees already reduced to |φ| <= 180 (+ rounding): x = |φ|/2 in radians is
+// in [0, π/2]; sin² x = s² (x <= π/4) or cos² y = 1 − sin² y with y = π/2 − x (>= 1/2, no
+// cancellation). One polynomial.
+[[gnu::always_inline]] inline double sin2_half_azimuth(double phi_reduced_deg) {
+    constexpr double kHalfRadPerDeg = kPi / 360.0;
+    const double x = __builtin_fabs(phi_reduced_deg) * kHalfRadPerDeg;
+    const bool upper = x > 0.25 * kPi;
+    const double y = select(upper, (kPio2Hi - x) + kPio2Lo, x);  // may be ~−1e-16: sin² is even
+    const double s = kernel_sin(y), s2 = s * s;
+    return select(upper, 1.0 - s2, s2);
+}
+
+// Brightness for elements [begin, end), one block of kBlock elements at a time. Inlined into one
+// wrapper per instruction set so that the loops are auto-vectorised for it. One pass per block
+// reads the inputs where they are (a broadcast scalar is read from a block filled once),
+// validates them (branch-free; nothing is returned unless all are valid) and computes everything
+// but the exponential (Gaussian, libmvec) or w^(−3/2) (exponential); a last pass writes
+// the result. Per element: one reduction and two short polynomials per polar angle (sin and cos
+// together), one polynomial for sin²(φs/2) after an exact reduction of φs modulo 360°, one
+// division at most (Gaussian: 1/q_z²; exponential: none); no general-purpose sin/cos, no pow.
 template <Correlation C, GeometricFactor F, Radiometry R, Isa I>
 [[gnu::always_inline]] inline void very_rough_body(const VeryRoughInputs& in, ssize_t begin,
                                                    ssize_t end, double* __restrict out,
@@ -470,73 +523,107 @@ template <Correlation C, GeometricFactor F, Radiometry R, Isa I>
     constexpr double kRadPerDeg = kPi / 180.0;
     constexpr double kHalfPi = kPi / 2.0;
     constexpr double kMax = std::numeric_limits<double>::max();
-    alignas(64) double ti[kBlock], ts[kBlock], half_phi[kBlock], m2[kBlock];
-    alignas(64) double si[kBlock], ci[kBlock], ss[kBlock], cs[kBlock], sh[kBlock], arg[kBlock];
+    constexpr double kRound = 0x1.8p52;  // (x + kRound) − kRound = nearest integer, |x| < 2^51
+    constexpr double kWide = 0x1p44;     // |φs| below this: φs − 360 k is exact
+    // km = 1/(4 m²) (Gaussian) or 1/m² (exponential), m = σ/T.
+    constexpr double kM = C == Correlation::Gaussian ? 0.25 : 1.0;
+    alignas(64) double km[kBlock], pref[kBlock], arg[kBlock], aux[kBlock];
+    alignas(64) double scalar_ti[kBlock], scalar_ts[kBlock], scalar_p[kBlock], wide_p[kBlock];
+    // Operands repeated over the result (step 0) are read from a block filled once.
+    auto source = [](const double* data, ssize_t step, double* fill) {
+        if (step == 0) std::fill_n(fill, kBlock, data[0]);
+        return step == 0;
+    };
+    const bool ti_rep = source(in.theta_i_deg, in.step_i, scalar_ti);
+    const bool ts_rep = source(in.theta_s_deg, in.step_s, scalar_ts);
+    const bool p_rep = source(in.phi_s_deg, in.step_p, scalar_p);
+    const bool m_rep = in.step_m == 0;
+    const double m0 = in.sigma_over_T[0];
+    const bool m0_bad = !(m0 > 0.0 && m0 <= kMax);
+    if (m_rep) std::fill_n(km, kBlock, kM / (m0 * m0));
     for (ssize_t start = begin; start < end; start += kBlock) {
         const ssize_t n = std::min(kBlock, end - start);
-        load_block(in.theta_i_deg, in.step_i, start, n, kRadPerDeg, ti);
-        load_block(in.theta_s_deg, in.step_s, start, n, kRadPerDeg, ts);
-        load_block(in.sigma_over_T, in.step_m, start, n, 1.0, m2);  // σ/T, squared below
-        load_block(in.phi_s_deg, in.step_p, start, n, 0.5 * kRadPerDeg, half_phi);
-        int wide = 0;
-        for (ssize_t j = 0; j < n; ++j)
-            wide += !(__builtin_fabs(half_phi[j]) < 720.0 * (0.5 * kRadPerDeg));
-        // Validation of the block, branch-free; the library's checks find and report the
-        // first bad element when there is one. Nothing is returned unless all are valid.
-        int bad = 0;
-        for (ssize_t j = 0; j < n; ++j) {
-            const double dp = half_phi[j] - half_phi[j];  // 0 if finite, NaN otherwise
-            bad += static_cast<int>(!(ti[j] >= 0.0) | !(ti[j] < kHalfPi) | !(ts[j] >= 0.0) |
-                                    !(ts[j] < kHalfPi) | !(dp == 0.0) | !(m2[j] > 0.0) |
-                                    !(m2[j] <= kMax));
-        }
-        if (bad) validate_very_rough(in, start, start + n, at);
-        for (ssize_t j = 0; j < n; ++j) m2[j] *= m2[j];
-        if (wide) {  // rare: reduce large azimuths exactly first (keeps sin(φs/2) accurate)
+        const double* __restrict ti_deg = ti_rep ? scalar_ti : in.theta_i_deg + start;
+        const double* __restrict ts_deg = ts_rep ? scalar_ts : in.theta_s_deg + start;
+        const double* __restrict p_deg = p_rep ? scalar_p : in.phi_s_deg + start;
+        int bad = m_rep && m0_bad;
+        if (!m_rep) {
+            const double* __restrict m = in.sigma_over_T + start;
             for (ssize_t j = 0; j < n; ++j) {
-                const double p = in.phi_s_deg[(start + j) * in.step_p];
-                half_phi[j] = std::fmod(p, 360.0) * (0.5 * kRadPerDeg);
+                bad += static_cast<int>(!(m[j] > 0.0) | !(m[j] <= kMax));
+                km[j] = kM / (m[j] * m[j]);
             }
         }
-        apply_math<I>(MathFn::Sin, ti, si, n);
-        apply_math<I>(MathFn::Cos, ti, ci, n);
-        apply_math<I>(MathFn::Sin, ts, ss, n);
-        apply_math<I>(MathFn::Cos, ts, cs, n);
-        apply_math<I>(MathFn::Sin, half_phi, sh, n);
+        // The pass (inlined: it must be compiled for the wrapper's instruction set); `phi_deg`
+        // holds φs, reduced exactly below when |φs| < 2^44.
+        auto pass = [&](const double* __restrict phi_deg) __attribute__((always_inline)) {
+            int bad_here = 0, wide = 0;
+            for (ssize_t j = 0; j < n; ++j) {
+                const double t_i = ti_deg[j] * kRadPerDeg, t_s = ts_deg[j] * kRadPerDeg;
+                const double p = phi_deg[j];
+                const double dp = p - p;  // 0 if finite, NaN otherwise
+                bad_here += static_cast<int>(!(t_i >= 0.0) | !(t_i < kHalfPi) | !(t_s >= 0.0) |
+                                             !(t_s < kHalfPi) | !(dp == 0.0));
+                wide += static_cast<int>(!(__builtin_fabs(p) < kWide));
+                const double k = (p * (1.0 / 360.0) + kRound) - kRound;
+                const double sh2 = sin2_half_azimuth(p - 360.0 * k);  // φs − 360k in [−180, 180]
+                double si, ci, ss, cs;
+                polar_sincos(t_i, si, ci);
+                polar_sincos(t_s, ss, cs);
+                // q_xy² = sin²θi + sin²θs − 2 sinθi sinθs cos φs, without cancellation:
+                const double d = si - ss;
+                const double qxy2 = d * d + 4.0 * si * ss * sh2;
+                const double sum_c = ci + cs;
+                const double qz2 = sum_c * sum_c;
+                double F2;
+                if constexpr (F == GeometricFactor::VernoldHarvey) {
+                    F2 = ci;  // F_VH² = cos θi (§3.2)
+                } else {
+                    // Eq. 6 with cos φs = 1 − 2 sin²(φs/2).
+                    const double cos_phi = 1.0 - 2.0 * sh2;
+                    double f = (1.0 + ci * cs - si * ss * cos_phi) / (ci * sum_c);
+                    if constexpr (F == GeometricFactor::Ogilvy) f *= ci;
+                    if constexpr (F == GeometricFactor::Kirchhoff) f *= ci / cs;
+                    F2 = f * f;
+                }
+                // The radiometric factor 1/cos θs of intensity (§3.3) joins the denominator.
+                if constexpr (C == Correlation::Gaussian) {
+                    // Eq. 4 shape: F²/q_z² exp(−q_xy²/(4 m² q_z²))
+                    if constexpr (R == Radiometry::Intensity) {
+                        const double r = 1.0 / (qz2 * cs);
+                        pref[j] = F2 * r;
+                        arg[j] = -(qxy2 * km[j]) * (cs * r);
+                    } else {
+                        const double r = 1.0 / qz2;
+                        pref[j] = F2 * r;
+                        arg[j] = -(qxy2 * km[j]) * r;
+                    }
+                } else {
+                    // Eq. 5 shape: F²/(q_z² t^{3/2}), t = 1 + q_xy²/(m² q_z²). With w = q_z² t =
+                    // q_z² + q_xy²/m² (> 0, no cancellation) and √q_z² = cos θi + cos θs:
+                    // F²/(q_z² t^{3/2}) = F² (cos θi + cos θs)/(w √w); the root is taken below.
+                    pref[j] = F2 * sum_c;
+                    arg[j] = qz2 + qxy2 * km[j];
+                    if constexpr (R == Radiometry::Intensity) pref[j] /= cs;
+                }
+            }
+            bad += bad_here;
+            return wide;
+        };
+        if (pass(p_deg)) {  // rare: some |φs| >= 2^44 degrees; reduce those with the exact fmod
+            for (ssize_t j = 0; j < n; ++j)
+                wide_p[j] = __builtin_fabs(p_deg[j]) < kWide ? p_deg[j] : std::fmod(p_deg[j], 360.0);
+            pass(wide_p);
+        }
+        // The library's checks find and report the first bad element of the block.
+        if (bad) validate_very_rough(in, start, start + n, at);
         double* __restrict o = out + start;
-        for (ssize_t j = 0; j < n; ++j) {
-            const double d = si[j] - ss[j];
-            const double qxy2 = d * d + 4.0 * si[j] * ss[j] * sh[j] * sh[j];
-            const double sum_c = ci[j] + cs[j];
-            const double qz2 = sum_c * sum_c;
-            double F2;
-            if constexpr (F == GeometricFactor::VernoldHarvey) {
-                F2 = ci[j];  // F_VH² = cos θi (§3.2)
-            } else {
-                // Eq. 6 with cos φs = 1 − 2 sin²(φs/2).
-                const double cos_phi = 1.0 - 2.0 * sh[j] * sh[j];
-                double f = (1.0 + ci[j] * cs[j] - si[j] * ss[j] * cos_phi) / (ci[j] * sum_c);
-                if constexpr (F == GeometricFactor::Ogilvy) f *= ci[j];
-                if constexpr (F == GeometricFactor::Kirchhoff) f *= ci[j] / cs[j];
-                F2 = f * f;
-            }
-            double pref = F2 / qz2;
-            if constexpr (R == Radiometry::Intensity) pref /= cs[j];  // §3.3
-            if constexpr (C == Correlation::Gaussian) {
-                o[j] = pref;  // Eq. 4 shape: F²/q_z² exp(−q_xy²/(4 m² q_z²))
-                arg[j] = -qxy2 / (4.0 * m2[j] * qz2);
-            } else {
-                o[j] = pref;  // Eq. 5 shape: F²/(q_z² t^{3/2}), t = 1 + q_xy²/(m² q_z²)
-                arg[j] = 1.0 + qxy2 / (m2[j] * qz2);
-            }
-        }
         if constexpr (C == Correlation::Gaussian) {
             apply_math<I>(MathFn::Exp, arg, arg, n);
-            for (ssize_t j = 0; j < n; ++j) o[j] *= arg[j];
+            for (ssize_t j = 0; j < n; ++j) o[j] = pref[j] * arg[j];
         } else {
-            double* root = ti;  // ti is no longer needed
-            apply_math<I>(MathFn::Sqrt, arg, root, n);
-            for (ssize_t j = 0; j < n; ++j) o[j] /= arg[j] * root[j];
+            apply_math<I>(MathFn::InvPow32, arg, aux, n);  // w^(−3/2)
+            for (ssize_t j = 0; j < n; ++j) o[j] = pref[j] * aux[j];
         }
     }
 }
