@@ -12,17 +12,17 @@
 //        lambert_baseline/1M            cos θi over 1M random geometries (the baseline)
 //        very_rough/<eq>/<how>/1M       Eq. 4 / Eq. 5 over the same 1M geometries
 // items_per_second counts evaluations; divide times by the baseline's for ratios.
-#include <benchmark/benchmark.h>
-
 #include <cmath>
 #include <random>
 #include <string>
 #include <vector>
 
-#include "roughscope/beckmann.hpp"
-#include "roughscope/geometry.hpp"
-#include "roughscope/models.hpp"
-#include "roughscope/scattering.hpp"
+#include <benchmark/benchmark.h>
+
+#include "roughscope/scattering/beckmann.hpp"
+#include "roughscope/scattering/factors.hpp"
+#include "roughscope/scattering/geometry.hpp"
+#include "roughscope/scattering/reflectance_models.hpp"
 
 namespace {
 
@@ -75,8 +75,8 @@ std::string g_name(double g) {
     for (bool gaussian : {true, false}) {
         const std::string kind = gaussian ? "gaussian" : "exponential";
         for (double g : {1e-3, 1e-1, 1.0, 10.0, 1e2, 7e2, 1e3, 1e4, 1e5, 1e6}) {
-            benchmark::RegisterBenchmark(("series/" + kind + "/g=" + g_name(g)).c_str(),
-                                         BM_series, gaussian, g);
+            benchmark::RegisterBenchmark(("series/" + kind + "/g=" + g_name(g)).c_str(), BM_series,
+                                         gaussian, g);
             if (g <= kNaiveMaxG)
                 benchmark::RegisterBenchmark(("naive/" + kind + "/g=" + g_name(g)).c_str(),
                                              BM_naive, gaussian, g);

@@ -8,15 +8,15 @@
 // Data: ../shared/data/curet relative to the working directory, $ROUGHSCOPE_CURET, or
 // <repo>/../shared/data/curet found from the executable (<repo>/<build>/bin/roughscope_bench).
 // Without it the benchmarks report an error and do nothing.
-#include <benchmark/benchmark.h>
-
 #include <filesystem>
 #include <optional>
 #include <string>
 
-#include "roughscope/comparison.hpp"
-#include "roughscope/curet.hpp"
-#include "roughscope/errors.hpp"
+#include <benchmark/benchmark.h>
+
+#include "roughscope/brdf/comparison.hpp"
+#include "roughscope/brdf/curet.hpp"
+#include "roughscope/core/errors.hpp"
 
 namespace {
 

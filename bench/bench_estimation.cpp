@@ -6,19 +6,19 @@
 // (moderately rough surfaces) is measured too.
 //
 // Fits: 205 measurements (the size of a CUReT sample) at pseudo-random geometries, 1 % noise.
-// Baseline in the same run: an exhaustive 1-D search over σ/T (1000 log-spaced values, gain profiled
-// out — the kind of search the paper uses for the Lafortune exponent, §5.3), which gives no
-// uncertainty; the Ceres fit should be faster and returns the covariance.
-#include <benchmark/benchmark.h>
-
+// Baseline in the same run: an exhaustive 1-D search over σ/T (1000 log-spaced values, gain
+// profiled out — the kind of search the paper uses for the Lafortune exponent, §5.3), which gives
+// no uncertainty; the Ceres fit should be faster and returns the covariance.
 #include <cmath>
 #include <random>
 #include <vector>
 
-#include "roughscope/beckmann.hpp"
-#include "roughscope/estimation.hpp"
-#include "roughscope/fit.hpp"
-#include "roughscope/geometry.hpp"
+#include <benchmark/benchmark.h>
+
+#include "roughscope/estimation/estimation.hpp"
+#include "roughscope/fit/fit.hpp"
+#include "roughscope/scattering/beckmann.hpp"
+#include "roughscope/scattering/geometry.hpp"
 
 namespace {
 
@@ -60,7 +60,8 @@ void BM_SolverNormalView(benchmark::State& state) {
     for (auto _ : state) {
         benchmark::DoNotOptimize(rs::sigma_over_T_two_geometries(r[i++ & 63], g1, g2, c));
     }
-    state.SetLabel(c == rs::Correlation::Gaussian ? "gaussian (vs Eq. 17)" : "exponential (vs Eq. 19)");
+    state.SetLabel(c == rs::Correlation::Gaussian ? "gaussian (vs Eq. 17)"
+                                                  : "exponential (vs Eq. 19)");
 }
 BENCHMARK(BM_SolverNormalView)->Arg(0)->Arg(1);
 
@@ -139,7 +140,8 @@ void BM_Fit205(benchmark::State& state) {
         const auto r = rs::fit_roughness(ms, o);
         benchmark::DoNotOptimize(r.sse);
     }
-    state.SetLabel(c == rs::Correlation::Gaussian ? "very rough, gaussian" : "very rough, exponential");
+    state.SetLabel(c == rs::Correlation::Gaussian ? "very rough, gaussian"
+                                                  : "very rough, exponential");
 }
 BENCHMARK(BM_Fit205)->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
 
@@ -157,7 +159,9 @@ void BM_Fit205_SlightlyRough(benchmark::State& state) {
     std::vector<rs::Measurement> ms;
     for (int i = 0; i < 205; ++i) {
         const auto g = rs::make_geometry(th(rng), th(rng), ph(rng));
-        ms.push_back({g, rs::mean_scattered_power(g, {0.03, 0.4, rs::Correlation::Gaussian}, mo).diffuse, 1.0});
+        ms.push_back(
+            {g, rs::mean_scattered_power(g, {0.03, 0.4, rs::Correlation::Gaussian}, mo).diffuse,
+             1.0});
     }
     rs::FitOptions o;
     o.model = rs::FitModel::SlightlyRough;

@@ -15,6 +15,7 @@
 #include <set>
 #include <sstream>
 #include <system_error>
+
 #include <unistd.h>
 
 namespace roughscope::cli {
@@ -127,8 +128,8 @@ int run_app(CLI::App& app, int argc, char** argv) {
                 known = known || sub->check_name(name);
             }
             if (!known) {
-                throw UsageError("unknown subcommand '" + name + "' (available: " +
-                                 join(names, ", ") + "; see --help)");
+                throw UsageError("unknown subcommand '" + name +
+                                 "' (available: " + join(names, ", ") + "; see --help)");
             }
         }
         try {
@@ -188,16 +189,15 @@ std::vector<double> parse_number_list(std::string_view text, std::size_t count,
                                       std::string_view what) {
     const auto parts = split(text, ',');
     if (parts.size() != count) {
-        throw roughscope::InvalidArgument(std::string(what) + ": expected " +
-                                          std::to_string(count) +
-                                          " comma-separated numbers, got '" +
-                                          std::string(trim(text)) + "'");
+        throw roughscope::InvalidArgument(
+            std::string(what) + ": expected " + std::to_string(count) +
+            " comma-separated numbers, got '" + std::string(trim(text)) + "'");
     }
     std::vector<double> out;
     out.reserve(count);
     for (std::size_t i = 0; i < parts.size(); ++i) {
-        out.push_back(parse_double_or_throw(parts[i], std::string(what) + " (item " +
-                                                          std::to_string(i + 1) + ")"));
+        out.push_back(parse_double_or_throw(
+            parts[i], std::string(what) + " (item " + std::to_string(i + 1) + ")"));
     }
     return out;
 }
@@ -248,9 +248,8 @@ void write_file_atomic(const std::filesystem::path& path, const std::string& con
     if (!fs::is_directory(dir, ec)) fail("directory " + dir.string() + " does not exist");
 
     std::random_device rd;
-    const fs::path tmp =
-        dir / ("." + path.filename().string() + ".tmp-" + std::to_string(::getpid()) + "-" +
-               std::to_string(rd()));
+    const fs::path tmp = dir / ("." + path.filename().string() + ".tmp-" +
+                                std::to_string(::getpid()) + "-" + std::to_string(rd()));
     {
         std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
         if (!out) fail(std::strerror(errno));
@@ -368,10 +367,9 @@ std::vector<CsvRow> read_csv_with_header(const std::filesystem::path& path,
         }
 
         if (fields.size() != header.size()) {
-            throw roughscope::DataError(where(line_no) + "expected " +
-                                        std::to_string(header.size()) + " fields (" +
-                                        join(header, ",") + "), found " +
-                                        std::to_string(fields.size()));
+            throw roughscope::DataError(
+                where(line_no) + "expected " + std::to_string(header.size()) + " fields (" +
+                join(header, ",") + "), found " + std::to_string(fields.size()));
         }
         CsvRow row;
         row.line = line_no;
@@ -423,7 +421,8 @@ CLI::Validator number_validator(std::function<bool(double)> ok, std::string rang
             std::string reason;
             const auto value = parse_double(text, reason);
             if (!value) return "'" + std::string(trim(text)) + "' is " + reason + "; " + range;
-            if (!ok(*value)) return "value " + std::string(trim(text)) + " is out of range; " + range;
+            if (!ok(*value))
+                return "value " + std::string(trim(text)) + " is out of range; " + range;
             return {};
         },
         std::move(tag));
@@ -437,8 +436,7 @@ CLI::Validator polar_angle_validator() {
 }
 
 CLI::Validator finite_validator() {
-    return number_validator([](double) { return true; }, "a finite number is required",
-                            "FINITE");
+    return number_validator([](double) { return true; }, "a finite number is required", "FINITE");
 }
 
 CLI::Validator positive_validator(const std::string& unit) {

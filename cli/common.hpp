@@ -9,21 +9,22 @@
 //    cli::UsageError) for bad input, roughscope::NoSolution, roughscope::DataError for files.
 #pragma once
 
-#include <CLI/CLI.hpp>
 #include <cstddef>
 #include <filesystem>
 #include <functional>
 #include <iosfwd>
 #include <map>
-#include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
 #include <string_view>
 #include <utility>
 #include <vector>
 
-#include "roughscope/errors.hpp"
-#include "roughscope/scattering.hpp"
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+
+#include "roughscope/core/errors.hpp"
+#include "roughscope/scattering/factors.hpp"
 
 namespace roughscope::cli {
 
@@ -105,10 +106,10 @@ void write_output(const std::optional<std::filesystem::path>& path, const std::s
 
 // One data row of a CSV file read by read_csv_with_header.
 struct CsvRow {
-    std::size_t line = 0;                          // 1-based line number in the file
-    std::map<std::string, double> values;          // parsed required + present optional columns
-    std::map<std::string, std::string> text;       // every column, trimmed, as written
-    double at(const std::string& column) const;    // required column (asserted present)
+    std::size_t line = 0;                        // 1-based line number in the file
+    std::map<std::string, double> values;        // parsed required + present optional columns
+    std::map<std::string, std::string> text;     // every column, trimmed, as written
+    double at(const std::string& column) const;  // required column (asserted present)
     std::optional<double> find(const std::string& column) const;  // optional column
 };
 
@@ -146,8 +147,7 @@ CLI::Option* add_positive_option(CLI::App& app, const std::string& flag, double&
 
 // Finite number >= 0.
 CLI::Option* add_non_negative_option(CLI::App& app, const std::string& flag, double& value,
-                                     const std::string& description,
-                                     const std::string& unit = "");
+                                     const std::string& description, const std::string& unit = "");
 
 // Finite number in [lo, hi].
 CLI::Option* add_range_option(CLI::App& app, const std::string& flag, double& value, double lo,

@@ -5,7 +5,7 @@
 // command writes the comparison as JSON to a temporary file and runs
 // `$ROUGHSCOPE_PYTHON -m roughscope.curet_figures` (default /usr/bin/python3), with the package
 // beside the executable (<bin>/../python) put first on PYTHONPATH.
-#include <unistd.h>
+#include "roughscope/brdf/curet.hpp"
 
 #include <cmath>
 #include <cstdio>
@@ -19,12 +19,13 @@
 #include <string>
 #include <vector>
 
+#include <unistd.h>
+
 #include "commands.hpp"
 #include "common.hpp"
-#include "roughscope/brdf_table.hpp"
-#include "roughscope/comparison.hpp"
-#include "roughscope/curet.hpp"
-#include "roughscope/errors.hpp"
+#include "roughscope/brdf/comparison.hpp"
+#include "roughscope/brdf/table.hpp"
+#include "roughscope/core/errors.hpp"
 
 namespace roughscope::cli {
 namespace {
@@ -121,9 +122,8 @@ std::string text_report(const Comparison& c) {
                             short_number(rad_to_deg(t.theta2_rad), "theta2"));
         kv.emplace_back("E1/E2", format_result(*t.E1_over_E2, "E1/E2"));
         kv.emplace_back("sigma/T (Gaussian, Eq. 17)",
-                        t.sigma_over_T_gaussian
-                            ? format_result(*t.sigma_over_T_gaussian, "sigma/T")
-                            : "unavailable: " + t.gaussian_reason);
+                        t.sigma_over_T_gaussian ? format_result(*t.sigma_over_T_gaussian, "sigma/T")
+                                                : "unavailable: " + t.gaussian_reason);
         kv.emplace_back("sigma/T (exponential, Eq. 19)",
                         t.sigma_over_T_exponential
                             ? format_result(*t.sigma_over_T_exponential, "sigma/T")
@@ -135,7 +135,9 @@ std::string text_report(const Comparison& c) {
     out << "\nErrors (Table 4 = sum of squared differences of max-normalised brightness; RMSE = "
            "sqrt(Table 4 / N); gain SSE = after the optimal gain):\n";
     std::vector<std::vector<std::string>> rows;
-    auto skipped = [](const ModelResult& r) { return is_fit(r.model) && r.reason == "fits not requested"; };
+    auto skipped = [](const ModelResult& r) {
+        return is_fit(r.model) && r.reason == "fits not requested";
+    };
     for (const ModelResult& r : c.models) {
         if (skipped(r)) continue;
         std::vector<std::string> row{ascii(display_name(r.model))};
@@ -162,8 +164,7 @@ std::string text_report(const Comparison& c) {
     out << "\nWinner by gain SSE (fits included): "
         << (c.winner ? ascii(display_name(*c.winner)) : std::string("-"))
         << "\nWinner by the Table-4 metric (paper's methods): "
-        << (c.winner_paper_metric ? ascii(display_name(*c.winner_paper_metric))
-                                  : std::string("-"))
+        << (c.winner_paper_metric ? ascii(display_name(*c.winner_paper_metric)) : std::string("-"))
         << "\n";
     for (const ModelResult& r : c.models)
         if (!r.available && !skipped(r))
@@ -183,7 +184,8 @@ std::string text_report_all(const std::vector<Comparison>& all) {
         std::vector<std::string> row{std::to_string(c.sample)};
         const TwoPointEstimate& t = c.two_point;
         row.push_back(t.E1_over_E2 ? short_number(*t.E1_over_E2, "E1/E2") : "-");
-        row.push_back(t.sigma_over_T_gaussian ? short_number(*t.sigma_over_T_gaussian, "s/T") : "-");
+        row.push_back(t.sigma_over_T_gaussian ? short_number(*t.sigma_over_T_gaussian, "s/T")
+                                              : "-");
         row.push_back(t.sigma_over_T_exponential ? short_number(*t.sigma_over_T_exponential, "s/T")
                                                  : "-");
         for (ComparisonModel m : kPaperComparisonModels) {
@@ -207,8 +209,10 @@ std::string text_report_all(const std::vector<Comparison>& all) {
 std::string shell_quote(const std::string& s) {
     std::string out = "'";
     for (char ch : s) {
-        if (ch == '\'') out += "'\\''";
-        else out += ch;
+        if (ch == '\'')
+            out += "'\\''";
+        else
+            out += ch;
     }
     return out + "'";
 }
@@ -236,12 +240,14 @@ std::optional<fs::path> package_dir_beside_executable() {
 struct TempFile {
     fs::path path;
     explicit TempFile(const std::string& suffix) {
-        std::string tmpl = (fs::temp_directory_path() / ("roughscope-curet-XXXXXX" + suffix)).string();
+        std::string tmpl =
+            (fs::temp_directory_path() / ("roughscope-curet-XXXXXX" + suffix)).string();
         std::vector<char> buf(tmpl.begin(), tmpl.end());
         buf.push_back('\0');
         const int fd = mkstemps(buf.data(), static_cast<int>(suffix.size()));
-        if (fd < 0) throw roughscope::DataError("cannot create a temporary file in " +
-                                                fs::temp_directory_path().string());
+        if (fd < 0)
+            throw roughscope::DataError("cannot create a temporary file in " +
+                                        fs::temp_directory_path().string());
         ::close(fd);
         path = buf.data();
     }
@@ -291,8 +297,7 @@ void draw_plot(const std::string& comparison_json, const std::string& kind,
 
 void run(Args& a) {
     const int modes = (given(a.o_sample) ? 1 : 0) + (a.all ? 1 : 0) + (given(a.o_table) ? 1 : 0);
-    if (modes != 1)
-        throw UsageError("give exactly one of --sample N, --all or --table FILE.csv");
+    if (modes != 1) throw UsageError("give exactly one of --sample N, --all or --table FILE.csv");
     if (a.json_flag) {
         if (given(a.o_format) && a.format != Format::Json)
             throw UsageError("--json conflicts with --format");
@@ -341,10 +346,18 @@ void run(Args& a) {
         const CuretDatabase db = load_curet(dir, a.channel);
         const std::vector<Comparison> all = compare_curet_all(db, o, a.threads);
         switch (a.format) {
-            case Format::Json: text = json_text(to_json(all, a.series)); break;
-            case Format::Csv: text = to_csv(all); break;
-            case Format::Markdown: text = to_markdown(all); break;
-            case Format::Text: text = text_report_all(all); break;
+            case Format::Json:
+                text = json_text(to_json(all, a.series));
+                break;
+            case Format::Csv:
+                text = to_csv(all);
+                break;
+            case Format::Markdown:
+                text = to_markdown(all);
+                break;
+            case Format::Text:
+                text = text_report_all(all);
+                break;
         }
         if (!a.plot_path.empty()) {
             plot_json = to_json(all, false, -1);
@@ -363,10 +376,18 @@ void run(Args& a) {
             c = compare_curet_sample(db, a.sample, o);
         }
         switch (a.format) {
-            case Format::Json: text = json_text(to_json(c, a.series)); break;
-            case Format::Csv: text = to_csv({c}); break;
-            case Format::Markdown: text = to_markdown({c}); break;
-            case Format::Text: text = text_report(c); break;
+            case Format::Json:
+                text = json_text(to_json(c, a.series));
+                break;
+            case Format::Csv:
+                text = to_csv({c});
+                break;
+            case Format::Markdown:
+                text = to_markdown({c});
+                break;
+            case Format::Text:
+                text = text_report(c);
+                break;
         }
         if (!a.plot_path.empty()) plot_json = to_json(c, true, -1);
     }
@@ -454,8 +475,7 @@ void register_curet(CLI::App& app) {
     cmd->add_option("--plot", a.plot_path,
                     "Write a PNG: Fig. 10 for one sample, the database summary for --all")
         ->group(outg);
-    cmd->add_option("--output", a.output_path, "Write the results to FILE atomically")
-        ->group(outg);
+    cmd->add_option("--output", a.output_path, "Write the results to FILE atomically")->group(outg);
 
     a.o_sample = cmd->get_option("--sample");
     a.o_all = cmd->get_option("--all");

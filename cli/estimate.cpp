@@ -16,13 +16,13 @@
 
 #include "commands.hpp"
 #include "common.hpp"
-#include "roughscope/beckmann.hpp"
-#include "roughscope/errors.hpp"
-#include "roughscope/estimation.hpp"
-#include "roughscope/fit.hpp"
-#include "roughscope/geometry.hpp"
-#include "roughscope/scattering.hpp"
-#include "roughscope/validity.hpp"
+#include "roughscope/core/errors.hpp"
+#include "roughscope/estimation/estimation.hpp"
+#include "roughscope/fit/fit.hpp"
+#include "roughscope/scattering/beckmann.hpp"
+#include "roughscope/scattering/factors.hpp"
+#include "roughscope/scattering/geometry.hpp"
+#include "roughscope/scattering/validity.hpp"
 
 namespace roughscope::cli {
 namespace {
@@ -48,8 +48,8 @@ struct RatioArgs {
 
 void add_ratio_options(CLI::App& cmd, RatioArgs& r) {
     const std::string g = "Brightness (give --ratio, or --e1 and --e2)";
-    r.o_ratio = add_positive_option(cmd, "--ratio", r.ratio, "Brightness ratio E1/E2 (> 0)")
-                    ->group(g);
+    r.o_ratio =
+        add_positive_option(cmd, "--ratio", r.ratio, "Brightness ratio E1/E2 (> 0)")->group(g);
     r.o_e1 = add_positive_option(cmd, "--e1", r.e1, "Brightness E1 at geometry 1 (> 0)")->group(g);
     r.o_e2 = add_positive_option(cmd, "--e2", r.e2, "Brightness E2 at geometry 2 (> 0)")->group(g);
 }
@@ -155,10 +155,9 @@ void emit(const OutputArgs& o, const json& record) {
                 v = format_result(value.get<double>(), key);
             } else if (value.is_array() && key.rfind("valid_ratio_range", 0) == 0) {
                 // Open interval; no upper bound is written "> lower" (never "inf").
-                v = value[1].is_null()
-                        ? "> " + format_result(value[0].get<double>(), key)
-                        : "(" + format_result(value[0].get<double>(), key) + ", " +
-                              format_result(value[1].get<double>(), key) + ")";
+                v = value[1].is_null() ? "> " + format_result(value[0].get<double>(), key)
+                                       : "(" + format_result(value[0].get<double>(), key) + ", " +
+                                             format_result(value[1].get<double>(), key) + ")";
             } else if (value.is_array()) {
                 if (key == "warnings") continue;  // printed below, one per line
                 for (const auto& x : value) {
@@ -174,12 +173,13 @@ void emit(const OutputArgs& o, const json& record) {
         std::ostringstream os;
         print_key_values(os, items);
         if (record.contains("warnings"))
-            for (const auto& w : record["warnings"]) os << "warning: " << w.get<std::string>() << "\n";
+            for (const auto& w : record["warnings"])
+                os << "warning: " << w.get<std::string>() << "\n";
         text = os.str();
     }
-    write_output(given(o.o_output) ? std::optional<std::filesystem::path>(o.output_path)
-                                   : std::nullopt,
-                 text);
+    write_output(
+        given(o.o_output) ? std::optional<std::filesystem::path>(o.output_path) : std::nullopt,
+        text);
 }
 
 // An estimate's value and (when computed) its standard error.
@@ -187,7 +187,8 @@ void put(json& out, const std::string& key, const std::optional<Estimate>& e, bo
          double scale = 1.0) {
     out[key] = e ? finite_number(e->value * scale, key) : json(nullptr);
     if (with_error)
-        out[key + "_stderr"] = e ? finite_number(e->std_error * scale, key + "_stderr") : json(nullptr);
+        out[key + "_stderr"] =
+            e ? finite_number(e->std_error * scale, key + "_stderr") : json(nullptr);
 }
 
 // The keys every estimate carries (§3.5 derived quantities, class, g, warnings).
@@ -230,20 +231,23 @@ struct SpecularArgs {
 
 void run_specular(const SpecularArgs& a) {
     if (!given(a.o_theta))
-        throw UsageError("missing --theta: the specular angle theta = theta_i = theta_s in degrees "
-                         "[0, 90)");
+        throw UsageError(
+            "missing --theta: the specular angle theta = theta_i = theta_s in degrees "
+            "[0, 90)");
     SpecularInput in;
     if (given(a.o_r_spec) && (given(a.o_e_tot) || given(a.o_e_dif)))
-        throw UsageError("--r-spec excludes --e-tot/--e-dif: give R_spec, or both brightness "
-                         "values (R_spec = 1 - E_dif/E_tot)");
+        throw UsageError(
+            "--r-spec excludes --e-tot/--e-dif: give R_spec, or both brightness "
+            "values (R_spec = 1 - E_dif/E_tot)");
     if (given(a.o_r_spec)) {
         in.R_spec = a.r_spec;
     } else if (given(a.o_e_tot) && given(a.o_e_dif)) {
         in.E_tot = a.e_tot;
         in.E_dif = a.e_dif;
     } else {
-        throw UsageError("missing specular measurement: give --r-spec R, or --e-tot E --e-dif E "
-                         "(peak and surrounding diffuse brightness)");
+        throw UsageError(
+            "missing specular measurement: give --r-spec R, or --e-tot E --e-dif E "
+            "(peak and surrounding diffuse brightness)");
     }
     in.theta_rad = deg_to_rad(a.theta_deg);
     in.wavelength_um = a.wavelength_um;
@@ -251,7 +255,8 @@ void run_specular(const SpecularArgs& a) {
     in.relative_noise_tot = in.relative_noise_dif = a.noise;
     const RoughnessEstimate e = estimate_sigma_specular(in);
     const bool err = given(a.o_noise);
-    const double R = in.E_tot ? specular_reflectance_from_brightness(*in.E_tot, *in.E_dif) : in.R_spec;
+    const double R =
+        in.E_tot ? specular_reflectance_from_brightness(*in.E_tot, *in.E_dif) : in.R_spec;
 
     json out;
     out["estimator"] = "specular (Eq. 12-13)";
@@ -282,8 +287,9 @@ struct CorrelationLengthArgs {
 
 void run_correlation_length(const CorrelationLengthArgs& a) {
     if (!given(a.o_sigma))
-        throw UsageError("missing --sigma: the RMS height in um (> 0), e.g. from `estimate "
-                         "specular`");
+        throw UsageError(
+            "missing --sigma: the RMS height in um (> 0), e.g. from `estimate "
+            "specular`");
     const auto [g1, g2] = geometries_from(a.pair);
     if (a.regime == Regime::VeryRough || a.regime == Regime::VeryRoughSeriesLimit)
         throw UsageError("--regime " + std::string(to_string(a.regime)) +
@@ -374,8 +380,8 @@ void run_slope(const SlopeArgs& a) {
 
     json out;
     const bool closed = normal_view(g1) && normal_view(g2);
-    out["estimator"] = closed ? "slope ratio (Eq. 16-19)"
-                              : "slope ratio (two-geometry solver, TOMS 748)";
+    out["estimator"] =
+        closed ? "slope ratio (Eq. 16-19)" : "slope ratio (two-geometry solver, TOMS 748)";
     put(out, "sigma_over_T", primary.sigma_over_T, err);
     put(out, "sigma_over_T_gaussian", eg ? eg->sigma_over_T : std::nullopt, err);
     put(out, "sigma_over_T_exponential", ee ? ee->sigma_over_T : std::nullopt, err);
@@ -393,8 +399,8 @@ void run_slope(const SlopeArgs& a) {
             c == Correlation::Gaussian
                 ? ratio_range_gaussian(g1.theta_i_rad, g2.theta_i_rad, a.factor)
                 : ratio_range_exponential(g1.theta_i_rad, g2.theta_i_rad, a.factor);
-        return json::array({finite_number(r.lower), std::isinf(r.upper) ? json(nullptr)
-                                                                         : finite_number(r.upper)});
+        return json::array(
+            {finite_number(r.lower), std::isinf(r.upper) ? json(nullptr) : finite_number(r.upper)});
     };
     if (eg) out["valid_ratio_range_gaussian"] = range(Correlation::Gaussian);
     if (ee) out["valid_ratio_range_exponential"] = range(Correlation::Exponential);
@@ -403,8 +409,10 @@ void run_slope(const SlopeArgs& a) {
     out["factor"] = std::string(to_string(a.factor));
     out["radiometry"] = std::string(to_string(a.radiometry));
     std::vector<std::string> ws;
-    if (eg) for (const auto& w : eg->warnings) ws.push_back((ee ? "gaussian: " : "") + w);
-    if (ee) for (const auto& w : ee->warnings) ws.push_back((eg ? "exponential: " : "") + w);
+    if (eg)
+        for (const auto& w : eg->warnings) ws.push_back((ee ? "gaussian: " : "") + w);
+    if (ee)
+        for (const auto& w : ee->warnings) ws.push_back((eg ? "exponential: " : "") + w);
     out["warnings"] = warnings_json(ws);
     emit(a.out, out);
 }
@@ -442,9 +450,9 @@ std::vector<Measurement> read_measurements(const std::filesystem::path& path) {
             for (const char* col : {"theta_i", "theta_s"}) {
                 const double v = row.at(col);
                 if (!(v >= 0.0 && v < 90.0))
-                    throw roughscope::InvalidArgument("column '" + std::string(col) + "': " +
-                                                      format_result(v, col) +
-                                                      " is outside the valid range [0, 90) degrees");
+                    throw roughscope::InvalidArgument(
+                        "column '" + std::string(col) + "': " + format_result(v, col) +
+                        " is outside the valid range [0, 90) degrees");
             }
             const double b = row.at("brightness");
             if (!(b > 0.0))
@@ -520,11 +528,13 @@ json fit_json(const FitResult& r, bool with_residuals) {
 
 void run_fit(const FitArgs& a) {
     if (!given(a.o_measurements))
-        throw UsageError("missing --measurements FILE.csv (columns theta_i, phi_i, theta_s, "
-                         "phi_s, brightness[, weight]; degrees)");
+        throw UsageError(
+            "missing --measurements FILE.csv (columns theta_i, phi_i, theta_s, "
+            "phi_s, brightness[, weight]; degrees)");
     if (a.model == FitModel::VeryRough) {
         for (auto [o, f] : {std::pair{a.o_initial_sigma, "--initial-sigma"},
-                            {a.o_initial_T, "--initial-T"}, {a.o_regime, "--regime"},
+                            {a.o_initial_T, "--initial-T"},
+                            {a.o_regime, "--regime"},
                             {a.o_wavelength, "--wavelength"}})
             if (given(o))
                 throw UsageError(std::string(f) + " applies to --model slightly-rough only");
@@ -571,9 +581,9 @@ void run_fit(const FitArgs& a) {
             for (const char* k : {"sigma_um", "sigma_um_stderr", "T_um", "T_um_stderr"})
                 out[k] = jb[k];
         // Caron's θK, ξK, m from the Gaussian fit (they are Gaussian-correlation quantities).
-        for (const char* k : {"theta_K_deg", "theta_K_deg_stderr", "xi_K", "xi_K_stderr",
-                              "rms_slope", "rms_slope_stderr", "roughness_class",
-                              "roughness_class_assumed", "g"})
+        for (const char* k :
+             {"theta_K_deg", "theta_K_deg_stderr", "xi_K", "xi_K_stderr", "rms_slope",
+              "rms_slope_stderr", "roughness_class", "roughness_class_assumed", "g"})
             out[k] = jg[k];
         out["gaussian"] = jg;
         out["exponential"] = je;
@@ -643,11 +653,11 @@ void register_estimate(CLI::App& app) {
             "correlation-length",
             "Correlation length T of a slightly rough surface from two diffuse brightness values "
             "with sigma known (Eq. 14-15; any geometry via the numeric solver)");
-        a.o_sigma = add_positive_option(*cmd, "--sigma", a.sigma_um, "RMS height sigma (um, > 0)",
-                                        "um");
-        a.o_sigma_stderr = add_non_negative_option(*cmd, "--sigma-stderr", a.sigma_stderr_um,
-                                                   "Standard error of sigma (um), propagated",
-                                                   "um");
+        a.o_sigma =
+            add_positive_option(*cmd, "--sigma", a.sigma_um, "RMS height sigma (um, > 0)", "um");
+        a.o_sigma_stderr =
+            add_non_negative_option(*cmd, "--sigma-stderr", a.sigma_stderr_um,
+                                    "Standard error of sigma (um), propagated", "um");
         add_ratio_options(*cmd, a.ratio);
         add_pair_options(*cmd, a.pair);
         add_wavelength_option(*cmd, a.wavelength_um);
@@ -715,9 +725,9 @@ void register_estimate(CLI::App& app) {
                         "Robust loss: none (default), huber, cauchy, soft_l_one");
         add_positive_option(*cmd, "--loss-scale", a.loss_scale,
                             "Residual size where the robust loss bends (default 0.05)");
-        a.o_initial_sigma_over_T = add_positive_option(*cmd, "--initial-sigma-over-T",
-                                                       a.initial_sigma_over_T,
-                                                       "Starting sigma/T (default: automatic)");
+        a.o_initial_sigma_over_T =
+            add_positive_option(*cmd, "--initial-sigma-over-T", a.initial_sigma_over_T,
+                                "Starting sigma/T (default: automatic)");
         a.o_initial_sigma = add_positive_option(*cmd, "--initial-sigma", a.initial_sigma_um,
                                                 "Starting sigma (um; default automatic)", "um");
         a.o_initial_T = add_positive_option(*cmd, "--initial-T", a.initial_T_um,

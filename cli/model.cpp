@@ -2,7 +2,6 @@
 // of §5) at one geometry given on the command line, or at every row of a CSV file.
 //
 // Angles are degrees here and radians in the library; lengths are µm. See docs/cli.md.
-#include <Eigen/Core>
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
@@ -13,14 +12,16 @@
 #include <string>
 #include <vector>
 
+#include <Eigen/Core>
+
 #include "commands.hpp"
 #include "common.hpp"
-#include "roughscope/beckmann.hpp"
-#include "roughscope/errors.hpp"
-#include "roughscope/geometry.hpp"
-#include "roughscope/models.hpp"
-#include "roughscope/scattering.hpp"
-#include "roughscope/validity.hpp"
+#include "roughscope/core/errors.hpp"
+#include "roughscope/scattering/beckmann.hpp"
+#include "roughscope/scattering/factors.hpp"
+#include "roughscope/scattering/geometry.hpp"
+#include "roughscope/scattering/reflectance_models.hpp"
+#include "roughscope/scattering/validity.hpp"
 
 namespace roughscope::cli {
 namespace {
@@ -35,17 +36,22 @@ ModelKind parse_model(std::string_view name) {
     if (name == "oren_nayar") return ModelKind::OrenNayar;
     if (name == "oren_nayar_qualitative") return ModelKind::OrenNayarQualitative;
     if (name == "lafortune") return ModelKind::Lafortune;
-    throw roughscope::InvalidArgument("unknown model '" + std::string(name) + "' (expected one of " +
-                                      kModelNames + ")");
+    throw roughscope::InvalidArgument("unknown model '" + std::string(name) +
+                                      "' (expected one of " + kModelNames + ")");
 }
 
 std::string model_name(ModelKind m) {
     switch (m) {
-        case ModelKind::BK: return "bk";
-        case ModelKind::Lambert: return "lambert";
-        case ModelKind::OrenNayar: return "oren-nayar";
-        case ModelKind::OrenNayarQualitative: return "oren-nayar-qualitative";
-        case ModelKind::Lafortune: return "lafortune";
+        case ModelKind::BK:
+            return "bk";
+        case ModelKind::Lambert:
+            return "lambert";
+        case ModelKind::OrenNayar:
+            return "oren-nayar";
+        case ModelKind::OrenNayarQualitative:
+            return "oren-nayar-qualitative";
+        case ModelKind::Lafortune:
+            return "lafortune";
     }
     return "?";
 }
@@ -73,10 +79,10 @@ struct Args {
     std::string output_path;
 
     // option handles, to know what was given
-    CLI::Option *o_theta_i{}, *o_theta_s{}, *o_phi_s{}, *o_retro{}, *o_specular{},
-        *o_normal_view{}, *o_normal{}, *o_light{}, *o_view{}, *o_curet{}, *o_csv{};
-    CLI::Option *o_sigma{}, *o_T{}, *o_sigma_over_T{}, *o_correlation{}, *o_factor{},
-        *o_regime{}, *o_radiometry{}, *o_wavelength{}, *o_patch_x{}, *o_patch_y{};
+    CLI::Option *o_theta_i{}, *o_theta_s{}, *o_phi_s{}, *o_retro{}, *o_specular{}, *o_normal_view{},
+        *o_normal{}, *o_light{}, *o_view{}, *o_curet{}, *o_csv{};
+    CLI::Option *o_sigma{}, *o_T{}, *o_sigma_over_T{}, *o_correlation{}, *o_factor{}, *o_regime{},
+        *o_radiometry{}, *o_wavelength{}, *o_patch_x{}, *o_patch_y{};
     CLI::Option *o_on_sigma{}, *o_albedo{}, *o_n{}, *o_lobe{}, *o_rho_d{}, *o_output{};
 };
 
@@ -139,8 +145,9 @@ Point point_from_flags(const Args& a) {
     }
     if (given(a.o_light) || given(a.o_view) || given(a.o_normal)) {
         if (!given(a.o_light) || !given(a.o_view)) {
-            throw UsageError("--normal/--light/--view: give both --light x,y,z and --view x,y,z "
-                             "(--normal defaults to 0,0,1)");
+            throw UsageError(
+                "--normal/--light/--view: give both --light x,y,z and --view x,y,z "
+                "(--normal defaults to 0,0,1)");
         }
         const Eigen::Vector3d N = parse_direction(a.normal_text, "--normal");
         const Eigen::Vector3d L = parse_direction(a.light_text, "--light");
@@ -152,7 +159,8 @@ Point point_from_flags(const Args& a) {
     // --theta-i --theta-s --phi-s
     if (!given(a.o_theta_i) || !given(a.o_theta_s) || !given(a.o_phi_s)) {
         std::string missing;
-        for (auto [o, name] : {std::pair{a.o_theta_i, "--theta-i"}, {a.o_theta_s, "--theta-s"},
+        for (auto [o, name] : {std::pair{a.o_theta_i, "--theta-i"},
+                               {a.o_theta_s, "--theta-s"},
                                {a.o_phi_s, "--phi-s"}}) {
             if (!given(o)) missing += std::string(missing.empty() ? "" : ", ") + name;
         }
@@ -179,8 +187,9 @@ void check_geometry_source(const Args& a) {
     if (given(a.o_curet)) sources.push_back("--curet-frame");
     if (given(a.o_csv)) sources.push_back("--csv");
     if (sources.empty()) {
-        throw UsageError("no geometry given: use --theta-i/--theta-s/--phi-s, --retro, "
-                         "--specular, --normal-view, --light/--view, --curet-frame or --csv");
+        throw UsageError(
+            "no geometry given: use --theta-i/--theta-s/--phi-s, --retro, "
+            "--specular, --normal-view, --light/--view, --curet-frame or --csv");
     }
     if (sources.size() > 1) {
         std::string list;
@@ -193,16 +202,20 @@ void check_geometry_source(const Args& a) {
 void check_model_options(const Args& a) {
     const auto reject = [&](const CLI::Option* o, const char* flag, const char* models) {
         if (given(o)) {
-            throw UsageError(std::string(flag) + " applies to --model " + models + " only (model is " +
-                             model_name(a.model) + ")");
+            throw UsageError(std::string(flag) + " applies to --model " + models +
+                             " only (model is " + model_name(a.model) + ")");
         }
     };
     if (a.model != ModelKind::BK) {
-        for (auto [o, f] : {std::pair{a.o_sigma, "--sigma"}, {a.o_T, "--T"},
+        for (auto [o, f] : {std::pair{a.o_sigma, "--sigma"},
+                            {a.o_T, "--T"},
                             {a.o_sigma_over_T, "--sigma-over-T"},
-                            {a.o_correlation, "--correlation"}, {a.o_factor, "--factor"},
-                            {a.o_regime, "--regime"}, {a.o_radiometry, "--radiometry"},
-                            {a.o_wavelength, "--wavelength"}, {a.o_patch_x, "--patch-x"},
+                            {a.o_correlation, "--correlation"},
+                            {a.o_factor, "--factor"},
+                            {a.o_regime, "--regime"},
+                            {a.o_radiometry, "--radiometry"},
+                            {a.o_wavelength, "--wavelength"},
+                            {a.o_patch_x, "--patch-x"},
                             {a.o_patch_y, "--patch-y"}}) {
             reject(o, f, "bk");
         }
@@ -218,8 +231,9 @@ void check_model_options(const Args& a) {
     }
     if (a.model == ModelKind::BK) {
         if (given(a.o_sigma_over_T) && (given(a.o_sigma) || given(a.o_T))) {
-            throw UsageError("--sigma-over-T excludes --sigma/--T: give either --sigma UM --T UM "
-                             "or --sigma-over-T M");
+            throw UsageError(
+                "--sigma-over-T excludes --sigma/--T: give either --sigma UM --T UM "
+                "or --sigma-over-T M");
         }
         if (given(a.o_sigma) != given(a.o_T) && !given(a.o_csv)) {
             throw UsageError(std::string("missing ") + (given(a.o_sigma) ? "--T" : "--sigma") +
@@ -227,19 +241,22 @@ void check_model_options(const Args& a) {
                              "--sigma-over-T M for the very-rough forms)");
         }
         if (!given(a.o_sigma) && !given(a.o_T) && !given(a.o_sigma_over_T) && !given(a.o_csv)) {
-            throw UsageError("missing roughness: the B-K model needs --sigma UM and --T UM "
-                             "(> 0), or --sigma-over-T M (> 0) for the very-rough forms");
+            throw UsageError(
+                "missing roughness: the B-K model needs --sigma UM and --T UM "
+                "(> 0), or --sigma-over-T M (> 0) for the very-rough forms");
         }
     }
     if (a.model == ModelKind::OrenNayar || a.model == ModelKind::OrenNayarQualitative) {
         if (!given(a.o_on_sigma)) {
-            throw UsageError("missing --on-sigma: the Oren-Nayar model needs the facet slope "
-                             "deviation in radians (>= 0)");
+            throw UsageError(
+                "missing --on-sigma: the Oren-Nayar model needs the facet slope "
+                "deviation in radians (>= 0)");
         }
     }
     if (a.model == ModelKind::Lafortune && !given(a.o_n) && !given(a.o_lobe)) {
-        throw UsageError("missing --n: the Lafortune model needs --n N (> 0, diffuse lobe "
-                         "Cz = 1) and/or --lobe Cx,Cy,Cz,n,rho");
+        throw UsageError(
+            "missing --n: the Lafortune model needs --n N (> 0, diffuse lobe "
+            "Cz = 1) and/or --lobe Cx,Cy,Cz,n,rho");
     }
 }
 
@@ -271,8 +288,8 @@ double evaluate_bk(const Args& a, const Point& p, const Roughness& r, json& out)
     std::optional<double> coherent, diffuse, total, g;
     std::optional<std::string> regime, roughness_class;
     double brightness = 0.0;
-    std::optional<double> m = absolute ? std::optional<double>(*r.sigma_um / *r.T_um)
-                                       : r.sigma_over_T;
+    std::optional<double> m =
+        absolute ? std::optional<double>(*r.sigma_um / *r.T_um) : r.sigma_over_T;
 
     if (absolute) {
         const Surface surface{*r.sigma_um, *r.T_um, a.correlation};
@@ -306,8 +323,8 @@ double evaluate_bk(const Args& a, const Point& p, const Roughness& r, json& out)
                 " correlation needs --sigma and --T; with --sigma-over-T only --regime auto or "
                 "very_rough (Eq. 4/5; for gaussian also very_rough_series_limit) are possible");
         }
-        regime = std::string(to_string(series_limit_ok ? Regime::VeryRoughSeriesLimit
-                                                         : Regime::VeryRough));
+        regime = std::string(
+            to_string(series_limit_ok ? Regime::VeryRoughSeriesLimit : Regime::VeryRough));
         if (p.geom) {
             brightness = very_rough_brightness(*p.geom, *m, a.correlation, a.factor, a.radiometry);
             const double F2 = geometric_factor_squared(a.factor, *p.geom);
@@ -379,10 +396,10 @@ json evaluate(const Args& a, const Point& p, const Roughness& r) {
             const auto lobes = lafortune_lobes(a);
             if (p.geom) {
                 // Brightness = BRDF × cos θi (unit irradiance along L).
-                brightness = (lobes.size() == 1 && a.lobe_texts.empty() && a.rho_d == 0.0)
-                                 ? lafortune_diffuse_brightness(*p.geom, a.lafortune_n)
-                                 : lafortune_brdf(*p.geom, lobes, a.rho_d) *
-                                       std::cos(p.geom->theta_i_rad);
+                brightness =
+                    (lobes.size() == 1 && a.lobe_texts.empty() && a.rho_d == 0.0)
+                        ? lafortune_diffuse_brightness(*p.geom, a.lafortune_n)
+                        : lafortune_brdf(*p.geom, lobes, a.rho_d) * std::cos(p.geom->theta_i_rad);
             }
             json lobes_json = json::array();
             for (const auto& l : lobes) {
@@ -458,8 +475,9 @@ Roughness roughness_for_row(const Args& a, const CsvRow& row, const std::string&
     const auto t = row.find("T_um");
     const auto m = row.find("sigma_over_T");
     if (m && (s || t)) {
-        throw roughscope::DataError(where + "give either sigma_um,T_um or sigma_over_T on a row, "
-                                            "not both");
+        throw roughscope::DataError(where +
+                                    "give either sigma_um,T_um or sigma_over_T on a row, "
+                                    "not both");
     }
     if (m) {
         r = Roughness{};
@@ -475,13 +493,14 @@ Roughness roughness_for_row(const Args& a, const CsvRow& row, const std::string&
                                     "--sigma/--T), or sigma_over_T");
     }
     if (!r.sigma_um && !r.sigma_over_T) {
-        throw roughscope::DataError(where + "no roughness: give --sigma and --T or "
-                                            "--sigma-over-T, or columns sigma_um,T_um or "
-                                            "sigma_over_T");
+        throw roughscope::DataError(where +
+                                    "no roughness: give --sigma and --T or "
+                                    "--sigma-over-T, or columns sigma_um,T_um or "
+                                    "sigma_over_T");
     }
     if (r.sigma_over_T && !(*r.sigma_over_T > 0.0)) {
-        throw roughscope::DataError(where + "column 'sigma_over_T': " +
-                                    format_result(*r.sigma_over_T) + " must be > 0");
+        throw roughscope::DataError(
+            where + "column 'sigma_over_T': " + format_result(*r.sigma_over_T) + " must be > 0");
     }
     for (auto [v, col] : {std::pair{r.sigma_um, "sigma_um"}, {r.T_um, "T_um"}}) {
         if (v && !(*v > 0.0)) {
@@ -526,8 +545,8 @@ void run_model(const Args& a) {
         try {
             check_polar_deg(ti, "column 'theta_i'");
             check_polar_deg(ts, "column 'theta_s'");
-            const Roughness r = a.model == ModelKind::BK ? roughness_for_row(a, row, where)
-                                                         : Roughness{};
+            const Roughness r =
+                a.model == ModelKind::BK ? roughness_for_row(a, row, where) : Roughness{};
             const Point p =
                 point_from(make_geometry(deg_to_rad(ti), deg_to_rad(ts), deg_to_rad(ps)));
             records.push_back(evaluate(a, p, r));
@@ -575,8 +594,7 @@ void register_model(CLI::App& app) {
     cmd->add_option("--light", a.light_text,
                     "Light direction L as x,y,z (normalised; below the horizon gives 0)")
         ->group(geo);
-    cmd->add_option("--view", a.view_text, "Viewing direction V as x,y,z (normalised)")
-        ->group(geo);
+    cmd->add_option("--view", a.view_text, "Viewing direction V as x,y,z (normalised)")->group(geo);
     cmd->add_option("--curet-frame", a.curet_frame_text,
                     "Both azimuths given: theta_i,phi_i,theta_v,phi_v in degrees")
         ->group(geo);
@@ -591,8 +609,7 @@ void register_model(CLI::App& app) {
                     "bk (default), lambert, oren-nayar, oren-nayar-qualitative, lafortune")
         ->group(mod);
     const std::string bk = "B-K model (--model bk)";
-    add_positive_option(*cmd, "--sigma", a.sigma_um, "RMS height sigma (um, > 0)", "um")
-        ->group(bk);
+    add_positive_option(*cmd, "--sigma", a.sigma_um, "RMS height sigma (um, > 0)", "um")->group(bk);
     add_positive_option(*cmd, "--T", a.T_um, "Correlation length T (um, > 0)", "um")->group(bk);
     add_positive_option(*cmd, "--sigma-over-T", a.sigma_over_T,
                         "Slope ratio sigma/T (> 0) instead of --sigma/--T: very-rough forms "
@@ -637,8 +654,7 @@ void register_model(CLI::App& app) {
 
     // Output.
     const std::string outg = "Output";
-    cmd->add_flag("--json", a.json_output,
-                  "Print JSON: one object, or an array with --csv")
+    cmd->add_flag("--json", a.json_output, "Print JSON: one object, or an array with --csv")
         ->group(outg);
     cmd->add_option("--output", a.output_path,
                     "Write the results to FILE (CSV, or JSON with --json) atomically")

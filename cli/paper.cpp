@@ -22,10 +22,10 @@
 
 #include "commands.hpp"
 #include "common.hpp"
-#include "roughscope/errors.hpp"
-#include "roughscope/estimation.hpp"
-#include "roughscope/geometry.hpp"
-#include "roughscope/validity.hpp"
+#include "roughscope/core/errors.hpp"
+#include "roughscope/estimation/estimation.hpp"
+#include "roughscope/scattering/geometry.hpp"
+#include "roughscope/scattering/validity.hpp"
 
 namespace roughscope::cli {
 namespace {
@@ -104,15 +104,13 @@ std::string num(double x, int decimals) {
 }
 
 const json& need(const json& j, const char* key, const std::string& where) {
-    if (!j.contains(key))
-        throw roughscope::DataError(where + ": missing key '" + key + "'");
+    if (!j.contains(key)) throw roughscope::DataError(where + ": missing key '" + key + "'");
     return j.at(key);
 }
 
 double num_at(const json& j, const char* key, const std::string& where) {
     const json& v = need(j, key, where);
-    if (!v.is_number())
-        throw roughscope::DataError(where + ": key '" + key + "' is not a number");
+    if (!v.is_number()) throw roughscope::DataError(where + ": key '" + key + "' is not a number");
     return v.get<double>();
 }
 
@@ -124,16 +122,16 @@ struct SlopeChecks {
 
 SlopeChecks check_slope_ratios(const json& row, const std::string& where, double ratio,
                                int ratio_decimals, double theta1_rad, double theta2_rad) {
-    const Check cg = check(num_at(row, "sigma_over_T_G", where), 4, {ratio}, {ratio_decimals},
-                           [&](const std::vector<double>& x) {
-                               return sigma_over_T_gaussian_from_ratio(x[0], theta1_rad,
-                                                                       theta2_rad);
-                           });
-    const Check ce = check(num_at(row, "sigma_over_T_E", where), 4, {ratio}, {ratio_decimals},
-                           [&](const std::vector<double>& x) {
-                               return sigma_over_T_exponential_from_ratio(x[0], theta1_rad,
-                                                                          theta2_rad);
-                           });
+    const Check cg =
+        check(num_at(row, "sigma_over_T_G", where), 4, {ratio}, {ratio_decimals},
+              [&](const std::vector<double>& x) {
+                  return sigma_over_T_gaussian_from_ratio(x[0], theta1_rad, theta2_rad);
+              });
+    const Check ce =
+        check(num_at(row, "sigma_over_T_E", where), 4, {ratio}, {ratio_decimals},
+              [&](const std::vector<double>& x) {
+                  return sigma_over_T_exponential_from_ratio(x[0], theta1_rad, theta2_rad);
+              });
     return {cg, ce};
 }
 
@@ -189,8 +187,8 @@ void run_tables(const Args& a) {
                             {"sigma_um", cs.to_json()},
                             {"T_um", cT.to_json()},
                             {"sigma_over_T", cm.to_json()}});
-            cells.push_back({name, num(R, 3), num(s, 3), num(cs.recomputed, 4), mark(cs),
-                             num(r, 3), num(cT.printed, 3), num(cT.recomputed, 4), mark(cT),
+            cells.push_back({name, num(R, 3), num(s, 3), num(cs.recomputed, 4), mark(cs), num(r, 3),
+                             num(cT.printed, 3), num(cT.recomputed, 4), mark(cT),
                              num(cm.printed, 3), num(cm.recomputed, 4), mark(cm)});
         }
         out["table1"] = {{"conditions", cond}, {"rows", rows}};
@@ -217,14 +215,12 @@ void run_tables(const Args& a) {
             const double r = num_at(row, "E1_over_E2", w);
             const auto [cg, ce] = check_slope_ratios(row, w, r, 3, t1, t2);
             const double sG = cg.printed;
-            const Check ck = check(num_at(row, "theta_K_deg", w), 0, {sG}, {4},
-                                   [&](const std::vector<double>& x) {
-                                       return rad_to_deg(caron_theta_K_rad(x[0]));
-                                   });
-            const Check cx = check(num_at(row, "xi_K_percent", w), 1, {sG}, {4},
-                                   [&](const std::vector<double>& x) {
-                                       return 100.0 * caron_xi_K(x[0]);
-                                   });
+            const Check ck = check(
+                num_at(row, "theta_K_deg", w), 0, {sG}, {4},
+                [&](const std::vector<double>& x) { return rad_to_deg(caron_theta_K_rad(x[0])); });
+            const Check cx =
+                check(num_at(row, "xi_K_percent", w), 1, {sG}, {4},
+                      [&](const std::vector<double>& x) { return 100.0 * caron_xi_K(x[0]); });
             const std::string name = need(row, "surface", w).get<std::string>();
             rows.push_back({{"surface", name},
                             {"E1_over_E2", r},
@@ -260,7 +256,8 @@ void run_tables(const Args& a) {
             const double r = num_at(row, "E1_over_E2", w);
             const auto [cg, ce] = check_slope_ratios(row, w, r, 6, t1, t2);
             std::string name = need(row, "name", w).get<std::string>();
-            if (row.contains("sample")) name += " (" + std::to_string(row["sample"].get<int>()) + ")";
+            if (row.contains("sample"))
+                name += " (" + std::to_string(row["sample"].get<int>()) + ")";
             rows.push_back({{"sample", name},
                             {"E1_over_E2", r},
                             {"sigma_over_T_G", cg.to_json()},
@@ -271,8 +268,7 @@ void run_tables(const Args& a) {
         out["table3"] = {{"conditions", cond}, {"rows", rows}};
         text << "\nTable 3 (CUReT; sigma/T from E1/E2 by Eq. 17 and 19 at "
              << num(rad_to_deg(t1), 1) << "/" << num(rad_to_deg(t2), 1) << " deg, F_VH)\n";
-        print_table(text, {"sample", "E1/E2", "s/T_G", "s/T_G*", "", "s/T_E", "s/T_E*", ""},
-                    cells);
+        print_table(text, {"sample", "E1/E2", "s/T_G", "s/T_G*", "", "s/T_E", "s/T_E*", ""}, cells);
     }
     text << "\n* recomputed from the printed inputs.  = same at the printed digits;  ~ within the "
             "rounding of the printed inputs;  DIFFERS otherwise.\n";

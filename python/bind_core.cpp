@@ -11,10 +11,6 @@
 //    whose message names the input, its value, the valid range and, for arrays, the element's
 //    index ("at index 3: ..."). The first bad element (in C order) is the one reported.
 //  * loops run without the GIL, in parallel over chunks for large arrays.
-#include <pybind11/numpy.h>
-#include <pybind11/pybind11.h>
-#include <pybind11/stl.h>
-
 #include <algorithm>
 #include <array>
 #include <atomic>
@@ -29,6 +25,10 @@
 #include <tuple>
 #include <utility>
 #include <vector>
+
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
 
 #include "bindings.hpp"
 #include "roughscope/roughscope.hpp"
@@ -268,8 +268,7 @@ py::object map_double(const std::array<const char*, N>& names,
 // Small helpers
 
 Geometry geometry_deg(double theta_i_deg, double theta_s_deg, double phi_s_deg) {
-    return make_geometry(deg_to_rad(theta_i_deg), deg_to_rad(theta_s_deg),
-                         deg_to_rad(phi_s_deg));
+    return make_geometry(deg_to_rad(theta_i_deg), deg_to_rad(theta_s_deg), deg_to_rad(phi_s_deg));
 }
 
 template <class Enum, std::size_t K>
@@ -284,8 +283,7 @@ constexpr std::array<Correlation, 2> kCorrelations = {Correlation::Gaussian,
 constexpr std::array<GeometricFactor, 4> kFactors = {
     GeometricFactor::Beckmann, GeometricFactor::VernoldHarvey, GeometricFactor::Ogilvy,
     GeometricFactor::Kirchhoff};
-constexpr std::array<Radiometry, 2> kRadiometries = {Radiometry::Radiance,
-                                                     Radiometry::Intensity};
+constexpr std::array<Radiometry, 2> kRadiometries = {Radiometry::Radiance, Radiometry::Intensity};
 constexpr std::array<Regime, 5> kRegimes = {Regime::Auto, Regime::Series, Regime::SlightlyRough,
                                             Regime::VeryRough, Regime::VeryRoughSeriesLimit};
 constexpr std::array<RoughnessClass, 3> kRoughnessClasses = {
@@ -315,7 +313,8 @@ inline void apply_scalar(Fn fn, const double* x, double* y, ssize_t n) {
 
 void apply_generic(MathFn fn, const double* x, double* y, ssize_t n) {
     switch (fn) {
-        case MathFn::Exp: return apply_scalar([](double v) { return std::exp(v); }, x, y, n);
+        case MathFn::Exp:
+            return apply_scalar([](double v) { return std::exp(v); }, x, y, n);
         case MathFn::InvPow32:
             return apply_scalar([](double v) { return 1.0 / (v * std::sqrt(v)); }, x, y, n);
     }
@@ -345,8 +344,10 @@ void apply_avx2_fn(const double* x, double* y, ssize_t n) {
 
 void apply_avx2(MathFn fn, const double* x, double* y, ssize_t n) {
     switch (fn) {
-        case MathFn::Exp: return apply_avx2_fn<_ZGVdN4v_exp>(x, y, n);
-        case MathFn::InvPow32: return apply_avx2_fn<inv_pow32_avx2>(x, y, n);
+        case MathFn::Exp:
+            return apply_avx2_fn<_ZGVdN4v_exp>(x, y, n);
+        case MathFn::InvPow32:
+            return apply_avx2_fn<inv_pow32_avx2>(x, y, n);
     }
 }
 #pragma GCC pop_options
@@ -380,8 +381,10 @@ void apply_avx512_fn(const double* x, double* y, ssize_t n) {
 
 void apply_avx512(MathFn fn, const double* x, double* y, ssize_t n) {
     switch (fn) {
-        case MathFn::Exp: return apply_avx512_fn<_ZGVeN8v_exp>(x, y, n);
-        case MathFn::InvPow32: return apply_avx512_fn<inv_pow32_avx512>(x, y, n);
+        case MathFn::Exp:
+            return apply_avx512_fn<_ZGVeN8v_exp>(x, y, n);
+        case MathFn::InvPow32:
+            return apply_avx512_fn<inv_pow32_avx512>(x, y, n);
     }
 }
 #pragma GCC pop_options
@@ -405,9 +408,12 @@ Isa best_isa() { return std::min(cpu_isa(), g_isa_cap.load()); }
 
 const char* isa_name(Isa isa) {
     switch (isa) {
-        case Isa::Generic: return "generic";
-        case Isa::Avx2: return "avx2";
-        case Isa::Avx512: return "avx512";
+        case Isa::Generic:
+            return "generic";
+        case Isa::Avx2:
+            return "avx2";
+        case Isa::Avx512:
+            return "avx512";
     }
     return "generic";
 }
@@ -451,12 +457,14 @@ void validate_very_rough(const VeryRoughInputs& in, ssize_t begin, ssize_t end, 
         // The library accepted what the quick test rejected (never expected): say so anyway.
         if (!(ti >= 0.0 && ti < kHalfPi && ts >= 0.0 && ts < kHalfPi && std::isfinite(p) &&
               m > 0.0 && m <= std::numeric_limits<double>::max()))
-            throw InvalidArgument("very_rough_brightness: angles must be in [0, 90) degrees, "
-                                  "phi_s_deg finite and sigma_over_T finite and > 0");
+            throw InvalidArgument(
+                "very_rough_brightness: angles must be in [0, 90) degrees, "
+                "phi_s_deg finite and sigma_over_T finite and > 0");
     }
 }
 
-// sin x and cos x for |x| <= π/4 (fdlibm's __kernel_sin / __kernel_cos minimax polynomials, ~1 ulp).
+// sin x and cos x for |x| <= π/4 (fdlibm's __kernel_sin / __kernel_cos minimax polynomials, ~1
+// ulp).
 [[gnu::always_inline]] inline double kernel_sin(double x) {
     constexpr double S1 = -1.66666666666666324348e-01, S2 = 8.33333333332248946124e-03,
                      S3 = -1.98412698298579493134e-04, S4 = 2.75573137070700676789e-06,
@@ -612,7 +620,8 @@ template <Correlation C, GeometricFactor F, Radiometry R, Isa I>
         };
         if (pass(p_deg)) {  // rare: some |φs| >= 2^44 degrees; reduce those with the exact fmod
             for (ssize_t j = 0; j < n; ++j)
-                wide_p[j] = __builtin_fabs(p_deg[j]) < kWide ? p_deg[j] : std::fmod(p_deg[j], 360.0);
+                wide_p[j] =
+                    __builtin_fabs(p_deg[j]) < kWide ? p_deg[j] : std::fmod(p_deg[j], 360.0);
             pass(wide_p);
         }
         // The library's checks find and report the first bad element of the block.
@@ -635,15 +644,13 @@ void very_rough_generic(const VeryRoughInputs& in, ssize_t begin, ssize_t end, d
 }
 #if ROUGHSCOPE_HAVE_LIBMVEC
 template <Correlation C, GeometricFactor F, Radiometry R>
-__attribute__((target("avx2,fma"))) void very_rough_avx2(const VeryRoughInputs& in,
-                                                          ssize_t begin, ssize_t end,
-                                                          double* out, ssize_t& at) {
+__attribute__((target("avx2,fma"))) void very_rough_avx2(const VeryRoughInputs& in, ssize_t begin,
+                                                         ssize_t end, double* out, ssize_t& at) {
     very_rough_body<C, F, R, Isa::Avx2>(in, begin, end, out, at);
 }
 template <Correlation C, GeometricFactor F, Radiometry R>
-__attribute__((target("avx512f"))) void very_rough_avx512(const VeryRoughInputs& in,
-                                                           ssize_t begin, ssize_t end,
-                                                           double* out, ssize_t& at) {
+__attribute__((target("avx512f"))) void very_rough_avx512(const VeryRoughInputs& in, ssize_t begin,
+                                                          ssize_t end, double* out, ssize_t& at) {
     very_rough_body<C, F, R, Isa::Avx512>(in, begin, end, out, at);
 }
 #endif
@@ -663,11 +670,14 @@ VeryRoughKernel pick_isa(Isa isa) {
 template <Correlation C, Radiometry R>
 VeryRoughKernel pick_kernel(GeometricFactor f, Isa isa) {
     switch (f) {
-        case GeometricFactor::Beckmann: return pick_isa<C, GeometricFactor::Beckmann, R>(isa);
+        case GeometricFactor::Beckmann:
+            return pick_isa<C, GeometricFactor::Beckmann, R>(isa);
         case GeometricFactor::VernoldHarvey:
             return pick_isa<C, GeometricFactor::VernoldHarvey, R>(isa);
-        case GeometricFactor::Ogilvy: return pick_isa<C, GeometricFactor::Ogilvy, R>(isa);
-        case GeometricFactor::Kirchhoff: return pick_isa<C, GeometricFactor::Kirchhoff, R>(isa);
+        case GeometricFactor::Ogilvy:
+            return pick_isa<C, GeometricFactor::Ogilvy, R>(isa);
+        case GeometricFactor::Kirchhoff:
+            return pick_isa<C, GeometricFactor::Kirchhoff, R>(isa);
     }
     return nullptr;
 }
@@ -701,9 +711,8 @@ py::object very_rough_brightness_py(py::handle theta_i_deg, py::handle theta_s_d
     const VeryRoughKernel kernel = pick_kernel(c, f, r, best_isa());
     py::array_t<double> out = make_output(b);
     double* o = out.mutable_data();
-    run_chunks(b, worker_count(b.size, 16384), [&](ssize_t begin, ssize_t end, ssize_t& at) {
-        kernel(in, begin, end, o, at);
-    });
+    run_chunks(b, worker_count(b.size, 16384),
+               [&](ssize_t begin, ssize_t end, ssize_t& at) { kernel(in, begin, end, o, at); });
     return finish(b, out);
 }
 
@@ -726,11 +735,16 @@ std::vector<LafortuneLobe> lobes_from_python(py::handle lobes) {
                 for (auto kv : d) {
                     const std::string key = py::str(kv.first);
                     const double v = py::cast<double>(kv.second);
-                    if (key == "Cx") lobe.Cx = v;
-                    else if (key == "Cy") lobe.Cy = v;
-                    else if (key == "Cz") lobe.Cz = v;
-                    else if (key == "n") lobe.n = v;
-                    else if (key == "albedo" || key == "rho") lobe.albedo = v;
+                    if (key == "Cx")
+                        lobe.Cx = v;
+                    else if (key == "Cy")
+                        lobe.Cy = v;
+                    else if (key == "Cz")
+                        lobe.Cz = v;
+                    else if (key == "n")
+                        lobe.n = v;
+                    else if (key == "albedo" || key == "rho")
+                        lobe.albedo = v;
                     else
                         throw InvalidArgument("lobes: unknown key '" + key +
                                               "' (expected Cx, Cy, Cz, n, albedo)");
@@ -743,9 +757,10 @@ std::vector<LafortuneLobe> lobes_from_python(py::handle lobes) {
     DoubleArray a = to_double_array("lobes", lobes);
     if (a.ndim() == 1 && a.shape(0) == 5) a = to_double_array("lobes", a.reshape({1, 5}));
     if (a.ndim() != 2 || a.shape(1) != 5)
-        throw InvalidArgument("lobes must be a list of dicts (Cx, Cy, Cz, n, albedo) or an array "
-                              "of shape (N, 5) with columns Cx, Cy, Cz, n, albedo; got shape " +
-                              shape_string({a.shape(), a.shape() + a.ndim()}));
+        throw InvalidArgument(
+            "lobes must be a list of dicts (Cx, Cy, Cz, n, albedo) or an array "
+            "of shape (N, 5) with columns Cx, Cy, Cz, n, albedo; got shape " +
+            shape_string({a.shape(), a.shape() + a.ndim()}));
     for (ssize_t k = 0; k < a.shape(0); ++k) {
         const double* row = a.data() + 5 * k;
         result.push_back(LafortuneLobe{row[0], row[1], row[2], row[3], row[4]});
@@ -775,9 +790,12 @@ void bind_core(py::module_& m) {
         "_set_vector_isa",
         [](const std::string& name) {
             Isa isa;
-            if (name == "generic") isa = Isa::Generic;
-            else if (name == "avx2") isa = Isa::Avx2;
-            else if (name == "avx512" || name == "best") isa = Isa::Avx512;
+            if (name == "generic")
+                isa = Isa::Generic;
+            else if (name == "avx2")
+                isa = Isa::Avx2;
+            else if (name == "avx512" || name == "best")
+                isa = Isa::Avx512;
             else
                 throw InvalidArgument("isa = '" + name +
                                       "' is not one of 'generic', 'avx2', 'avx512', 'best'");
@@ -790,7 +808,8 @@ void bind_core(py::module_& m) {
     m.def(
         "_set_max_threads",
         [](int n) {
-            if (n < 0) throw InvalidArgument("max_threads = " + std::to_string(n) + " must be >= 0");
+            if (n < 0)
+                throw InvalidArgument("max_threads = " + std::to_string(n) + " must be >= 0");
             g_max_threads.store(n);
         },
         arg("n"), "Benchmark aid: cap the worker threads of array loops (0: no cap).");
@@ -816,8 +835,7 @@ void bind_core(py::module_& m) {
                 os[i] = g ? rad_to_deg(g->theta_s_rad) : 0.0;
                 op[i] = g ? rad_to_deg(g->phi_s_rad) : 0.0;
             });
-            if (b.scalar)
-                return py::make_tuple(oi[0], os[0], op[0], py::bool_(ov[0]));
+            if (b.scalar) return py::make_tuple(oi[0], os[0], op[0], py::bool_(ov[0]));
             return py::make_tuple(ti, ts, ps, visible);
         },
         arg("N"), arg("L"), arg("V"), arg("unit_tolerance") = 1e-6,
@@ -838,9 +856,8 @@ vectors, arrays of the leading shape otherwise.)doc");
         "geometry_from_two_azimuths",
         [](py::handle theta_i_deg, py::handle phi_i_deg, py::handle theta_v_deg,
            py::handle phi_v_deg) {
-            auto [ops, b] =
-                broadcast<4>({"theta_i_deg", "phi_i_deg", "theta_v_deg", "phi_v_deg"},
-                             {theta_i_deg, phi_i_deg, theta_v_deg, phi_v_deg});
+            auto [ops, b] = broadcast<4>({"theta_i_deg", "phi_i_deg", "theta_v_deg", "phi_v_deg"},
+                                         {theta_i_deg, phi_i_deg, theta_v_deg, phi_v_deg});
             py::array_t<double> ti = make_output(b), ts = make_output(b), ps = make_output(b);
             double *oi = ti.mutable_data(), *os = ts.mutable_data(), *op = ps.mutable_data();
             for_each_element(b, true, [&](ssize_t i) {
@@ -890,15 +907,14 @@ k = 2π/λ. Angles in degrees, wavelength_um > 0 (default 0.555, the paper's). R
         "roughness_g",
         [](py::handle theta_i_deg, py::handle theta_s_deg, py::handle sigma_um,
            py::handle wavelength_um) {
-            return map_double<4>(
-                {"theta_i_deg", "theta_s_deg", "sigma_um", "wavelength_um"},
-                {theta_i_deg, theta_s_deg, sigma_um, wavelength_um},
-                [](double ti, double ts, double sigma, double wl) {
-                    const Geometry g = geometry_deg(ti, ts, 0.0);
-                    check::non_negative("sigma_um", sigma, "um");
-                    check::positive("wavelength_um", wl, "um");
-                    return roughness_g(g, sigma, wl);
-                });
+            return map_double<4>({"theta_i_deg", "theta_s_deg", "sigma_um", "wavelength_um"},
+                                 {theta_i_deg, theta_s_deg, sigma_um, wavelength_um},
+                                 [](double ti, double ts, double sigma, double wl) {
+                                     const Geometry g = geometry_deg(ti, ts, 0.0);
+                                     check::non_negative("sigma_um", sigma, "um");
+                                     check::positive("wavelength_um", wl, "um");
+                                     return roughness_g(g, sigma, wl);
+                                 });
         },
         arg("theta_i_deg"), arg("theta_s_deg"), arg("sigma_um"), arg("wavelength_um") = 0.555,
         R"doc(Roughness parameter g = σ² v_z² = (2πσ/λ)² (cos θi + cos θs)² (§3.1); it does not
@@ -912,8 +928,7 @@ depend on φs. sigma_um >= 0, wavelength_um > 0 (µm), angles in degrees, in [0,
             return map_double<3>({"theta_i_deg", "theta_s_deg", "phi_s_deg"},
                                  {theta_i_deg, theta_s_deg, phi_s_deg},
                                  [f](double ti, double ts, double ps) {
-                                     return geometric_factor_squared(f,
-                                                                     geometry_deg(ti, ts, ps));
+                                     return geometric_factor_squared(f, geometry_deg(ti, ts, ps));
                                  });
         },
         arg("factor"), arg("theta_i_deg"), arg("theta_s_deg"), arg("phi_s_deg"),
@@ -977,11 +992,10 @@ F_Beck(0, 0, ·) = 1; retro (θ, θ, 180): 1/cos²θ. Angles in degrees.)doc");
             opt.regime = parse_regime(regime);
             opt.radiometry = parse_radiometry(radiometry);
             opt.auto_tolerance = auto_tolerance;
-            auto [ops, b] = broadcast<8>(
-                {"theta_i_deg", "theta_s_deg", "phi_s_deg", "sigma_um", "T_um", "wavelength_um",
-                 "patch_x_um", "patch_y_um"},
-                {theta_i_deg, theta_s_deg, phi_s_deg, sigma_um, T_um, wavelength_um, patch_x_um,
-                 patch_y_um});
+            auto [ops, b] = broadcast<8>({"theta_i_deg", "theta_s_deg", "phi_s_deg", "sigma_um",
+                                          "T_um", "wavelength_um", "patch_x_um", "patch_y_um"},
+                                         {theta_i_deg, theta_s_deg, phi_s_deg, sigma_um, T_um,
+                                          wavelength_um, patch_x_um, patch_y_um});
             py::array_t<double> coh = make_output(b), dif = make_output(b), tot = make_output(b),
                                 bri = make_output(b), gg = make_output(b);
             py::array_t<std::uint8_t> reg(b.shape), cls(b.shape);
@@ -994,8 +1008,8 @@ F_Beck(0, 0, ·) = 1; retro (θ, θ, 180): 1/cos²θ. Angles in degrees.)doc");
                 o.wavelength_um = x[5];
                 o.patch_x_um = x[6];
                 o.patch_y_um = x[7];
-                const ScatteredPower p = mean_scattered_power(
-                    geometry_deg(x[0], x[1], x[2]), Surface{x[3], x[4], corr}, o);
+                const ScatteredPower p = mean_scattered_power(geometry_deg(x[0], x[1], x[2]),
+                                                              Surface{x[3], x[4], corr}, o);
                 oc[i] = p.coherent;
                 od[i] = p.diffuse;
                 ot[i] = p.total;
@@ -1003,10 +1017,10 @@ F_Beck(0, 0, ·) = 1; retro (θ, θ, 180): 1/cos²θ. Angles in degrees.)doc");
                 og[i] = p.g;
                 orr[i] = static_cast<std::uint8_t>(
                     std::find(kRegimes.begin(), kRegimes.end(), p.regime) - kRegimes.begin());
-                ocl[i] = static_cast<std::uint8_t>(
-                    std::find(kRoughnessClasses.begin(), kRoughnessClasses.end(),
-                              p.roughness_class) -
-                    kRoughnessClasses.begin());
+                ocl[i] = static_cast<std::uint8_t>(std::find(kRoughnessClasses.begin(),
+                                                             kRoughnessClasses.end(),
+                                                             p.roughness_class) -
+                                                   kRoughnessClasses.begin());
             });
             py::dict d;
             d["coherent"] = finish(b, coh);
@@ -1100,34 +1114,39 @@ exponential-correlation series without its prefactor. g >= 0, T2_vxy2 >= 0.)doc"
             py::arg("F2"), py::arg("T_um"), py::arg("area_um2"), py::arg("g"), py::arg("vxy2"),
             doc);
     };
-    series_like("diffuse_power_gaussian_series",
-                [](double a, double b, double c, double d, double e) {
-                    return diffuse_power_gaussian_series(a, b, c, d, e);
-                },
-                "Eq. 2: (πT²/A) F² exp(−g) Σ gⁿ/(n! n) exp(−T² v_xy²/(4n)). vxy2 = v_xy² in 1/µm².");
-    series_like("diffuse_power_slightly_rough_gaussian",
-                [](double a, double b, double c, double d, double e) {
-                    return diffuse_power_slightly_rough_gaussian(a, b, c, d, e);
-                },
-                "Eq. 3: (πT²/A) g F² exp(−g − T² v_xy²/4). vxy2 in 1/µm².");
-    series_like("diffuse_power_exponential_series",
-                [](double a, double b, double c, double d, double e) {
-                    return diffuse_power_exponential_series(a, b, c, d, e);
-                },
-                "Exact exponential-correlation series: (2πT²/A) F² exp(−g) Σ gⁿ/n! · n/(n² + "
-                "T² v_xy²)^{3/2}.");
-    series_like("diffuse_power_slightly_rough_exponential",
-                [](double a, double b, double c, double d, double e) {
-                    return diffuse_power_slightly_rough_exponential(a, b, c, d, e);
-                },
-                "First term of the exact exponential series: (2πT²/A) F² g exp(−g) / (1 + "
-                "T² v_xy²)^{3/2}.");
-    series_like("diffuse_power_very_rough_exponential_series_limit",
-                [](double a, double b, double c, double d, double e) {
-                    return diffuse_power_very_rough_exponential_series_limit(a, b, c, d, e);
-                },
-                "g → ∞ limit of the exact exponential series: (2πT²/A) F² g / (g² + T² "
-                "v_xy²)^{3/2}.");
+    series_like(
+        "diffuse_power_gaussian_series",
+        [](double a, double b, double c, double d, double e) {
+            return diffuse_power_gaussian_series(a, b, c, d, e);
+        },
+        "Eq. 2: (πT²/A) F² exp(−g) Σ gⁿ/(n! n) exp(−T² v_xy²/(4n)). vxy2 = v_xy² in 1/µm².");
+    series_like(
+        "diffuse_power_slightly_rough_gaussian",
+        [](double a, double b, double c, double d, double e) {
+            return diffuse_power_slightly_rough_gaussian(a, b, c, d, e);
+        },
+        "Eq. 3: (πT²/A) g F² exp(−g − T² v_xy²/4). vxy2 in 1/µm².");
+    series_like(
+        "diffuse_power_exponential_series",
+        [](double a, double b, double c, double d, double e) {
+            return diffuse_power_exponential_series(a, b, c, d, e);
+        },
+        "Exact exponential-correlation series: (2πT²/A) F² exp(−g) Σ gⁿ/n! · n/(n² + "
+        "T² v_xy²)^{3/2}.");
+    series_like(
+        "diffuse_power_slightly_rough_exponential",
+        [](double a, double b, double c, double d, double e) {
+            return diffuse_power_slightly_rough_exponential(a, b, c, d, e);
+        },
+        "First term of the exact exponential series: (2πT²/A) F² g exp(−g) / (1 + "
+        "T² v_xy²)^{3/2}.");
+    series_like(
+        "diffuse_power_very_rough_exponential_series_limit",
+        [](double a, double b, double c, double d, double e) {
+            return diffuse_power_very_rough_exponential_series_limit(a, b, c, d, e);
+        },
+        "g → ∞ limit of the exact exponential series: (2πT²/A) F² g / (g² + T² "
+        "v_xy²)^{3/2}.");
 
     auto very_rough_like = [&m](const char* name, auto fn, const char* doc) {
         m.def(
@@ -1150,17 +1169,19 @@ exponential-correlation series without its prefactor. g >= 0, T2_vxy2 >= 0.)doc"
             py::arg("F2"), py::arg("sigma_um"), py::arg("T_um"), py::arg("area_um2"),
             py::arg("vz2"), py::arg("vxy2"), doc);
     };
-    very_rough_like("diffuse_power_very_rough_gaussian",
-                    [](double a, double b, double c, double d, double e, double f) {
-                        return diffuse_power_very_rough_gaussian(a, b, c, d, e, f);
-                    },
-                    "Eq. 4: (πT²/(Aσ²)) F²/v_z² exp(−T² v_xy² / (4σ² v_z²)). vz2, vxy2 in 1/µm².");
-    very_rough_like("diffuse_power_very_rough_exponential",
-                    [](double a, double b, double c, double d, double e, double f) {
-                        return diffuse_power_very_rough_exponential(a, b, c, d, e, f);
-                    },
-                    "Eq. 5 as published: (2πT²/(Aσ²)) F² / (v_z² [1 + T² v_xy²/(σ² "
-                    "v_z²)]^{3/2}).");
+    very_rough_like(
+        "diffuse_power_very_rough_gaussian",
+        [](double a, double b, double c, double d, double e, double f) {
+            return diffuse_power_very_rough_gaussian(a, b, c, d, e, f);
+        },
+        "Eq. 4: (πT²/(Aσ²)) F²/v_z² exp(−T² v_xy² / (4σ² v_z²)). vz2, vxy2 in 1/µm².");
+    very_rough_like(
+        "diffuse_power_very_rough_exponential",
+        [](double a, double b, double c, double d, double e, double f) {
+            return diffuse_power_very_rough_exponential(a, b, c, d, e, f);
+        },
+        "Eq. 5 as published: (2πT²/(Aσ²)) F² / (v_z² [1 + T² v_xy²/(σ² "
+        "v_z²)]^{3/2}).");
 
     m.def(
         "diffuse_power_quadrature",
@@ -1298,12 +1319,13 @@ cos³θ exp(−k² ([T sin θ]² + [2σ cos θ]²)), k = 2π/λ. Lengths in µm.
         "Full Oren–Nayar model (1994) with the inter-reflection term, radiance for unit "
         "irradiance. sigma_rad: standard deviation of the facet slope angle in radians (>= 0; "
         "not the height σ); albedo in [0, 1]. σ = 0 gives (ρ/π) cos θi. Angles in degrees.");
-    oren_nayar_like("oren_nayar_qualitative_radiance",
-                    [](const Geometry& g, const OrenNayarParams& p) {
-                        return oren_nayar_qualitative_radiance(g, p);
-                    },
-                    "Qualitative Oren–Nayar model: (ρ/π) cos θi [A + B max(0, cos(φr − φi)) "
-                    "sin α tan β]. sigma_rad in radians, albedo in [0, 1]; angles in degrees.");
+    oren_nayar_like(
+        "oren_nayar_qualitative_radiance",
+        [](const Geometry& g, const OrenNayarParams& p) {
+            return oren_nayar_qualitative_radiance(g, p);
+        },
+        "Qualitative Oren–Nayar model: (ρ/π) cos θi [A + B max(0, cos(φr − φi)) "
+        "sin α tan β]. sigma_rad in radians, albedo in [0, 1]; angles in degrees.");
 
     m.def(
         "lafortune_diffuse_brightness",
@@ -1311,8 +1333,8 @@ cos³θ exp(−k² ([T sin θ]² + [2σ cos θ]²)), k = 2π/λ. Lengths in µm.
             return map_double<4>({"theta_i_deg", "theta_s_deg", "phi_s_deg", "n"},
                                  {theta_i_deg, theta_s_deg, phi_s_deg, n},
                                  [](double ti, double ts, double ps, double nn) {
-                                     return lafortune_diffuse_brightness(
-                                         geometry_deg(ti, ts, ps), nn);
+                                     return lafortune_diffuse_brightness(geometry_deg(ti, ts, ps),
+                                                                         nn);
                                  });
         },
         arg("theta_i_deg"), arg("theta_s_deg"), arg("phi_s_deg"), arg("n"),
@@ -1321,18 +1343,16 @@ cos³θ exp(−k² ([T sin θ]² + [2σ cos θ]²)), k = 2π/λ. Lengths in µm.
 
     m.def(
         "lafortune_brdf",
-        [](py::handle theta_i_deg, py::handle theta_s_deg, py::handle phi_s_deg,
-           py::handle lobes, double rho_d) {
+        [](py::handle theta_i_deg, py::handle theta_s_deg, py::handle phi_s_deg, py::handle lobes,
+           double rho_d) {
             const std::vector<LafortuneLobe> lobe_list = lobes_from_python(lobes);
-            return map_double<3>({"theta_i_deg", "theta_s_deg", "phi_s_deg"},
-                                 {theta_i_deg, theta_s_deg, phi_s_deg},
-                                 [&lobe_list, rho_d](double ti, double ts, double ps) {
-                                     return lafortune_brdf(geometry_deg(ti, ts, ps), lobe_list,
-                                                           rho_d);
-                                 });
+            return map_double<3>(
+                {"theta_i_deg", "theta_s_deg", "phi_s_deg"}, {theta_i_deg, theta_s_deg, phi_s_deg},
+                [&lobe_list, rho_d](double ti, double ts, double ps) {
+                    return lafortune_brdf(geometry_deg(ti, ts, ps), lobe_list, rho_d);
+                });
         },
-        arg("theta_i_deg"), arg("theta_s_deg"), arg("phi_s_deg"), arg("lobes"),
-        arg("rho_d") = 0.0,
+        arg("theta_i_deg"), arg("theta_s_deg"), arg("phi_s_deg"), arg("lobes"), arg("rho_d") = 0.0,
         R"doc(Lafortune et al. (1997) BRDF: rho_d/π + Σ_lobes albedo [Cx Lx Vx + Cy Ly Vy + Cz Lz Vz]^n
 (a lobe is 0 where its bracket is <= 0). lobes: a list of dicts with keys Cx, Cy, Cz, n, albedo
 (missing keys: Cx = Cy = 0, Cz = 1, n = 1, albedo = 1), or an array of shape (N, 5) with those

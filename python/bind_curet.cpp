@@ -1,20 +1,20 @@
 // Bindings for measured BRDFs (CUReT and any BRDF table) and the model comparison of §5.3.
 // Angles cross this boundary in degrees. Comparisons are returned as JSON text (the same document
 // as `roughscope curet --json --series`); the pure-Python roughscope.curet parses it.
+#include <optional>
+#include <string>
+#include <vector>
+
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 #include <pybind11/stl/filesystem.h>
 
-#include <optional>
-#include <string>
-#include <vector>
-
 #include "bindings.hpp"
-#include "roughscope/brdf_table.hpp"
-#include "roughscope/comparison.hpp"
-#include "roughscope/curet.hpp"
-#include "roughscope/errors.hpp"
+#include "roughscope/brdf/comparison.hpp"
+#include "roughscope/brdf/curet.hpp"
+#include "roughscope/brdf/table.hpp"
+#include "roughscope/core/errors.hpp"
 
 namespace py = pybind11;
 
@@ -31,15 +31,15 @@ py::array_t<double> matrix_array(const std::vector<std::vector<double>>& rows) {
     py::array_t<double> out({n, m});
     auto r = out.mutable_unchecked<2>();
     for (py::ssize_t i = 0; i < n; ++i)
-        for (py::ssize_t j = 0; j < m; ++j) r(i, j) = rows[static_cast<std::size_t>(i)][static_cast<std::size_t>(j)];
+        for (py::ssize_t j = 0; j < m; ++j)
+            r(i, j) = rows[static_cast<std::size_t>(i)][static_cast<std::size_t>(j)];
     return out;
 }
 
 ComparisonOptions make_options(std::optional<double> theta1_deg, std::optional<double> theta2_deg,
                                std::optional<std::vector<int>> pair,
-                               std::optional<double> on_sigma_rad,
-                               std::optional<double> on_albedo, bool fits,
-                               const std::string& radiometry,
+                               std::optional<double> on_sigma_rad, std::optional<double> on_albedo,
+                               bool fits, const std::string& radiometry,
                                std::optional<double> max_overflow) {
     ComparisonOptions o;
     if (theta1_deg.has_value() != theta2_deg.has_value())
@@ -96,33 +96,30 @@ py::dict table_dict(const BrdfTable& t) {
     return d;
 }
 
-BrdfTable table_from_arrays(py::array_t<double, py::array::c_style | py::array::forcecast> ti,
-                            py::array_t<double, py::array::c_style | py::array::forcecast> pi,
-                            py::array_t<double, py::array::c_style | py::array::forcecast> ts,
-                            py::array_t<double, py::array::c_style | py::array::forcecast> ps,
-                            py::array_t<double, py::array::c_style | py::array::forcecast> value,
-                            std::optional<py::array_t<double, py::array::c_style |
-                                                                  py::array::forcecast>>
-                                weight,
-                            const std::string& name) {
+BrdfTable table_from_arrays(
+    py::array_t<double, py::array::c_style | py::array::forcecast> ti,
+    py::array_t<double, py::array::c_style | py::array::forcecast> pi,
+    py::array_t<double, py::array::c_style | py::array::forcecast> ts,
+    py::array_t<double, py::array::c_style | py::array::forcecast> ps,
+    py::array_t<double, py::array::c_style | py::array::forcecast> value,
+    std::optional<py::array_t<double, py::array::c_style | py::array::forcecast>> weight,
+    const std::string& name) {
     const py::ssize_t n = value.size();
     for (auto [label, arr] : {std::pair{"theta_i_deg", &ti}, std::pair{"phi_i_deg", &pi},
                               std::pair{"theta_s_deg", &ts}, std::pair{"phi_s_deg", &ps}})
         if (arr->ndim() != 1 || arr->size() != n)
             throw InvalidArgument(std::string(label) + " must be a 1-D array as long as value (" +
-                                  std::to_string(n) + "), got size " +
-                                  std::to_string(arr->size()));
+                                  std::to_string(n) + "), got size " + std::to_string(arr->size()));
     if (value.ndim() != 1) throw InvalidArgument("value must be a 1-D array");
     if (weight && (weight->ndim() != 1 || weight->size() != n))
-        throw InvalidArgument("weight must be a 1-D array as long as value (" +
-                              std::to_string(n) + ")");
+        throw InvalidArgument("weight must be a 1-D array as long as value (" + std::to_string(n) +
+                              ")");
     BrdfTable t;
     t.name = name;
     for (py::ssize_t j = 0; j < n; ++j)
         t.measurements.push_back(make_brdf_measurement(
             static_cast<int>(j + 1), deg_to_rad(ti.at(j)), deg_to_rad(pi.at(j)),
-            deg_to_rad(ts.at(j)), deg_to_rad(ps.at(j)), value.at(j),
-            weight ? weight->at(j) : 1.0));
+            deg_to_rad(ts.at(j)), deg_to_rad(ps.at(j)), value.at(j), weight ? weight->at(j) : 1.0));
     return t;
 }
 
@@ -133,13 +130,14 @@ void bind_curet(py::module_& m) {
                               "The CUReT BRDF database for one channel (load with curet_load).")
         .def_property_readonly("directory",
                                [](const CuretDatabase& db) { return db.directory.string(); })
-        .def_property_readonly("channel",
-                               [](const CuretDatabase& db) { return std::string(to_string(db.channel)); })
+        .def_property_readonly(
+            "channel", [](const CuretDatabase& db) { return std::string(to_string(db.channel)); })
         .def_property_readonly(
             "samples",
             [](const CuretDatabase& db) {
                 py::array_t<long long> out(static_cast<py::ssize_t>(db.samples.size()));
-                for (std::size_t k = 0; k < db.samples.size(); ++k) out.mutable_at(static_cast<py::ssize_t>(k)) = db.samples[k];
+                for (std::size_t k = 0; k < db.samples.size(); ++k)
+                    out.mutable_at(static_cast<py::ssize_t>(k)) = db.samples[k];
                 return out;
             },
             "Sample numbers in file order (int64, shape (61,))")
@@ -182,7 +180,8 @@ void bind_curet(py::module_& m) {
             "table.txt in degrees (sample frame) plus theta_s_deg, phi_s_deg in the paper's frame "
             "(theta_s = theta_v, phi_s = phi_v - phi_i + 180)")
         .def(
-            "sample_table", [](const CuretDatabase& db, int sample) { return table_dict(db.sample_table(sample)); },
+            "sample_table",
+            [](const CuretDatabase& db, int sample) { return table_dict(db.sample_table(sample)); },
             py::arg("sample"), "One sample's measurements as a dict of numpy arrays (degrees)")
         .def(
             "compare",
@@ -190,9 +189,8 @@ void bind_curet(py::module_& m) {
                std::optional<double> theta2_deg, std::optional<std::vector<int>> pair,
                std::optional<double> on_sigma_rad, std::optional<double> on_albedo, bool fits,
                const std::string& radiometry, std::optional<double> max_overflow, bool series) {
-                const ComparisonOptions o =
-                    make_options(theta1_deg, theta2_deg, pair, on_sigma_rad, on_albedo, fits,
-                                 radiometry, max_overflow);
+                const ComparisonOptions o = make_options(theta1_deg, theta2_deg, pair, on_sigma_rad,
+                                                         on_albedo, fits, radiometry, max_overflow);
                 py::gil_scoped_release release;
                 return to_json(compare_curet_sample(db, sample, o), series, -1);
             },
@@ -207,9 +205,9 @@ void bind_curet(py::module_& m) {
             [](const CuretDatabase& db, bool fits, const std::string& radiometry,
                std::optional<double> max_overflow, int threads, const std::string& format,
                bool series) {
-                const ComparisonOptions o = make_options(std::nullopt, std::nullopt, std::nullopt,
-                                                         std::nullopt, std::nullopt, fits,
-                                                         radiometry, max_overflow);
+                const ComparisonOptions o =
+                    make_options(std::nullopt, std::nullopt, std::nullopt, std::nullopt,
+                                 std::nullopt, fits, radiometry, max_overflow);
                 if (format != "json" && format != "csv" && format != "markdown")
                     throw InvalidArgument("format '" + format +
                                           "' is not one of: json, csv, markdown");
@@ -243,8 +241,9 @@ void bind_curet(py::module_& m) {
         },
         py::arg("data_dir") = py::none(), py::arg("channel") = "mean",
         "Load the CUReT database (channel: mean, red, green, blue)");
-    m.def("curet_sample_name", [](int s) { return std::string(curet_sample_name(s)); },
-          py::arg("sample"), "The paper's name for samples 25, 34, 41; '' otherwise");
+    m.def(
+        "curet_sample_name", [](int s) { return std::string(curet_sample_name(s)); },
+        py::arg("sample"), "The paper's name for samples 25, 34, 41; '' otherwise");
     m.def(
         "curet_paper_oren_nayar",
         [](int s) -> py::object {
@@ -269,8 +268,7 @@ void bind_curet(py::module_& m) {
         [](const std::string& path, std::optional<std::string> channel,
            std::optional<double> theta1_deg, std::optional<double> theta2_deg,
            std::optional<std::vector<int>> pair, std::optional<double> on_sigma_rad,
-           std::optional<double> on_albedo, bool fits, const std::string& radiometry,
-           bool series) {
+           std::optional<double> on_albedo, bool fits, const std::string& radiometry, bool series) {
             BrdfCsvOptions co;
             co.channel = channel;
             const ComparisonOptions o = make_options(theta1_deg, theta2_deg, pair, on_sigma_rad,
@@ -301,21 +299,21 @@ void bind_curet(py::module_& m) {
                                                      on_albedo, fits, radiometry, std::nullopt);
             return to_json(compare_brdf(t, o), series, -1);
         },
-        py::arg("theta_i_deg"), py::arg("phi_i_deg"), py::arg("theta_s_deg"),
-        py::arg("phi_s_deg"), py::arg("value"), py::kw_only(), py::arg("weight") = py::none(),
-        py::arg("name") = "table", py::arg("theta1_deg") = py::none(),
-        py::arg("theta2_deg") = py::none(), py::arg("pair") = py::none(),
-        py::arg("on_sigma_rad") = py::none(), py::arg("on_albedo") = py::none(),
-        py::arg("fits") = true, py::arg("radiometry") = "radiance", py::arg("series") = true,
+        py::arg("theta_i_deg"), py::arg("phi_i_deg"), py::arg("theta_s_deg"), py::arg("phi_s_deg"),
+        py::arg("value"), py::kw_only(), py::arg("weight") = py::none(), py::arg("name") = "table",
+        py::arg("theta1_deg") = py::none(), py::arg("theta2_deg") = py::none(),
+        py::arg("pair") = py::none(), py::arg("on_sigma_rad") = py::none(),
+        py::arg("on_albedo") = py::none(), py::arg("fits") = true,
+        py::arg("radiometry") = "radiance", py::arg("series") = true,
         "Compare every model with a BRDF table given as arrays (degrees; measurement j+1 is "
         "element j). JSON text.");
     m.def(
         "comparison_error_measures",
         [](std::vector<double> model, std::vector<double> data,
            std::optional<std::vector<double>> weights) {
-            const ErrorMeasures e =
-                error_measures(model, data, weights ? std::span<const double>(*weights)
-                                                    : std::span<const double>());
+            const ErrorMeasures e = error_measures(
+                model, data,
+                weights ? std::span<const double>(*weights) : std::span<const double>());
             py::dict d;
             d["sse"] = e.paper_sse;
             d["rmse"] = e.rmse;

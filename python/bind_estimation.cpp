@@ -6,11 +6,6 @@
 // element raises a roughscope.Error subclass (ValueError) whose message starts with its index.
 // The estimate_* functions and the fits take scalars / 1-d arrays and return dicts whose keys are
 // those of the CLI's --json output.
-#include <pybind11/eigen.h>
-#include <pybind11/numpy.h>
-#include <pybind11/pybind11.h>
-#include <pybind11/stl.h>
-
 #include <array>
 #include <cmath>
 #include <optional>
@@ -18,14 +13,19 @@
 #include <utility>
 #include <vector>
 
+#include <pybind11/eigen.h>
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
 #include "bindings.hpp"
-#include "roughscope/beckmann.hpp"
-#include "roughscope/errors.hpp"
-#include "roughscope/estimation.hpp"
-#include "roughscope/fit.hpp"
-#include "roughscope/geometry.hpp"
-#include "roughscope/scattering.hpp"
-#include "roughscope/validity.hpp"
+#include "roughscope/core/errors.hpp"
+#include "roughscope/estimation/estimation.hpp"
+#include "roughscope/fit/fit.hpp"
+#include "roughscope/scattering/beckmann.hpp"
+#include "roughscope/scattering/factors.hpp"
+#include "roughscope/scattering/geometry.hpp"
+#include "roughscope/scattering/validity.hpp"
 
 namespace py = pybind11;
 using namespace py::literals;
@@ -168,7 +168,8 @@ std::vector<Measurement> measurements_from(py::handle theta_i_deg, py::handle th
     auto as_1d = [](const char* name, py::handle h) {
         DoubleArray a = DoubleArray::ensure(h);
         if (!a || a.ndim() > 1)
-            throw InvalidArgument(std::string(name) + " must be a number or a 1-d array of numbers");
+            throw InvalidArgument(std::string(name) +
+                                  " must be a number or a 1-d array of numbers");
         return a;
     };
     DoubleArray ti = as_1d("theta_i_deg", theta_i_deg), ts = as_1d("theta_s_deg", theta_s_deg),
@@ -200,12 +201,12 @@ std::vector<Measurement> measurements_from(py::handle theta_i_deg, py::handle th
 FitOptions fit_options_from(const std::string& model, const std::string& correlation,
                             const std::string& factor, const std::string& radiometry,
                             const std::string& regime, double wavelength_um,
-                            const std::string& residual, const std::string& loss,
-                            double loss_scale, std::optional<double> initial_sigma_over_T,
+                            const std::string& residual, const std::string& loss, double loss_scale,
+                            std::optional<double> initial_sigma_over_T,
                             std::optional<double> initial_sigma_um,
                             std::optional<double> initial_T_um, py::handle sigma_over_T_bounds,
-                            py::handle sigma_bounds_um, py::handle T_bounds_um,
-                            int max_iterations, bool scale_covariance) {
+                            py::handle sigma_bounds_um, py::handle T_bounds_um, int max_iterations,
+                            bool scale_covariance) {
     FitOptions o;
     o.model = parse_fit_model(model);
     o.correlation = correlation_of(correlation);
@@ -222,7 +223,8 @@ FitOptions fit_options_from(const std::string& model, const std::string& correla
     auto bounds = [](const char* name, py::handle h, double& lo, double& hi) {
         if (h.is_none()) return;
         auto v = h.cast<std::vector<double>>();
-        if (v.size() != 2) throw InvalidArgument(std::string(name) + " must be a pair (lower, upper)");
+        if (v.size() != 2)
+            throw InvalidArgument(std::string(name) + " must be a pair (lower, upper)");
         lo = v[0];
         hi = v[1];
     };
@@ -240,30 +242,29 @@ py::dict fit_dict(const FitResult& r) {
     d["message"] = r.message;
     py::dict params;
     for (const auto& p : r.parameters) {
-        params[p.name.c_str()] = py::dict("value"_a = p.value,
-                                          "stderr"_a = r.covariance_available
-                                                           ? py::object(py::float_(p.std_error))
-                                                           : py::object(py::none()),
-                                          "lower"_a = p.lower, "upper"_a = p.upper,
-                                          "at_bound"_a = p.at_bound);
+        params[p.name.c_str()] =
+            py::dict("value"_a = p.value,
+                     "stderr"_a = r.covariance_available ? py::object(py::float_(p.std_error))
+                                                         : py::object(py::none()),
+                     "lower"_a = p.lower, "upper"_a = p.upper, "at_bound"_a = p.at_bound);
     }
     d["parameters"] = params;
     const FitParameter& gain = r.parameter("gain");
     d["gain"] = gain.value;
-    d["gain_stderr"] = r.covariance_available ? py::object(py::float_(gain.std_error))
-                                              : py::object(py::none());
+    d["gain_stderr"] =
+        r.covariance_available ? py::object(py::float_(gain.std_error)) : py::object(py::none());
     if (!r.covariance_available) {
         for (const char* k : {"sigma_um_stderr", "T_um_stderr", "sigma_over_T_stderr",
                               "theta_K_deg_stderr", "xi_K_stderr", "rms_slope_stderr"})
             if (d.contains(k)) d[k] = py::none();
     }
     d["covariance_available"] = r.covariance_available;
-    d["covariance"] = r.covariance_available ? py::object(py::cast(r.covariance))
-                                             : py::object(py::none());
-    d["residuals"] = py::array_t<double>(static_cast<py::ssize_t>(r.residuals.size()),
-                                         r.residuals.data());
-    d["predicted"] = py::array_t<double>(static_cast<py::ssize_t>(r.predicted.size()),
-                                         r.predicted.data());
+    d["covariance"] =
+        r.covariance_available ? py::object(py::cast(r.covariance)) : py::object(py::none());
+    d["residuals"] =
+        py::array_t<double>(static_cast<py::ssize_t>(r.residuals.size()), r.residuals.data());
+    d["predicted"] =
+        py::array_t<double>(static_cast<py::ssize_t>(r.predicted.size()), r.predicted.data());
     d["sse"] = r.sse;
     d["aic"] = r.aic;
     d["aicc"] = r.aicc;
@@ -283,9 +284,11 @@ void bind_estimation(py::module_& m) {
     // ---- §4.2 closed forms (vectorised) -----------------------------------------------------
     m.def(
         "sigma_over_T_gaussian",
-        [](py::handle ratio, py::handle theta1_deg, py::handle theta2_deg, const std::string& factor) {
+        [](py::handle ratio, py::handle theta1_deg, py::handle theta2_deg,
+           const std::string& factor) {
             const GeometricFactor f = factor_of(factor);
-            return vectorize<3>({"ratio", "theta1_deg", "theta2_deg"}, {ratio, theta1_deg, theta2_deg},
+            return vectorize<3>({"ratio", "theta1_deg", "theta2_deg"},
+                                {ratio, theta1_deg, theta2_deg},
                                 [f](double r, double t1, double t2) {
                                     return sigma_over_T_gaussian_from_ratio(r, rad(t1), rad(t2), f);
                                 });
@@ -296,12 +299,14 @@ void bind_estimation(py::module_& m) {
         "NoSolution (a ValueError) with the valid range of ratios when there is no solution.");
     m.def(
         "sigma_over_T_exponential",
-        [](py::handle ratio, py::handle theta1_deg, py::handle theta2_deg, const std::string& factor) {
+        [](py::handle ratio, py::handle theta1_deg, py::handle theta2_deg,
+           const std::string& factor) {
             const GeometricFactor f = factor_of(factor);
-            return vectorize<3>({"ratio", "theta1_deg", "theta2_deg"}, {ratio, theta1_deg, theta2_deg},
-                                [f](double r, double t1, double t2) {
-                                    return sigma_over_T_exponential_from_ratio(r, rad(t1), rad(t2), f);
-                                });
+            return vectorize<3>(
+                {"ratio", "theta1_deg", "theta2_deg"}, {ratio, theta1_deg, theta2_deg},
+                [f](double r, double t1, double t2) {
+                    return sigma_over_T_exponential_from_ratio(r, rad(t1), rad(t2), f);
+                });
         },
         arg("ratio"), arg("theta1_deg"), arg("theta2_deg"), arg("factor") = "vh",
         "Eq. 19 (exponential correlation, Eq. 5 as published): sigma/T from E1/E2 at theta1, "
@@ -312,7 +317,8 @@ void bind_estimation(py::module_& m) {
             return range_tuple(ratio_range_gaussian(rad(t1), rad(t2), factor_of(factor)));
         },
         arg("theta1_deg"), arg("theta2_deg"), arg("factor") = "vh",
-        "Open interval (lower, upper) of E1/E2 for which Eq. 17 has a solution (upper may be inf).");
+        "Open interval (lower, upper) of E1/E2 for which Eq. 17 has a solution (upper may be "
+        "inf).");
     m.def(
         "ratio_range_exponential",
         [](double t1, double t2, const std::string& factor) {
@@ -333,8 +339,9 @@ void bind_estimation(py::module_& m) {
     m.def(
         "specular_reflectance_from_brightness",
         [](py::handle E_tot, py::handle E_dif) {
-            return vectorize<2>({"E_tot", "E_dif"}, {E_tot, E_dif},
-                                [](double t, double d) { return specular_reflectance_from_brightness(t, d); });
+            return vectorize<2>({"E_tot", "E_dif"}, {E_tot, E_dif}, [](double t, double d) {
+                return specular_reflectance_from_brightness(t, d);
+            });
         },
         arg("E_tot"), arg("E_dif"),
         "R_spec = 1 - E_dif/E_tot (section 4.1.1) from the peak and the surrounding diffuse "
@@ -357,12 +364,12 @@ void bind_estimation(py::module_& m) {
         [](py::handle ratio, py::handle sigma_um, py::handle theta1_deg, py::handle theta2_deg,
            py::handle wavelength_um, const std::string& factor) {
             const GeometricFactor f = factor_of(factor);
-            return vectorize<5>(
-                {"ratio", "sigma_um", "theta1_deg", "theta2_deg", "wavelength_um"},
-                {ratio, sigma_um, theta1_deg, theta2_deg, wavelength_um},
-                [f](double r, double s, double t1, double t2, double l) {
-                    return correlation_length_from_ratio(r, s, rad(t1), rad(t2), l, f);
-                });
+            return vectorize<5>({"ratio", "sigma_um", "theta1_deg", "theta2_deg", "wavelength_um"},
+                                {ratio, sigma_um, theta1_deg, theta2_deg, wavelength_um},
+                                [f](double r, double s, double t1, double t2, double l) {
+                                    return correlation_length_from_ratio(r, s, rad(t1), rad(t2), l,
+                                                                         f);
+                                });
         },
         arg("ratio"), arg("sigma_um"), arg("theta1_deg"), arg("theta2_deg"),
         arg("wavelength_um") = 0.555, arg("factor") = "vh",
@@ -407,18 +414,18 @@ void bind_estimation(py::module_& m) {
             o.regime = parse_regime(regime);
             o.wavelength_um = wavelength_um;
             const Correlation c = correlation_of(correlation);
-            return vectorize<8>(
-                {"ratio", "sigma_um", "theta_i1_deg", "theta_s1_deg", "phi_s1_deg",
-                 "theta_i2_deg", "theta_s2_deg", "phi_s2_deg"},
-                {ratio, sigma_um, ti1, ts1, ps1, ti2, ts2, ps2},
-                [o, c](double r, double s, double a1, double b1, double c1, double a2, double b2,
-                       double c2) {
-                    return correlation_length_two_geometries(r, geometry_deg(a1, b1, c1),
-                                                             geometry_deg(a2, b2, c2), s, c, o);
-                });
+            return vectorize<8>({"ratio", "sigma_um", "theta_i1_deg", "theta_s1_deg", "phi_s1_deg",
+                                 "theta_i2_deg", "theta_s2_deg", "phi_s2_deg"},
+                                {ratio, sigma_um, ti1, ts1, ps1, ti2, ts2, ps2},
+                                [o, c](double r, double s, double a1, double b1, double c1,
+                                       double a2, double b2, double c2) {
+                                    return correlation_length_two_geometries(
+                                        r, geometry_deg(a1, b1, c1), geometry_deg(a2, b2, c2), s, c,
+                                        o);
+                                });
         },
-        arg("ratio"), arg("sigma_um"), arg("theta_i1_deg"), arg("theta_s1_deg"),
-        arg("phi_s1_deg"), arg("theta_i2_deg"), arg("theta_s2_deg"), arg("phi_s2_deg"),
+        arg("ratio"), arg("sigma_um"), arg("theta_i1_deg"), arg("theta_s1_deg"), arg("phi_s1_deg"),
+        arg("theta_i2_deg"), arg("theta_s2_deg"), arg("phi_s2_deg"),
         arg("correlation") = "gaussian", arg("factor") = "vh", arg("radiometry") = "radiance",
         arg("regime") = "slightly_rough", arg("wavelength_um") = 0.555,
         "Correlation length T (um) with sigma known from E1/E2 at two arbitrary geometries, from "
@@ -514,16 +521,15 @@ void bind_estimation(py::module_& m) {
         "Returns a dict: status, message, parameters (value, stderr, bounds, at_bound), "
         "sigma_over_T(_stderr), gain, covariance (natural units), residuals, predicted, sse, aic, "
         "aicc, n, iterations, report, theta_K_deg, xi_K, rms_slope, roughness_class, g, warnings.";
-    auto fit_fn = [](py::handle ti, py::handle ts, py::handle ps, py::handle brightness,
-                     py::handle weight, const std::string& model, const std::string& correlation,
-                     const std::string& factor, const std::string& radiometry,
-                     const std::string& regime, double wavelength_um, const std::string& residual,
-                     const std::string& loss, double loss_scale,
-                     std::optional<double> initial_sigma_over_T,
-                     std::optional<double> initial_sigma_um, std::optional<double> initial_T_um,
-                     py::handle sigma_over_T_bounds, py::handle sigma_bounds_um,
-                     py::handle T_bounds_um, int max_iterations, bool scale_covariance,
-                     bool compare) -> py::dict {
+    auto fit_fn =
+        [](py::handle ti, py::handle ts, py::handle ps, py::handle brightness, py::handle weight,
+           const std::string& model, const std::string& correlation, const std::string& factor,
+           const std::string& radiometry, const std::string& regime, double wavelength_um,
+           const std::string& residual, const std::string& loss, double loss_scale,
+           std::optional<double> initial_sigma_over_T, std::optional<double> initial_sigma_um,
+           std::optional<double> initial_T_um, py::handle sigma_over_T_bounds,
+           py::handle sigma_bounds_um, py::handle T_bounds_um, int max_iterations,
+           bool scale_covariance, bool compare) -> py::dict {
         const auto ms = measurements_from(ti, ts, ps, brightness, weight);
         FitOptions o = fit_options_from(
             model, compare ? "gaussian" : correlation, factor, radiometry, regime, wavelength_um,
@@ -542,10 +548,9 @@ void bind_estimation(py::module_& m) {
             py::gil_scoped_release release;
             c = compare_correlations(ms, o);
         }
-        return py::dict("gaussian"_a = fit_dict(c.gaussian),
-                        "exponential"_a = fit_dict(c.exponential),
-                        "preferred"_a = std::string(to_string(c.preferred)),
-                        "delta_aic"_a = c.delta_aic);
+        return py::dict(
+            "gaussian"_a = fit_dict(c.gaussian), "exponential"_a = fit_dict(c.exponential),
+            "preferred"_a = std::string(to_string(c.preferred)), "delta_aic"_a = c.delta_aic);
     };
     m.def(
         "fit_roughness",
@@ -572,9 +577,9 @@ void bind_estimation(py::module_& m) {
     m.def(
         "compare_correlations",
         [fit_fn](py::handle ti, py::handle ts, py::handle ps, py::handle b, py::handle w,
-                 const std::string& model, const std::string& factor,
-                 const std::string& radiometry, const std::string& regime, double wavelength_um,
-                 const std::string& residual, const std::string& loss, double loss_scale) {
+                 const std::string& model, const std::string& factor, const std::string& radiometry,
+                 const std::string& regime, double wavelength_um, const std::string& residual,
+                 const std::string& loss, double loss_scale) {
             return fit_fn(ti, ts, ps, b, w, model, "gaussian", factor, radiometry, regime,
                           wavelength_um, residual, loss, loss_scale, std::nullopt, std::nullopt,
                           std::nullopt, py::none(), py::none(), py::none(), 200, true, true);

@@ -9,7 +9,7 @@
 #include <pybind11/pybind11.h>
 
 #include "bindings.hpp"
-#include "roughscope/errors.hpp"
+#include "roughscope/core/errors.hpp"
 #include "roughscope/version.hpp"
 
 namespace py = pybind11;
@@ -26,8 +26,7 @@ PYBIND11_MODULE(_core, m) {
     auto error = py::register_exception<roughscope::Error>(m, "Error", PyExc_ValueError);
     auto invalid =
         py::register_exception<roughscope::InvalidArgument>(m, "InvalidArgument", error.ptr());
-    auto no_solution =
-        py::register_exception<roughscope::NoSolution>(m, "NoSolution", error.ptr());
+    auto no_solution = py::register_exception<roughscope::NoSolution>(m, "NoSolution", error.ptr());
     auto data_error = py::register_exception<roughscope::DataError>(m, "DataError", error.ptr());
 
     // Show them as roughscope.Error etc. (the package re-exports them).

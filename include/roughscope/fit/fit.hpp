@@ -1,0 +1,147 @@
+// Least-squares roughness fits to N ≥ 3 brightness measurements (paper §4: "if a larger number of
+// measurements are available then least-square fitting techniques can be used").
+//
+// Brightness model: E_i = K · B(geom_i; θ) with an unknown camera gain K > 0 and
+//  * FitModel::VeryRough     θ = σ/T: B = Eq. 4 (Gaussian) or Eq. 5 as published (exponential)
+//                            without constants, × radiometric factor (any F, any radiometry);
+//  * FitModel::SlightlyRough θ = (σ, T) in µm: B = the diffuse term of mean_scattered_power in
+//                            the chosen regime (Eq. 3 by default; the exact series for moderately
+//                            rough surfaces), × radiometric factor, at wavelength λ.
+// Solved with Ceres (Levenberg–Marquardt, dense QR) on the logarithms of the parameters (which
+// keeps them positive and makes the problem better scaled), with bounds and an optional robust
+// loss. The covariance of the parameters is (JᵀJ)⁻¹ from an SVD of the Jacobian at the solution
+// (rank deficiency is reported, not printed), scaled by
+// the residual variance SSE/(N − p) unless scale_covariance = false (then the weights must be
+// 1/variance of the residuals), and is mapped to natural units by the delta method.
+//
+// Model comparison: AIC = N ln(SSE/N) + 2p (Gaussian errors of unknown variance), also the
+// small-sample AICc = AIC + 2p(p+1)/(N − p − 1). Lower is better; compare_correlations fits both
+// correlation functions and reports ΔAIC.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "roughscope/estimation/estimation.hpp"
+#include "roughscope/scattering/beckmann.hpp"
+#include "roughscope/scattering/factors.hpp"
+#include "roughscope/scattering/geometry.hpp"
+
+namespace roughscope {
+
+// One brightness measurement at a geometry (paper frame, radians).
+struct Measurement {
+    Geometry geometry;
+    double brightness = 0.0;  // > 0 (any unit; the gain K absorbs it)
+    double weight = 1.0;      // > 0; multiplies the squared residual
+};
+
+enum class FitModel { VeryRough, SlightlyRough };
+enum class ResidualType {
+    Relative,  // √w (K B − E)/E: suited to a relative (multiplicative) noise — the default
+    Absolute,  // √w (K B − E)
+    Log,       // √w (ln(K B) − ln E)
+};
+enum class LossType { None, Huber, Cauchy, SoftLOne };
+enum class SolverStatus { Converged, NoConvergence, Failed };
+
+std::string_view to_string(FitModel m);           // "very_rough", "slightly_rough"
+std::string_view to_string(ResidualType r);       // "relative", "absolute", "log"
+std::string_view to_string(LossType l);           // "none", "huber", "cauchy", "soft_l_one"
+std::string_view to_string(SolverStatus s);       // "converged", "no_convergence", "failed"
+FitModel parse_fit_model(std::string_view name);  // throw InvalidArgument listing the names
+ResidualType parse_residual_type(std::string_view name);
+LossType parse_loss_type(std::string_view name);
+
+struct FitOptions {
+    FitModel model = FitModel::VeryRough;
+    Correlation correlation = Correlation::Gaussian;
+    GeometricFactor factor = GeometricFactor::VernoldHarvey;  // §4.2's recommendation
+    Radiometry radiometry = Radiometry::Radiance;             // Harvey (§3.3)
+    // SlightlyRough model only: the regime of the diffuse term (SlightlyRough = Eq. 3 / first
+    // exponential term; Series or Auto = exact series) and the wavelength.
+    Regime regime = Regime::SlightlyRough;
+    double wavelength_um = 0.555;
+
+    ResidualType residual = ResidualType::Relative;
+    LossType loss = LossType::None;
+    double loss_scale = 0.05;  // where the robust loss starts to bend, in residual units
+
+    // Bounds (inclusive) of the fitted parameters.
+    double sigma_over_T_min = 1e-3, sigma_over_T_max = 1e3;
+    double sigma_min_um = 1e-4, sigma_max_um = 100.0;
+    double T_min_um = 1e-4, T_max_um = 1e4;
+
+    // Starting values; automatic when not given (docs/estimation.md): the very-rough model scans
+    // 25 log-spaced σ/T over the bounds with K profiled out; the slightly-rough model starts from
+    // the linear least squares of Eq. 3 in logs (a coarse scan when that fails).
+    std::optional<double> initial_sigma_over_T;
+    std::optional<double> initial_sigma_um;
+    std::optional<double> initial_T_um;
+
+    int max_iterations = 200;
+    double function_tolerance = 1e-12;
+    double gradient_tolerance = 1e-14;
+    double parameter_tolerance = 1e-12;
+    bool scale_covariance = true;  // multiply by SSE/(N − p) (noise level unknown)
+};
+
+struct FitParameter {
+    std::string name;  // "sigma_over_T", "sigma_um", "T_um", "gain"
+    double value = 0.0;
+    double std_error = 0.0;  // valid when FitResult::covariance_available
+    double lower = 0.0;      // bounds (gain: 0, inf)
+    double upper = 0.0;
+    bool at_bound = false;  // the solution sits on a bound: its std_error is not meaningful
+};
+
+struct FitResult {
+    SolverStatus status = SolverStatus::Failed;
+    std::string message;                   // Ceres' termination message and our notes
+    FitOptions options;                    // what was fitted
+    std::vector<FitParameter> parameters;  // model parameters, then the gain K
+    bool covariance_available = false;
+    Eigen::MatrixXd covariance;     // natural units, order of `parameters`
+    std::vector<double> residuals;  // weighted residuals at the solution
+    std::vector<double> predicted;  // K · B(geom_i) at the solution
+    double sse = 0.0;               // Σ residual²
+    double aic = 0.0;               // N ln(SSE/N) + 2p
+    double aicc = 0.0;              // AIC + 2p(p+1)/(N − p − 1) (inf when N ≤ p + 1)
+    int num_measurements = 0;
+    int num_parameters = 0;
+    int iterations = 0;
+    double initial_cost = 0.0;  // Ceres cost ½ Σ ρ(r²) at the start and the end
+    double final_cost = 0.0;
+    RoughnessEstimate estimate;  // σ/T (σ, T), m, θK, ξK, g, class, warnings
+
+    const FitParameter& parameter(std::string_view name) const;  // throws InvalidArgument
+    std::string brief_report() const;  // one paragraph, like ceres::Solver::Summary::BriefReport
+};
+
+// Fits the model of `options` to the measurements. Throws InvalidArgument for bad input
+// (fewer than p + 1 measurements, brightness or weight not > 0, a geometry outside [0°, 90°),
+// bad options); a solver failure is reported in the result's status, not thrown.
+FitResult fit_roughness(const std::vector<Measurement>& measurements,
+                        const FitOptions& options = {});
+
+// Fits the same data with both correlation functions (Gaussian, exponential), all other options
+// as given. preferred is the one with the lower AIC; delta_aic = AIC(other) − AIC(preferred).
+struct CorrelationComparison {
+    FitResult gaussian;
+    FitResult exponential;
+    Correlation preferred = Correlation::Gaussian;
+    double delta_aic = 0.0;
+};
+CorrelationComparison compare_correlations(const std::vector<Measurement>& measurements,
+                                           const FitOptions& options = {});
+
+// The model brightness B(geom) the fit uses (gain 1), for the parameters of a model:
+// {σ/T} for VeryRough, {σ_um, T_um} for SlightlyRough. Validates its inputs.
+double fit_model_brightness(const Geometry& geom, const std::vector<double>& parameters,
+                            const FitOptions& options);
+
+}  // namespace roughscope

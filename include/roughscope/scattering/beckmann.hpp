@@ -1,0 +1,196 @@
+// The Beckmann–Kirchhoff (B–K) mean scattered power, paper §3.1 (Eq. 1–5), with the geometric
+// factor and radiometric interpretation of §3.2–3.3 selectable.
+//
+// P(θi, φi = π, θs, φs) = ρ0² e^{−g} + D                                          (Eq. 1)
+//
+// Diffuse term D for an isotropic Gaussian height distribution, in every regime:
+//  * Gaussian correlation C(τ) = exp(−τ²/T²):
+//      Series         Eq. 2  (πT²/A) F² e^{−g} Σ_{n≥1} gⁿ/(n! n) exp(−T² v_xy²/4n)
+//      SlightlyRough  Eq. 3  first term of Eq. 2 (g ≪ 1)
+//      VeryRough      Eq. 4  (πT²/Aσ²) F²/v_z² exp(−T² v_xy²/(4σ² v_z²))  (g ≫ 1; = limit of Eq. 2)
+//  * Exponential correlation C(τ) = exp(−|τ|/T):
+//      Series         (2πT²/A) F² e^{−g} Σ_{n≥1} gⁿ/n! · n/(n² + T² v_xy²)^{3/2}
+//                     (the exact Kirchhoff series, from Cⁿ = e^{−nτ/T} and the order-0 Hankel
+//                     transform; not printed in the paper)
+//      SlightlyRough  first term of that series
+//      VeryRough      Eq. 5 exactly as published: (2πT²/Aσ²) F²/(v_z² [1 + T²v_xy²/σ²v_z²]^{3/2})
+//      VeryRoughSeriesLimit  g → ∞ limit of the exact series: (2πT²/A) F² g/(g² + T²v_xy²)^{3/2}
+//    Eq. 5 is NOT the large-g limit of the exact series (docs/exponential-correlation.md); the
+//    paper's Figs. 3–4 and Eq. 8, 10, 18, 19 use Eq. 5. Every result reports which one was used.
+//
+// Units: σ, T, λ, X, Y in µm; P is dimensionless (Beckmann's normalisation to a smooth plate).
+#pragma once
+
+#include <cmath>
+#include <string_view>
+
+#include "roughscope/scattering/factors.hpp"
+#include "roughscope/scattering/geometry.hpp"
+#include "roughscope/scattering/validity.hpp"
+
+namespace roughscope {
+
+enum class Correlation { Gaussian, Exponential };
+
+enum class Regime {
+    Auto,                  // Series when σ, T (and λ) are known; see ModelOptions::auto_tolerance
+    Series,                // exact series (Eq. 2, or the exact exponential series)
+    SlightlyRough,         // first term only (Eq. 3 for Gaussian)
+    VeryRough,             // the paper's very-rough closed forms, Eq. 4 (Gaussian), Eq. 5 (exp.)
+    VeryRoughSeriesLimit,  // g → ∞ limit of the exact series (Gaussian: identical to Eq. 4)
+};
+
+std::string_view to_string(Correlation c);  // "gaussian", "exponential"
+std::string_view to_string(Regime r);       // "auto", "series", "slightly_rough", "very_rough",
+                                            // "very_rough_series_limit"
+Correlation parse_correlation(std::string_view name);  // throws InvalidArgument listing names
+Regime parse_regime(std::string_view name);
+
+// ---------------------------------------------------------------------------------------------
+// Dimensionless Poisson-weighted sums (the series without their prefactors).
+// Exact for every g in [0, 1e7] and every T²v_xy² ≥ 0 (relative error ≲ 1e−13, checked against
+// 40-digit references): summed outward from the peak of the summand, so no term count is fixed
+// and nothing overflows; for wide peaks (g ≳ 200) the sum is evaluated by the exponentially
+// convergent trapezoid rule on the analytic continuation of the summand (Poisson summation), so
+// the cost stays bounded (~1 µs) however large g is.
+// Underflow to 0 is an expected physical zero (far outside the diffuse lobe).
+
+// S_G(g, a) = e^{−g} Σ_{n≥1} gⁿ/(n! n) exp(−a/n),  a = T² v_xy²/4                   (Eq. 2)
+double gaussian_series_sum(double g, double T2_vxy2);
+
+// S_E(g, b) = e^{−g} Σ_{n≥1} gⁿ/n! · n/(n² + b)^{3/2},  b = T² v_xy²
+double exponential_series_sum(double g, double T2_vxy2);
+
+// Textbook summation from n = 1 with a fixed number of terms and e^{−g} applied at the end:
+// the baseline the benchmarks compare against. Overflows (returns inf/nan) beyond g ≈ 709 and
+// is inaccurate when max_terms < ~g + 10√g. Not for production use.
+double gaussian_series_sum_naive(double g, double T2_vxy2, int max_terms);
+double exponential_series_sum_naive(double g, double T2_vxy2, int max_terms);
+
+// ---------------------------------------------------------------------------------------------
+// The individual terms as pure functions (unchecked inputs; F2 = F², vxy2 = v_xy², vz2 = v_z²).
+
+// ρ0 = sinc(vx X) sinc(vy Y) for a 2X × 2Y patch (§3.1); ρ0 = 1 in the specular direction.
+inline double specular_amplitude_rho0(double vx, double vy, double X_um, double Y_um) {
+    auto sinc = [](double x) { return std::abs(x) < 1e-8 ? 1.0 - x * x / 6.0 : std::sin(x) / x; };
+    return sinc(vx * X_um) * sinc(vy * Y_um);
+}
+
+// Coherent term of Eq. 1: ρ0² e^{−g}.
+inline double coherent_power(double rho0, double g) { return rho0 * rho0 * std::exp(-g); }
+
+// Eq. 2.
+inline double diffuse_power_gaussian_series(double F2, double T_um, double area_um2, double g,
+                                            double vxy2) {
+    return kPi * T_um * T_um / area_um2 * F2 * gaussian_series_sum(g, T_um * T_um * vxy2);
+}
+
+// Eq. 3.
+inline double diffuse_power_slightly_rough_gaussian(double F2, double T_um, double area_um2,
+                                                    double g, double vxy2) {
+    return kPi * T_um * T_um / area_um2 * g * F2 * std::exp(-g - T_um * T_um * vxy2 / 4.0);
+}
+
+// Eq. 4.
+inline double diffuse_power_very_rough_gaussian(double F2, double sigma_um, double T_um,
+                                                double area_um2, double vz2, double vxy2) {
+    const double s2 = sigma_um * sigma_um, T2 = T_um * T_um;
+    return kPi * T2 / (area_um2 * s2) * F2 / vz2 * std::exp(-T2 * vxy2 / (4.0 * s2 * vz2));
+}
+
+// Exact exponential-correlation series (see file comment).
+inline double diffuse_power_exponential_series(double F2, double T_um, double area_um2, double g,
+                                               double vxy2) {
+    return 2.0 * kPi * T_um * T_um / area_um2 * F2 * exponential_series_sum(g, T_um * T_um * vxy2);
+}
+
+// First term (n = 1) of the exact exponential series.
+inline double diffuse_power_slightly_rough_exponential(double F2, double T_um, double area_um2,
+                                                       double g, double vxy2) {
+    const double b = T_um * T_um * vxy2;
+    return 2.0 * kPi * T_um * T_um / area_um2 * F2 * g * std::exp(-g) / std::pow(1.0 + b, 1.5);
+}
+
+// Eq. 5, exactly as published.
+inline double diffuse_power_very_rough_exponential(double F2, double sigma_um, double T_um,
+                                                   double area_um2, double vz2, double vxy2) {
+    const double s2 = sigma_um * sigma_um, T2 = T_um * T_um;
+    return 2.0 * kPi * T2 / (area_um2 * s2) * F2 /
+           (vz2 * std::pow(1.0 + T2 * vxy2 / (s2 * vz2), 1.5));
+}
+
+// g → ∞ limit of the exact exponential series: (2πT²/A) F² g/(g² + T² v_xy²)^{3/2}.
+inline double diffuse_power_very_rough_exponential_series_limit(double F2, double T_um,
+                                                                double area_um2, double g,
+                                                                double vxy2) {
+    const double b = T_um * T_um * vxy2;
+    return 2.0 * kPi * T_um * T_um / area_um2 * F2 * g / std::pow(g * g + b, 1.5);
+}
+
+// Very-rough brightness shapes, which depend on the slope ratio σ/T only (constants dropped):
+//   Gaussian (Eq. 4):    F²/q_z² · exp(−q_xy² /(4 (σ/T)² q_z²))
+//   Exponential (Eq. 5): F²/(q_z² [1 + q_xy²/((σ/T)² q_z²)]^{3/2})
+// with q = v/k. Eq. 4 = (πT²/(Aσ²k²)) × shape, Eq. 5 = (2πT²/(Aσ²k²)) × shape.
+inline double very_rough_shape_gaussian(double F2, const ScatteringDirection& q,
+                                        double sigma_over_T) {
+    const double m2 = sigma_over_T * sigma_over_T;
+    return F2 / q.qz2() * std::exp(-q.qxy2() / (4.0 * m2 * q.qz2()));
+}
+inline double very_rough_shape_exponential(double F2, const ScatteringDirection& q,
+                                           double sigma_over_T) {
+    const double m2 = sigma_over_T * sigma_over_T;
+    return F2 / (q.qz2() * std::pow(1.0 + q.qxy2() / (m2 * q.qz2()), 1.5));
+}
+
+// ---------------------------------------------------------------------------------------------
+// Validated, user-facing evaluation.
+
+struct Surface {
+    double sigma_um = 0.0;  // RMS height σ
+    double T_um = 0.0;      // correlation length T
+    Correlation correlation = Correlation::Gaussian;
+};
+
+struct ModelOptions {
+    GeometricFactor factor = GeometricFactor::VernoldHarvey;  // the paper's recommendation (§4.2)
+    Radiometry radiometry = Radiometry::Radiance;             // Harvey's interpretation (§3.3)
+    Regime regime = Regime::Auto;
+    double wavelength_um = 0.555;  // the paper's mean wavelength (§5)
+    double patch_x_um = 500.0;     // half-sizes X, Y of the 2X × 2Y illuminated patch, A = 4XY
+    double patch_y_um = 500.0;
+    // Auto uses the one-term (slightly-rough) form only when the omitted terms are below this
+    // relative size (estimated from the second term); otherwise the exact series.
+    double auto_tolerance = 1e-12;
+};
+
+struct ScatteredPower {
+    double coherent = 0.0;           // ρ0² e^{−g}
+    double diffuse = 0.0;            // D in the regime used
+    double total = 0.0;              // P = coherent + diffuse (Eq. 1)
+    double brightness = 0.0;         // E/K: total under the chosen radiometric interpretation
+    double g = 0.0;                  // σ² v_z² at this geometry
+    Regime regime = Regime::Series;  // the regime actually used (never Auto)
+    RoughnessClass roughness_class = RoughnessClass::SlightlyRough;
+};
+
+// Eq. 1 at one geometry. Validates: θi, θs in [0°, 90°), φs finite, σ, T, λ, X, Y > 0 and
+// finite, auto_tolerance in (0, 1); throws InvalidArgument naming the input otherwise.
+ScatteredPower mean_scattered_power(const Geometry& geom, const Surface& surface,
+                                    const ModelOptions& options = {});
+
+// Very-rough diffuse brightness from σ/T alone (Eq. 4 or Eq. 5 as published, constants dropped,
+// times the radiometric factor): what the paper's §4.2 and §5 use. Validates inputs.
+double very_rough_brightness(const Geometry& geom, double sigma_over_T, Correlation correlation,
+                             GeometricFactor factor = GeometricFactor::VernoldHarvey,
+                             Radiometry radiometry = Radiometry::Radiance);
+
+// The diffuse Kirchhoff integral evaluated by direct numerical quadrature (adaptive
+// Gauss–Kronrod), independent of the series:
+//   D = (2π/A) F² e^{−g} ∫₀^∞ [exp(g C(τ)) − 1] J0(v_xy τ) τ dτ
+// Used to verify the series; slow (~0.1–10 ms), intended for g ≲ 50 and T·v_xy ≲ 50. Its error
+// is absolute (~1e−16 of the integrand's scale), so relative accuracy is lost where D is many
+// decades below that scale (far tails of the Gaussian lobe, e.g. T·v_xy = 20 at g < 1).
+double diffuse_power_quadrature(Correlation correlation, double F2, double T_um, double area_um2,
+                                double g, double vxy2);
+
+}  // namespace roughscope

@@ -1,0 +1,60 @@
+#include "roughscope/core/errors.hpp"
+
+#include <charconv>
+#include <cmath>
+#include <numbers>
+
+namespace roughscope::check {
+
+std::string format_number(double value) {
+    if (std::isnan(value)) return "nan";
+    if (std::isinf(value)) return value > 0 ? "inf" : "-inf";
+    char buf[64];
+    auto res = std::to_chars(buf, buf + sizeof(buf), value);
+    return std::string(buf, res.ptr);
+}
+
+namespace {
+std::string with_unit(double value, std::string_view unit) {
+    std::string s = format_number(value);
+    if (!unit.empty()) {
+        s += ' ';
+        s += unit;
+    }
+    return s;
+}
+}  // namespace
+
+void finite(std::string_view name, double value) {
+    if (!std::isfinite(value))
+        throw InvalidArgument(std::string(name) + " = " + format_number(value) +
+                              " is not a finite number");
+}
+
+void positive(std::string_view name, double value, std::string_view unit) {
+    if (!(std::isfinite(value) && value > 0.0))
+        throw InvalidArgument(std::string(name) + " = " + with_unit(value, unit) +
+                              " is invalid: it must be a finite number > 0");
+}
+
+void non_negative(std::string_view name, double value, std::string_view unit) {
+    if (!(std::isfinite(value) && value >= 0.0))
+        throw InvalidArgument(std::string(name) + " = " + with_unit(value, unit) +
+                              " is invalid: it must be a finite number >= 0");
+}
+
+void polar_angle(std::string_view name, double theta_rad) {
+    if (!(std::isfinite(theta_rad) && theta_rad >= 0.0 && theta_rad < std::numbers::pi / 2)) {
+        const double deg = theta_rad * 180.0 / std::numbers::pi;
+        throw InvalidArgument(std::string(name) + " = " + format_number(deg) +
+                              " deg is outside the valid range [0, 90) deg");
+    }
+}
+
+void azimuth(std::string_view name, double phi_rad) {
+    if (!std::isfinite(phi_rad))
+        throw InvalidArgument(std::string(name) + " = " + format_number(phi_rad) +
+                              " is not a finite angle");
+}
+
+}  // namespace roughscope::check

@@ -1,0 +1,450 @@
+// The CUReT database and the paper's §5.3 comparison (Tables 3 and 4).
+// Real data: ROUGHSCOPE_SOURCE_DIR/../shared/data/curet (tests skip, saying so, when it is absent);
+// printed values: ROUGHSCOPE_SOURCE_DIR/../shared/reference/paper-tables.json.
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <string>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "roughscope/brdf/comparison.hpp"
+#include "roughscope/brdf/curet.hpp"
+#include "roughscope/core/errors.hpp"
+#include "roughscope/scattering/beckmann.hpp"
+#include "roughscope/scattering/reflectance_models.hpp"
+
+using namespace roughscope;
+namespace fs = std::filesystem;
+
+namespace {
+
+fs::path curet_dir() {
+    return fs::path(ROUGHSCOPE_SOURCE_DIR) / ".." / "shared" / "data" / "curet";
+}
+fs::path tables_path() {
+    return fs::path(ROUGHSCOPE_SOURCE_DIR) / ".." / "shared" / "reference" / "paper-tables.json";
+}
+
+bool have_curet() {
+    return fs::exists(curet_dir() / "abrdf.dat") && fs::exists(curet_dir() / "table.txt");
+}
+
+#define REQUIRE_CURET()                                                \
+    if (!have_curet())                                                 \
+    GTEST_SKIP() << "CUReT data not found at " << curet_dir().string() \
+                 << " (abrdf.dat, table.txt); the database is not part of the repository"
+
+#define REQUIRE_TABLES()            \
+    if (!fs::exists(tables_path())) \
+    GTEST_SKIP() << "paper tables not found at " << tables_path().string()
+
+const CuretDatabase& database() {
+    static const CuretDatabase db = load_curet(curet_dir());
+    return db;
+}
+
+nlohmann::json paper_tables() {
+    std::ifstream in(tables_path());
+    return nlohmann::json::parse(in);
+}
+
+// Rounds to `digits` significant digits.
+double significant(double x, int digits) {
+    const double scale = std::pow(10.0, digits - 1 - std::floor(std::log10(std::abs(x))));
+    return std::round(x * scale) / scale;
+}
+
+// Synthetic CUReT files in a temporary directory (independent of the real data).
+struct SyntheticCuret {
+    fs::path dir;
+    explicit SyntheticCuret(const std::string& tag) {
+        dir = fs::temp_directory_path() /
+              ("roughscope_curet_" + tag + "_" +
+               std::to_string(::testing::UnitTest::GetInstance()->random_seed()));
+        fs::create_directories(dir);
+        std::ofstream table(dir / "table.txt");
+        for (int j = 1; j <= kCuretMeasurementCount; ++j) {
+            double tv = 0.01 * (j % 80), pv = 0.03 * j, ti = 0.012 * (j % 100), pi = -0.02 * j;
+            if (j == kCuretTwoPointMeasurement1) tv = 0.0, pv = 0.0, ti = 0.785398, pi = 0.0;
+            if (j == kCuretTwoPointMeasurement2) tv = 1e-6, pv = 0.0, ti = 1.178097, pi = 0.0;
+            table << j << " " << tv << " " << pv << " " << ti << " " << pi << "\n";
+        }
+    }
+    void write_samples(const std::string& file, const std::vector<int>& samples, double value) {
+        std::ofstream f(dir / file);
+        for (int s : samples) {
+            f << s;
+            for (int j = 1; j <= kCuretMeasurementCount; ++j) f << " " << value * (1 + 0.001 * j);
+            f << "\n";
+        }
+    }
+    ~SyntheticCuret() {
+        std::error_code ec;
+        fs::remove_all(dir, ec);
+    }
+};
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------------
+// Loading
+
+TEST(Curet, LoadsTheDatabaseAsTheReadmeDescribes) {
+    REQUIRE_CURET();
+    const CuretDatabase& db = database();
+    ASSERT_EQ(db.samples.size(), static_cast<std::size_t>(kCuretSampleCount));
+    ASSERT_EQ(db.angles.size(), static_cast<std::size_t>(kCuretMeasurementCount));
+    EXPECT_EQ(db.samples.front(), 1);
+    EXPECT_EQ(db.samples.back(), 61);
+    // Measurement 81: θv = 0, θi = 45°, φi = 0; 112: θv ≈ 0, θi = 67.5° (README).
+    const CuretAngles& a81 = db.angles[80];
+    const CuretAngles& a112 = db.angles[111];
+    EXPECT_EQ(a81.measurement, 81);
+    EXPECT_NEAR(a81.theta_v_rad, 0.0, 1e-6);
+    EXPECT_NEAR(rad_to_deg(a81.theta_i_rad), 45.0, 1e-4);
+    EXPECT_NEAR(a112.theta_v_rad, 0.0, 1e-5);
+    EXPECT_NEAR(rad_to_deg(a112.theta_i_rad), 67.5, 1e-4);
+    // 43 of the 12,505 values are ≤ 0, and they are loaded as they are.
+    int nonpositive = 0;
+    for (const auto& row : db.brdf)
+        for (double f : row) nonpositive += f <= 0.0;
+    EXPECT_EQ(nonpositive, 43);
+    EXPECT_TRUE(db.overflow.empty());  // no overflow files in the shared copy
+}
+
+TEST(Curet, SampleTableUsesThePaperFrame) {
+    REQUIRE_CURET();
+    const BrdfTable t = database().sample_table(25);
+    ASSERT_EQ(t.size(), static_cast<std::size_t>(kCuretMeasurementCount));
+    for (const BrdfMeasurement& m : t.measurements) {
+        // θs = θv and cos(φs) = cos(φv − φi + π) = −cos(φv − φi).
+        EXPECT_DOUBLE_EQ(m.geometry.theta_s_rad, m.theta_v_rad);
+        EXPECT_NEAR(std::cos(m.geometry.phi_s_rad), -std::cos(m.phi_v_rad - m.phi_i_rad), 1e-12);
+    }
+}
+
+TEST(Curet, UnknownSampleAndChannelAreErrors) {
+    REQUIRE_CURET();
+    EXPECT_THROW(database().sample_table(62), InvalidArgument);
+    EXPECT_THROW(compare_curet_sample(database(), 0), InvalidArgument);
+    try {
+        load_curet(curet_dir(), CuretChannel::Red);  // rbrdf.dat is not in the shared copy
+        FAIL() << "expected DataError";
+    } catch (const DataError& e) {
+        EXPECT_NE(std::string(e.what()).find("rbrdf.dat"), std::string::npos) << e.what();
+    }
+    EXPECT_THROW(parse_curet_channel("purple"), InvalidArgument);
+    EXPECT_EQ(parse_curet_channel("g"), CuretChannel::Green);
+}
+
+TEST(CuretFiles, SyntheticFilesLoadWithOverflowFractions) {
+    SyntheticCuret s("ok");
+    s.write_samples("abrdf.dat", {3, 9}, 0.05);
+    s.write_samples("rover.dat", {9, 3}, 0.1);
+    s.write_samples("bover.dat", {3, 9}, 0.2);
+    const CuretDatabase db = load_curet(s.dir);
+    EXPECT_EQ(db.samples, (std::vector<int>{3, 9}));
+    ASSERT_EQ(db.overflow.size(), 2u);
+    // The mean channel takes the largest fraction over the channel files present.
+    EXPECT_NEAR(db.overflow[0][0], 0.2 * 1.001, 1e-12);
+    EXPECT_EQ(db.overflow_files, (std::vector<std::string>{"rover.dat", "bover.dat"}));
+    EXPECT_NEAR(db.brdf[1][204], 0.05 * 1.205, 1e-12);
+    const BrdfTable t = db.sample_table(9);
+    ASSERT_TRUE(t.measurements[0].overflow_fraction.has_value());
+}
+
+TEST(CuretFiles, MalformedFilesNameTheFileAndLine) {
+    auto error_of = [](const fs::path& dir) {
+        try {
+            load_curet(dir);
+        } catch (const DataError& e) {
+            return std::string(e.what());
+        }
+        return std::string("no error");
+    };
+    {
+        SyntheticCuret s("missing");
+        EXPECT_NE(error_of(s.dir).find("abrdf.dat"), std::string::npos);
+    }
+    {
+        SyntheticCuret s("nan");
+        s.write_samples("abrdf.dat", {1}, 0.05);
+        std::ofstream(s.dir / "abrdf.dat", std::ios::app) << "2 nan\n";
+        const std::string e = error_of(s.dir);
+        EXPECT_NE(e.find("abrdf.dat:2: expected 206 fields"), std::string::npos) << e;
+    }
+    {
+        SyntheticCuret s("dup");
+        s.write_samples("abrdf.dat", {4, 4}, 0.05);
+        EXPECT_NE(error_of(s.dir).find("abrdf.dat:2: sample 4 appears twice"), std::string::npos);
+    }
+    {
+        SyntheticCuret s("badnum");
+        std::ofstream f(s.dir / "abrdf.dat");
+        f << "1";
+        for (int j = 1; j <= kCuretMeasurementCount; ++j) f << (j == 7 ? " 0.1x" : " 0.1");
+        f << "\n";
+        f.close();
+        EXPECT_NE(error_of(s.dir).find("abrdf.dat:1: field 8 (BRDF value): '0.1x'"),
+                  std::string::npos)
+            << error_of(s.dir);
+    }
+    {
+        SyntheticCuret s("angles");
+        s.write_samples("abrdf.dat", {1}, 0.05);
+        std::ofstream(s.dir / "table.txt") << "1 0.1 0 2.0 0\n";
+        EXPECT_NE(error_of(s.dir).find("table.txt:1: theta_i"), std::string::npos)
+            << error_of(s.dir);
+    }
+    {
+        SyntheticCuret s("overflow");
+        s.write_samples("abrdf.dat", {1}, 0.05);
+        s.write_samples("gover.dat", {1}, 2.0);  // fractions > 1
+        EXPECT_NE(error_of(s.dir).find("gover.dat:1: measurement 1: overflow fraction"),
+                  std::string::npos)
+            << error_of(s.dir);
+    }
+}
+
+TEST(CuretFiles, FindDirectoryExplainsWhatIsMissing) {
+    try {
+        find_curet_directory(fs::path("/nonexistent/curet"));
+        FAIL() << "expected DataError";
+    } catch (const DataError& e) {
+        const std::string m = e.what();
+        EXPECT_NE(m.find("table.txt"), std::string::npos) << m;
+        EXPECT_NE(m.find("abrdf.dat"), std::string::npos) << m;
+        EXPECT_NE(m.find("CUReT"), std::string::npos) << m;
+    }
+    SyntheticCuret s("find");
+    s.write_samples("abrdf.dat", {1}, 0.05);
+    EXPECT_EQ(find_curet_directory(s.dir), s.dir);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Table 3
+
+TEST(CuretPaper, Table3EstimatesMatchThePrintedValues) {
+    REQUIRE_CURET();
+    REQUIRE_TABLES();
+    const nlohmann::json t3 = paper_tables()["table3_curet_parameters"];
+    for (const auto& row : t3["rows"]) {
+        const int sample = row["sample"];
+        const Comparison c = compare_curet_sample(database(), sample);
+        ASSERT_TRUE(c.two_point.available) << c.two_point.reason;
+        // 5 significant digits with the angle table's own θi.
+        EXPECT_EQ(significant(*c.two_point.E1_over_E2, 5),
+                  significant(row["E1_over_E2"].get<double>(), 5))
+            << "sample " << sample;
+        // σ/T to the 4 printed decimals.
+        EXPECT_NEAR(*c.two_point.sigma_over_T_gaussian, row["sigma_over_T_G"].get<double>(), 0.5e-4)
+            << "sample " << sample;
+        EXPECT_NEAR(*c.two_point.sigma_over_T_exponential, row["sigma_over_T_E"].get<double>(),
+                    0.5e-4)
+            << "sample " << sample;
+        // With the nominal angles θ1 = 45°, θ2 = 67.5° all 7 printed digits come back: the
+        // residual difference above is the angle table's last digit for measurement 112.
+        ComparisonOptions nominal;
+        nominal.theta1_rad = deg_to_rad(t3["conditions"]["theta1_deg"].get<double>());
+        nominal.theta2_rad = deg_to_rad(t3["conditions"]["theta2_deg"].get<double>());
+        nominal.fits = false;
+        const Comparison n = compare_curet_sample(database(), sample, nominal);
+        EXPECT_NEAR(*n.two_point.E1_over_E2, row["E1_over_E2"].get<double>(), 0.5e-6)
+            << "sample " << sample;
+        // The paper's Oren–Nayar parameters are the ones used.
+        const ModelResult& on = c.result(ComparisonModel::OrenNayar);
+        EXPECT_DOUBLE_EQ(*on.parameter("sigma_rad"), row["sigma_ON_rad"].get<double>());
+        EXPECT_DOUBLE_EQ(*on.parameter("albedo"), row["rho_ON"].get<double>());
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Table 4
+
+TEST(CuretPaper, Table4VeryRoughColumnsWithinOneTenthPercent) {
+    REQUIRE_CURET();
+    REQUIRE_TABLES();
+    const nlohmann::json t4 = paper_tables()["table4_curet_errors"];
+    const ComparisonModel columns[] = {ComparisonModel::BkGaussian, ComparisonModel::BkExponential,
+                                       ComparisonModel::VhGaussian, ComparisonModel::VhExponential};
+    for (const auto& row : t4["rows"]) {
+        const int sample = row["sample"];
+        ComparisonOptions o;
+        o.fits = false;
+        const Comparison c = compare_curet_sample(database(), sample, o);
+        for (int k = 0; k < 4; ++k) {
+            const double printed = row["values"][2 + k].get<double>();
+            const double got = c.result(columns[k]).errors.paper_sse;
+            EXPECT_NEAR(got / printed - 1.0, 0.0, 1e-3)
+                << "sample " << sample << " " << to_string(columns[k]) << ": " << got
+                << " vs printed " << printed;
+        }
+    }
+}
+
+TEST(CuretPaper, Table4OrenNayarForSamples25And34WithinHalfAPercent) {
+    REQUIRE_CURET();
+    REQUIRE_TABLES();
+    const nlohmann::json t4 = paper_tables()["table4_curet_errors"];
+    for (const auto& row : t4["rows"]) {
+        const int sample = row["sample"];
+        if (sample == 41) continue;  // not reproducible; see the next test and docs/curet.md
+        ComparisonOptions o;
+        o.fits = false;
+        const double got = compare_curet_sample(database(), sample, o)
+                               .result(ComparisonModel::OrenNayar)
+                               .errors.paper_sse;
+        const double printed = row["values"][0].get<double>();
+        EXPECT_NEAR(got / printed - 1.0, 0.0, 5e-3) << "sample " << sample << ": " << got;
+    }
+}
+
+TEST(CuretPaper, Table4RankingStatedInThePaperHolds) {
+    // §5.3: V–H below B–K ("an order of magnitude lower"), B–K(G) below B–K(E), O–N above both
+    // B–K variants, LFTG below O–N and above V–H, for the three samples. This also holds for the
+    // values that are not reproduced exactly (O–N for 41, LFTG).
+    REQUIRE_CURET();
+    for (int sample : {25, 34, 41}) {
+        ComparisonOptions o;
+        o.fits = false;
+        const Comparison c = compare_curet_sample(database(), sample, o);
+        auto e = [&](ComparisonModel m) { return c.result(m).errors.paper_sse; };
+        EXPECT_LT(5.0 * e(ComparisonModel::VhGaussian), e(ComparisonModel::BkGaussian));
+        EXPECT_LT(5.0 * e(ComparisonModel::VhExponential), e(ComparisonModel::BkExponential));
+        EXPECT_LT(e(ComparisonModel::BkGaussian), e(ComparisonModel::BkExponential));
+        EXPECT_GT(e(ComparisonModel::OrenNayar), e(ComparisonModel::BkExponential));
+        EXPECT_LT(e(ComparisonModel::Lafortune), e(ComparisonModel::OrenNayar));
+        EXPECT_GT(e(ComparisonModel::Lafortune), e(ComparisonModel::VhGaussian));
+        EXPECT_GT(e(ComparisonModel::Lafortune), e(ComparisonModel::VhExponential));
+    }
+}
+
+TEST(CuretPaper, PredictionsAreTheCoreModels) {
+    // The comparison evaluates the models through precomputed terms; they must equal the core
+    // functions at every geometry (Oren–Nayar through oren_nayar_radiance, LFTG through
+    // lafortune_diffuse_brightness, B–K/V–H through very_rough_brightness).
+    REQUIRE_CURET();
+    const Comparison c = compare_curet_sample(database(), 25);
+    const ModelResult& on = c.result(ComparisonModel::OrenNayar);
+    const ModelResult& laf = c.result(ComparisonModel::LafortuneFit);
+    const ModelResult& bk = c.result(ComparisonModel::BkGaussian);
+    const ModelResult& vh = c.result(ComparisonModel::VhExponentialFit);
+    const OrenNayarParams on_params{*on.parameter("sigma_rad"), *on.parameter("albedo")};
+    for (std::size_t j = 0; j < c.geometry.size(); ++j) {
+        const Geometry& g = c.geometry[j];
+        EXPECT_DOUBLE_EQ(on.prediction[j], oren_nayar_radiance(g, on_params));
+        EXPECT_NEAR(laf.prediction[j], lafortune_diffuse_brightness(g, *laf.parameter("n")),
+                    1e-13 * laf.prediction[j] + 1e-300);
+        EXPECT_NEAR(bk.prediction[j],
+                    very_rough_brightness(g, *bk.parameter("sigma_over_T"), Correlation::Gaussian,
+                                          GeometricFactor::Beckmann),
+                    1e-12 * bk.prediction[j]);
+        EXPECT_NEAR(
+            vh.prediction[j],
+            very_rough_brightness(g, *vh.parameter("sigma_over_T"), Correlation::Exponential),
+            1e-12 * vh.prediction[j]);
+        EXPECT_NEAR(c.brightness[j],
+                    database().brdf[24][static_cast<std::size_t>(c.measurement[j] - 1)] *
+                        std::cos(g.theta_i_rad),
+                    1e-15);
+    }
+}
+
+TEST(CuretPaper, FitsNeverDoWorseThanTheTwoPointEstimate) {
+    // The least-squares fit minimises the gain SSE over σ/T, so it cannot be above the two-point
+    // value of the same family (which is inside its search interval).
+    REQUIRE_CURET();
+    for (int sample : {7, 25, 34, 41, 57}) {
+        const Comparison c = compare_curet_sample(database(), sample);
+        const std::pair<ComparisonModel, ComparisonModel> pairs[] = {
+            {ComparisonModel::BkGaussian, ComparisonModel::BkGaussianFit},
+            {ComparisonModel::BkExponential, ComparisonModel::BkExponentialFit},
+            {ComparisonModel::VhGaussian, ComparisonModel::VhGaussianFit},
+            {ComparisonModel::VhExponential, ComparisonModel::VhExponentialFit},
+        };
+        for (const auto& [paper, fit] : pairs)
+            EXPECT_LE(c.result(fit).errors.gain_sse, c.result(paper).errors.gain_sse * (1 + 1e-9))
+                << "sample " << sample << " " << to_string(fit);
+        // The exhaustive search's n_d is a minimum of the Table-4 error on its grid.
+        const double n = *c.result(ComparisonModel::Lafortune).parameter("n");
+        EXPECT_GE(n, 0.1 - 1e-12);
+        EXPECT_LE(n, 20.0 + 1e-12);
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// The whole database, including sample 61
+
+TEST(CuretAll, EverySampleIsProcessedAndSample61ExplainsItsMissingEstimate) {
+    REQUIRE_CURET();
+    const std::vector<Comparison> all = compare_curet_all(database(), {}, 2);
+    ASSERT_EQ(all.size(), 61u);
+    int with_estimate = 0, nonpositive = 0;
+    for (const Comparison& c : all) {
+        with_estimate += c.two_point.available;
+        for (const DataIssue& d : c.data_issues) nonpositive += d.issue == "non_positive";
+        EXPECT_EQ(c.measurement.size(), 205u) << "sample " << c.sample;  // nothing dropped
+        EXPECT_TRUE(c.winner.has_value()) << "sample " << c.sample;
+    }
+    EXPECT_EQ(with_estimate, 60);
+    EXPECT_EQ(nonpositive, 43);
+    const Comparison& c61 = all.back();
+    ASSERT_EQ(c61.sample, 61);
+    EXPECT_FALSE(c61.two_point.available);
+    EXPECT_NE(c61.two_point.reason.find("measurement 81 has f = -0.001 <= 0"), std::string::npos)
+        << c61.two_point.reason;
+    EXPECT_NE(c61.two_point.reason.find("measurement 112"), std::string::npos);
+    int excluded = 0;
+    for (const DataIssue& d : c61.data_issues)
+        if (!d.excluded_from.empty()) {
+            ++excluded;
+            EXPECT_TRUE(d.measurement == 81 || d.measurement == 112);
+            EXPECT_EQ(d.excluded_from.front(), "two_point_estimate");
+        }
+    EXPECT_EQ(excluded, 2);
+    EXPECT_FALSE(c61.result(ComparisonModel::VhGaussian).available);
+    EXPECT_TRUE(c61.result(ComparisonModel::VhGaussianFit).available);
+    EXPECT_TRUE(c61.result(ComparisonModel::Lafortune).available);
+    // Threads do not change results.
+    const std::vector<Comparison> one = compare_curet_all(database(), {}, 1);
+    for (std::size_t k = 0; k < all.size(); ++k)
+        EXPECT_EQ(one[k].result(ComparisonModel::VhExponentialFit).errors.gain_sse,
+                  all[k].result(ComparisonModel::VhExponentialFit).errors.gain_sse);
+    EXPECT_THROW(compare_curet_all(database(), {}, -1), InvalidArgument);
+}
+
+TEST(CuretAll, OutputsCarryTheDocumentedKeysAndNeverNaN) {
+    REQUIRE_CURET();
+    ComparisonOptions o;
+    o.fits = false;
+    std::vector<Comparison> some = {compare_curet_sample(database(), 25, o),
+                                    compare_curet_sample(database(), 61, o)};
+    const std::string text = to_json(some, true);
+    EXPECT_EQ(text.find("nan"), std::string::npos);
+    EXPECT_EQ(text.find("NaN"), std::string::npos);
+    const nlohmann::json j = nlohmann::json::parse(text);
+    ASSERT_EQ(j.size(), 2u);
+    for (const char* key :
+         {"sample", "E1_over_E2", "sigma_over_T_gaussian", "sigma_over_T_exponential", "sse",
+          "rmse", "sse_gain", "winner", "data_issues", "series"})
+        EXPECT_TRUE(j[0].contains(key)) << key;
+    for (const char* key : {"oren_nayar", "lafortune", "bk_gaussian", "bk_exponential",
+                            "vh_gaussian", "vh_exponential"})
+        EXPECT_TRUE(j[0]["sse"][key].is_number()) << key;
+    EXPECT_EQ(j[0]["sample"], 25);
+    EXPECT_TRUE(j[1]["E1_over_E2"].is_null());
+    EXPECT_TRUE(j[1]["sse"]["vh_gaussian"].is_null());
+    EXPECT_EQ(j[0]["series"]["data"].size(), 205u);
+
+    const std::string csv = to_csv(some);
+    EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 3);
+    EXPECT_NE(csv.find("sse_vh_exponential"), std::string::npos);
+    const std::string md = to_markdown(some);
+    EXPECT_NE(md.find("| 25 | Quarry tile | 1.880180 | 0.3957 | 0.7982 |"), std::string::npos)
+        << md;
+}

@@ -1,0 +1,418 @@
+// Generic BRDF tables: the CSV reader, the paper-frame conversion, and the comparison machinery on
+// synthetic tables whose truth is known (no CUReT data needed).
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <sstream>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "roughscope/brdf/comparison.hpp"
+#include "roughscope/brdf/table.hpp"
+#include "roughscope/core/errors.hpp"
+#include "roughscope/scattering/beckmann.hpp"
+#include "roughscope/scattering/reflectance_models.hpp"
+
+using namespace roughscope;
+
+namespace {
+
+Eigen::Vector3d direction(double theta, double phi) {
+    return {std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi), std::cos(theta)};
+}
+
+// A CUReT-like set of directions: the two normal-view measurements 1 (45°) and 2 (67.5°), then a
+// spread of light and view directions with both azimuths in one sample frame.
+struct Direction {
+    double ti, pi, tv, pv;
+};
+std::vector<Direction> directions() {
+    std::vector<Direction> d = {{deg_to_rad(45.0), 0.3, 0.0, 0.0},
+                                {deg_to_rad(67.5), 0.3, 0.0, 0.0}};
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<double> pol(0.0, deg_to_rad(80.0)), az(-kPi, kPi);
+    for (int k = 0; k < 120; ++k) d.push_back({pol(rng), az(rng), pol(rng), az(rng)});
+    return d;
+}
+
+// A table whose BRDF is f = E/cos θi with E from `model` at the paper-frame geometry.
+template <class Model>
+BrdfTable synthetic_table(Model&& model, double gain = 1.0) {
+    BrdfTable t;
+    t.name = "synthetic";
+    int index = 0;
+    for (const Direction& d : directions()) {
+        const Geometry g = geometry_from_two_azimuths(d.ti, d.pi, d.tv, d.pv);
+        const double E = gain * model(g);
+        t.measurements.push_back(
+            make_brdf_measurement(++index, d.ti, d.pi, d.tv, d.pv, E / std::cos(d.ti)));
+    }
+    return t;
+}
+
+std::string write_temp(const std::string& name, const std::string& text) {
+    const auto path =
+        std::filesystem::temp_directory_path() /
+        ("roughscope_test_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) +
+         "_" + name);
+    std::ofstream(path) << text;
+    return path.string();
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------------
+// Frame conversion
+
+TEST(BrdfTable, FrameConversionPreservesTheAngleBetweenLightAndView) {
+    // L·V is invariant under the rotation about the normal that puts the light at azimuth π, so
+    // the sample-frame directions and the paper-frame geometry must give the same cosine.
+    for (const Direction& d : directions()) {
+        const BrdfMeasurement m = make_brdf_measurement(1, d.ti, d.pi, d.tv, d.pv, 0.1);
+        const double sample_frame = direction(d.ti, d.pi).dot(direction(d.tv, d.pv));
+        const double paper_frame = light_direction(m.geometry).dot(view_direction(m.geometry));
+        EXPECT_NEAR(sample_frame, paper_frame, 1e-12);
+        EXPECT_NEAR(m.geometry.theta_s_rad, d.tv, 1e-15);
+    }
+}
+
+TEST(BrdfTable, SameAzimuthIsRetroAndOppositeIsSpecularPlane) {
+    // §2: φs = π is retro-reflection (view on the light's side), φs = 0 the specular half-plane.
+    const BrdfMeasurement retro = make_brdf_measurement(1, 0.5, 1.2, 0.5, 1.2, 0.1);
+    EXPECT_NEAR(retro.geometry.phi_s_rad, kPi, 1e-12);
+    const BrdfMeasurement spec = make_brdf_measurement(2, 0.5, 1.2, 0.5, 1.2 + kPi, 0.1);
+    EXPECT_NEAR(std::cos(spec.geometry.phi_s_rad), 1.0, 1e-12);
+}
+
+TEST(BrdfTable, MakeMeasurementRejectsBadInput) {
+    EXPECT_THROW(make_brdf_measurement(1, deg_to_rad(90.0), 0, 0, 0, 0.1), InvalidArgument);
+    EXPECT_THROW(make_brdf_measurement(1, 0.1, 0, -0.1, 0, 0.1), InvalidArgument);
+    EXPECT_THROW(make_brdf_measurement(1, 0.1, 0, 0.1, 0, std::nan("")), InvalidArgument);
+    EXPECT_THROW(make_brdf_measurement(1, 0.1, 0, 0.1, 0, 0.1, -1.0), InvalidArgument);
+    EXPECT_THROW(make_brdf_measurement(1, 0.1, 0, 0.1, 0, 0.1, 1.0, 1.5), InvalidArgument);
+    // A non-positive BRDF value is data (noise), not an error.
+    EXPECT_NO_THROW(make_brdf_measurement(1, 0.1, 0, 0.1, 0, -0.004));
+}
+
+// ---------------------------------------------------------------------------------------------
+// CSV reader
+
+TEST(BrdfCsv, ReadsColumnsInAnyOrderWithCommentsAndCrlf) {
+    const std::string text =
+        "# a comment\r\n"
+        "value, phi_s, theta_s, phi_i, theta_i, weight, note\r\n"
+        "0.25, 180, 10, 180, 30, 2, first\r\n"
+        "\r\n"
+        "-0.001, 0, 20, 180, 40, , second\r\n";
+    const BrdfTable t = parse_brdf_csv(text, "mem.csv");
+    ASSERT_EQ(t.size(), 2u);
+    EXPECT_EQ(t.measurements[0].index, 1);
+    EXPECT_DOUBLE_EQ(t.measurements[0].value, 0.25);
+    EXPECT_DOUBLE_EQ(t.measurements[0].weight, 2.0);
+    EXPECT_DOUBLE_EQ(t.measurements[1].weight, 1.0);    // empty optional cell → default
+    EXPECT_DOUBLE_EQ(t.measurements[1].value, -0.001);  // carried, not dropped
+    // φi = 180° makes the file frame the paper's frame: φs = phi_s.
+    EXPECT_NEAR(t.measurements[0].geometry.phi_s_rad, kPi, 1e-12);
+    EXPECT_NEAR(t.measurements[1].geometry.phi_s_rad, 0.0, 1e-12);
+    EXPECT_NEAR(t.measurements[1].geometry.theta_i_rad, deg_to_rad(40.0), 1e-15);
+}
+
+TEST(BrdfCsv, MeasurementColumnAndChannels) {
+    const std::string text =
+        "measurement,channel,theta_i,phi_i,theta_s,phi_s,value\n"
+        "81,r,45,0,0,0,0.1\n81,g,45,0,0,0,0.2\n112,r,67.5,0,0,0,0.05\n112,g,67.5,0,0,0,0.07\n";
+    BrdfCsvOptions red;
+    red.channel = "r";
+    const BrdfTable t = parse_brdf_csv(text, "rgb.csv", red);
+    ASSERT_EQ(t.size(), 2u);
+    EXPECT_EQ(t.channel, "r");
+    ASSERT_TRUE(t.find(112).has_value());
+    EXPECT_DOUBLE_EQ(t.measurements[*t.find(112)].value, 0.05);
+    EXPECT_FALSE(t.find(7).has_value());
+}
+
+TEST(BrdfCsv, SeveralChannelsWithoutAChoiceIsAnError) {
+    const std::string text =
+        "channel,theta_i,phi_i,theta_s,phi_s,value\nr,45,0,0,0,0.1\n"
+        "g,45,0,0,0,0.2\n";
+    try {
+        parse_brdf_csv(text, "rgb.csv");
+        FAIL() << "expected DataError";
+    } catch (const DataError& e) {
+        EXPECT_NE(std::string(e.what()).find("g, r"), std::string::npos) << e.what();
+    }
+    BrdfCsvOptions blue;
+    blue.channel = "b";
+    EXPECT_THROW(parse_brdf_csv(text, "rgb.csv", blue), DataError);
+}
+
+TEST(BrdfCsv, MalformedInputNamesFileLineAndColumn) {
+    auto message = [](const std::string& text) {
+        try {
+            parse_brdf_csv(text, "bad.csv");
+        } catch (const DataError& e) {
+            return std::string(e.what());
+        }
+        return std::string("no error");
+    };
+    const std::string header = "theta_i,phi_i,theta_s,phi_s,value\n";
+    EXPECT_NE(message("theta_i,phi_i,theta_s,value\n1,2,3,4\n")
+                  .find("bad.csv:1: missing column(s) phi_s"),
+              std::string::npos);
+    EXPECT_NE(message(header + "10,0,10,0,0.1\n10,0,10,0,abc\n").find("bad.csv:3: column value"),
+              std::string::npos);
+    EXPECT_NE(message(header + "10,0,10,0,nan\n").find("bad.csv:2"), std::string::npos);
+    EXPECT_NE(message(header + "95,0,10,0,0.1\n").find("bad.csv:2"), std::string::npos);
+    EXPECT_NE(message(header + "10,0,10,0\n").find("expected 5 fields"), std::string::npos);
+    EXPECT_NE(message(header).find("no data rows"), std::string::npos);
+    EXPECT_NE(message("").find("no header"), std::string::npos);
+    EXPECT_NE(message("measurement," + header + "3,10,0,10,0,0.1\n3,20,0,10,0,0.1\n")
+                  .find("duplicate measurement 3"),
+              std::string::npos);
+    EXPECT_NE(message("weight," + header + "-1,10,0,10,0,0.1\n").find("bad.csv:2"),
+              std::string::npos);
+}
+
+TEST(BrdfCsv, ReadsAFileAndReportsAMissingOne) {
+    const std::string path =
+        write_temp("table.csv", "theta_i,phi_i,theta_s,phi_s,value\n30,180,0,0,0.2\n");
+    const BrdfTable t = read_brdf_csv(path);
+    EXPECT_EQ(t.size(), 1u);
+    std::filesystem::remove(path);
+    EXPECT_THROW(read_brdf_csv(path), DataError);
+}
+
+// ---------------------------------------------------------------------------------------------
+// The comparison machinery on tables with a known truth
+
+TEST(Comparison, TwoPointEstimateRecoversTheSlopeOfAVeryRoughSurface) {
+    // Brightness generated by Eq. 5 (V–H, exponential) with σ/T = 0.6: Eq. 19 on the two
+    // normal-view measurements must return 0.6, and the V–H exponential model then fits the table
+    // exactly (Table-4 error 0), with the winner being that model family.
+    const double truth = 0.6;
+    const BrdfTable t = synthetic_table(
+        [&](const Geometry& g) {
+            return very_rough_brightness(g, truth, Correlation::Exponential);
+        },
+        3.7);
+    ComparisonOptions o;
+    o.measurement1 = 1;
+    o.measurement2 = 2;
+    const Comparison c = compare_brdf(t, o);
+    ASSERT_TRUE(c.two_point.available) << c.two_point.reason;
+    ASSERT_TRUE(c.two_point.sigma_over_T_exponential.has_value());
+    EXPECT_NEAR(*c.two_point.sigma_over_T_exponential, truth, 1e-9);
+    EXPECT_LT(c.result(ComparisonModel::VhExponential).errors.paper_sse, 1e-18);
+    EXPECT_LT(c.result(ComparisonModel::VhExponential).errors.gain_sse, 1e-18);
+    EXPECT_GT(c.result(ComparisonModel::BkExponential).errors.paper_sse, 1e-3);
+    ASSERT_TRUE(c.winner.has_value());
+    EXPECT_TRUE(*c.winner == ComparisonModel::VhExponential ||
+                *c.winner == ComparisonModel::VhExponentialFit);
+}
+
+TEST(Comparison, FitsRecoverKnownParametersAndGain) {
+    // Each family generated with a known parameter and gain: its fit returns them.
+    ComparisonOptions o;
+    o.measurement1 = 1;
+    o.measurement2 = 2;
+    {
+        const BrdfTable t = synthetic_table(
+            [](const Geometry& g) {
+                return very_rough_brightness(g, 0.45, Correlation::Gaussian,
+                                             GeometricFactor::Beckmann);
+            },
+            2.0);
+        const Comparison c = compare_brdf(t, o);
+        const ModelResult& r = c.result(ComparisonModel::BkGaussianFit);
+        ASSERT_TRUE(r.available);
+        EXPECT_NEAR(*r.parameter("sigma_over_T"), 0.45, 1e-6);
+        EXPECT_LT(r.errors.gain_sse, 1e-12);
+        EXPECT_EQ(*r.fit_status, FitStatus::Converged);
+    }
+    {
+        const BrdfTable t = synthetic_table(
+            [](const Geometry& g) { return lafortune_diffuse_brightness(g, 5.0); }, 0.3);
+        const Comparison c = compare_brdf(t, o);
+        const ModelResult& r = c.result(ComparisonModel::LafortuneFit);
+        EXPECT_NEAR(*r.parameter("n"), 5.0, 1e-5);
+        // The exhaustive search lands on the grid value 5.00 too.
+        EXPECT_NEAR(*c.result(ComparisonModel::Lafortune).parameter("n"), 5.0, 1e-9);
+    }
+    {
+        const OrenNayarParams truth{0.4, 0.6};
+        const BrdfTable t =
+            synthetic_table([&](const Geometry& g) { return oren_nayar_radiance(g, truth); }, 5.0);
+        const Comparison c = compare_brdf(t, o);
+        const ModelResult& r = c.result(ComparisonModel::OrenNayarFit);
+        EXPECT_NEAR(*r.parameter("sigma_rad"), 0.4, 1e-4);
+        EXPECT_NEAR(*r.parameter("albedo"), 0.6, 1e-3);
+        EXPECT_LT(r.errors.gain_sse, 1e-12);
+    }
+}
+
+TEST(Comparison, FitStandardErrorsCoverTheTruthUnderNoise) {
+    // 1% multiplicative noise on a V–H Gaussian table (σ/T = 0.5): the estimate lies within
+    // 3 standard errors of the truth in at least 45 of 50 seeded trials, and the standard error is
+    // neither zero nor huge.
+    const std::vector<Direction> dirs = directions();
+    int covered = 0;
+    for (int trial = 0; trial < 50; ++trial) {
+        std::mt19937 rng(1000 + trial);
+        std::normal_distribution<double> noise(0.0, 0.01);
+        BrdfTable t;
+        int index = 0;
+        for (const Direction& d : dirs) {
+            const Geometry g = geometry_from_two_azimuths(d.ti, d.pi, d.tv, d.pv);
+            const double E =
+                very_rough_brightness(g, 0.5, Correlation::Gaussian) * (1.0 + noise(rng));
+            t.measurements.push_back(
+                make_brdf_measurement(++index, d.ti, d.pi, d.tv, d.pv, E / std::cos(d.ti)));
+        }
+        ComparisonOptions o;
+        o.measurement1 = 1;
+        o.measurement2 = 2;
+        const Comparison c = compare_brdf(t, o);
+        const ModelResult& r = c.result(ComparisonModel::VhGaussianFit);
+        const ModelParameter& p = r.parameters.at(0);
+        ASSERT_TRUE(p.standard_error.has_value());
+        EXPECT_GT(*p.standard_error, 1e-5);
+        EXPECT_LT(*p.standard_error, 0.05);
+        if (std::abs(p.value - 0.5) <= 3.0 * *p.standard_error) ++covered;
+    }
+    EXPECT_GE(covered, 45);
+}
+
+TEST(Comparison, NonPositivePairValueMakesTheEstimateUnavailableNotAnError) {
+    BrdfTable t = synthetic_table(
+        [](const Geometry& g) { return very_rough_brightness(g, 0.5, Correlation::Gaussian); });
+    t.measurements[1].value = -0.002;  // measurement 2 of the pair
+    t.measurements[7].value = 0.0;     // elsewhere: kept
+    ComparisonOptions o;
+    o.measurement1 = 1;
+    o.measurement2 = 2;
+    const Comparison c = compare_brdf(t, o);
+    EXPECT_FALSE(c.two_point.available);
+    EXPECT_FALSE(c.two_point.E1_over_E2.has_value());
+    EXPECT_NE(c.two_point.reason.find("measurement 2 has f = -0.002"), std::string::npos)
+        << c.two_point.reason;
+    EXPECT_FALSE(c.result(ComparisonModel::VhGaussian).available);
+    EXPECT_TRUE(c.result(ComparisonModel::VhGaussianFit).available);
+    EXPECT_EQ(c.measurement.size(), t.size());  // every value kept in the sums
+    ASSERT_EQ(c.data_issues.size(), 2u);
+    EXPECT_EQ(c.data_issues[0].measurement, 2);
+    EXPECT_EQ(c.data_issues[0].excluded_from, std::vector<std::string>{"two_point_estimate"});
+    EXPECT_EQ(c.data_issues[1].measurement, 8);
+    EXPECT_TRUE(c.data_issues[1].excluded_from.empty());
+}
+
+TEST(Comparison, OverflowThresholdAndZeroWeightExcludeMeasurements) {
+    BrdfTable t = synthetic_table(
+        [](const Geometry& g) { return very_rough_brightness(g, 0.5, Correlation::Gaussian); });
+    for (auto& m : t.measurements) m.overflow_fraction = 0.0;
+    t.measurements[5].overflow_fraction = 0.3;
+    t.measurements[6].weight = 0.0;
+    ComparisonOptions o;
+    o.measurement1 = 1;
+    o.measurement2 = 2;
+    o.max_overflow_fraction = 0.1;
+    const Comparison c = compare_brdf(t, o);
+    EXPECT_EQ(c.measurement.size(), t.size() - 2);
+    ASSERT_EQ(c.data_issues.size(), 2u);
+    EXPECT_EQ(c.data_issues[0].issue, "saturated");
+    EXPECT_EQ(c.data_issues[1].issue, "zero_weight");
+    o.max_overflow_fraction.reset();
+    EXPECT_EQ(compare_brdf(t, o).measurement.size(), t.size() - 1);
+}
+
+TEST(Comparison, NoPositiveDataLeavesEveryModelUnavailable) {
+    BrdfTable t = synthetic_table([](const Geometry&) { return -1.0; });
+    ComparisonOptions o;
+    o.measurement1 = 1;
+    o.measurement2 = 2;
+    const Comparison c = compare_brdf(t, o);
+    for (const ModelResult& r : c.models) {
+        EXPECT_FALSE(r.available);
+        EXPECT_FALSE(r.reason.empty());
+    }
+    EXPECT_FALSE(c.winner.has_value());
+}
+
+TEST(Comparison, BadOptionsAndEmptyTablesThrow) {
+    const BrdfTable t = synthetic_table([](const Geometry& g) { return std::cos(g.theta_i_rad); });
+    ComparisonOptions o;
+    o.measurement1 = o.measurement2 = 1;
+    EXPECT_THROW(compare_brdf(t, o), InvalidArgument);
+    o = {};
+    o.theta1_rad = deg_to_rad(95.0);
+    EXPECT_THROW(compare_brdf(t, o), InvalidArgument);
+    o = {};
+    o.lafortune_n_step = 0.0;
+    EXPECT_THROW(compare_brdf(t, o), InvalidArgument);
+    o = {};
+    o.fit_sigma_over_T_min = 2.0;
+    o.fit_sigma_over_T_max = 1.0;
+    EXPECT_THROW(compare_brdf(t, o), InvalidArgument);
+    o = {};
+    o.oren_nayar = OrenNayarParams{0.3, 1.5};
+    EXPECT_THROW(compare_brdf(t, o), InvalidArgument);
+    o = {};
+    o.max_overflow_fraction = -0.1;
+    EXPECT_THROW(compare_brdf(t, o), InvalidArgument);
+    EXPECT_THROW(compare_brdf(BrdfTable{}, {}), InvalidArgument);
+    // A pair the table lacks is reported, not thrown; so is a pair not viewed along the normal.
+    BrdfTable small = t;
+    small.measurements.resize(10);
+    const Comparison c = compare_brdf(small, {});
+    EXPECT_FALSE(c.two_point.available);
+    EXPECT_NE(c.two_point.reason.find("measurement 81 is not in the table"), std::string::npos);
+    ComparisonOptions off_normal;
+    off_normal.measurement1 = 1;
+    off_normal.measurement2 = 3;
+    const Comparison d = compare_brdf(t, off_normal);
+    EXPECT_FALSE(d.two_point.available);
+    EXPECT_NE(d.two_point.reason.find("measurement 3 has theta_v"), std::string::npos)
+        << d.two_point.reason;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Error measures
+
+TEST(ErrorMeasures, HandComputedValues) {
+    // data (1, 2) → (0.5, 1); model (2, 1) → (1, 0.5): Table-4 error 0.25 + 0.25 = 0.5,
+    // RMSE = sqrt(0.5/2) = 0.5; optimal gain K = (2·0.5 + 1·1)/(4 + 1) = 0.4, residuals 0.3 and
+    // −0.6: SSE 0.45.
+    const std::vector<double> data{1.0, 2.0}, model{2.0, 1.0};
+    const ErrorMeasures e = error_measures(model, data);
+    EXPECT_DOUBLE_EQ(e.paper_sse, 0.5);
+    EXPECT_DOUBLE_EQ(e.rmse, 0.5);
+    EXPECT_NEAR(e.gain, 0.4, 1e-15);
+    EXPECT_NEAR(e.gain_sse, 0.45, 1e-15);
+    // Scale invariance: multiplying the model changes neither the Table-4 error nor the gain SSE.
+    const ErrorMeasures s = error_measures(std::vector<double>{20.0, 10.0}, data);
+    EXPECT_DOUBLE_EQ(s.paper_sse, e.paper_sse);
+    EXPECT_NEAR(s.gain_sse, e.gain_sse, 1e-15);
+    // Weights: a zero weight drops the second term.
+    const ErrorMeasures w = error_measures(model, data, std::vector<double>{1.0, 0.0});
+    EXPECT_DOUBLE_EQ(w.paper_sse, 0.25);
+}
+
+TEST(ErrorMeasures, RejectsBadInput) {
+    const std::vector<double> two{1.0, 2.0}, three{1.0, 2.0, 3.0};
+    EXPECT_THROW(error_measures(two, three), InvalidArgument);
+    EXPECT_THROW(error_measures(std::vector<double>{}, std::vector<double>{}), InvalidArgument);
+    EXPECT_THROW(error_measures(two, std::vector<double>{-1.0, 0.0}), InvalidArgument);
+    EXPECT_THROW(error_measures(std::vector<double>{0.0, 0.0}, two), InvalidArgument);
+    EXPECT_THROW(error_measures(two, std::vector<double>{1.0, std::nan("")}), InvalidArgument);
+    EXPECT_THROW(error_measures(two, two, std::vector<double>{1.0}), InvalidArgument);
+    EXPECT_THROW(error_measures(two, two, std::vector<double>{1.0, -1.0}), InvalidArgument);
+}
+
+TEST(ComparisonNames, RoundTripAndRejectUnknown) {
+    for (ComparisonModel m : kComparisonModels) EXPECT_EQ(parse_comparison_model(to_string(m)), m);
+    EXPECT_EQ(to_string(ComparisonModel::VhExponential), "vh_exponential");
+    EXPECT_TRUE(is_fit(ComparisonModel::OrenNayarFit));
+    EXPECT_FALSE(is_fit(ComparisonModel::Lafortune));
+    EXPECT_THROW(parse_comparison_model("phong"), InvalidArgument);
+}
