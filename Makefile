@@ -9,6 +9,8 @@ PYTHON     ?= /usr/bin/python3
 CMAKE      ?= cmake
 CTEST      ?= ctest
 REPORT_DIR ?= out/report
+# Warnings as errors: ON in CI (.ci/run exports ROUGHSCOPE_WERROR=ON), OFF by default.
+ROUGHSCOPE_WERROR ?= OFF
 
 CONFIGURE_FLAGS = -G Ninja \
 	-DCMAKE_BUILD_TYPE=Release \
@@ -17,6 +19,7 @@ CONFIGURE_FLAGS = -G Ninja \
 	-DROUGHSCOPE_BUILD_BENCH=ON \
 	-DROUGHSCOPE_BUILD_CLI=ON \
 	-DROUGHSCOPE_SANITIZE=OFF \
+	-DROUGHSCOPE_WERROR=$(ROUGHSCOPE_WERROR) \
 	-DPython3_EXECUTABLE=$(PYTHON)
 
 ASAN_CONFIGURE_FLAGS = -G Ninja \
@@ -24,9 +27,10 @@ ASAN_CONFIGURE_FLAGS = -G Ninja \
 	-DROUGHSCOPE_BUILD_TESTS=ON \
 	-DROUGHSCOPE_BUILD_PYTHON=OFF \
 	-DROUGHSCOPE_BUILD_BENCH=OFF \
-	-DROUGHSCOPE_SANITIZE=ON
+	-DROUGHSCOPE_SANITIZE=ON \
+	-DROUGHSCOPE_WERROR=$(ROUGHSCOPE_WERROR)
 
-.PHONY: all deps configure build test demo sanitize bench clean
+.PHONY: all deps configure build test demo sanitize bench lint format clean
 
 all: build
 
@@ -53,6 +57,14 @@ sanitize: deps
 	$(CMAKE) --build $(ASAN_BUILD) -j $(JOBS) --target roughscope_tests
 	ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
 		$(CTEST) --test-dir $(ASAN_BUILD) --output-on-failure -j $(JOBS) -L '^cpp$$' --no-tests=error
+
+# clang-format check + clang-tidy (.clang-format, .clang-tidy) on the project's sources.
+lint: configure
+	JOBS=$(JOBS) scripts/lint $(BUILD)
+
+# Reformat every tracked C++ file in place.
+format:
+	git ls-files -- '*.cpp' '*.hpp' | xargs clang-format -i
 
 bench: build
 	$(BUILD)/bin/roughscope_bench

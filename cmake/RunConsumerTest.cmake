@@ -38,8 +38,9 @@ run("install" "${CMAKE_COMMAND}" --install "${RS_BINARY_DIR}" --prefix "${prefix
 
 foreach(f
     "include/roughscope/version.hpp"
-    "include/roughscope/geometry.hpp"
-    "include/roughscope/models.hpp")
+    "include/roughscope/scattering/geometry.hpp"
+    "include/roughscope/scattering/reflectance_models.hpp"
+    "include/roughscope/roughscope.hpp")
   if(NOT EXISTS "${prefix}/${f}")
     message(FATAL_ERROR "consumer test: ${f} was not installed into ${prefix}")
   endif()
@@ -86,31 +87,32 @@ endif()
 
 run("build" "${CMAKE_COMMAND}" --build "${build}" ${config_args})
 
-# --- 4. run it -----------------------------------------------------------------
-set(exe "")
-foreach(candidate
-    "${build}/roughscope_consumer"
-    "${build}/${RS_BUILD_TYPE}/roughscope_consumer"
-    "${build}/roughscope_consumer.exe"
-    "${build}/${RS_BUILD_TYPE}/roughscope_consumer.exe")
-  if(EXISTS "${candidate}" AND NOT IS_DIRECTORY "${candidate}")
-    set(exe "${candidate}")
-    break()
+# --- 4. run them: the umbrella target and one topic alone ---------------------
+foreach(name roughscope_consumer roughscope_consumer_scattering)
+  set(exe "")
+  foreach(candidate
+      "${build}/${name}"
+      "${build}/${RS_BUILD_TYPE}/${name}"
+      "${build}/${name}.exe"
+      "${build}/${RS_BUILD_TYPE}/${name}.exe")
+    if(EXISTS "${candidate}" AND NOT IS_DIRECTORY "${candidate}")
+      set(exe "${candidate}")
+      break()
+    endif()
+  endforeach()
+  if(NOT exe)
+    message(FATAL_ERROR "consumer test: built consumer executable ${name} not found in ${build}")
+  endif()
+
+  execute_process(COMMAND "${exe}"
+    RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+  message("${out}${err}")
+  if(NOT rc EQUAL 0)
+    message(FATAL_ERROR "consumer test: ${exe} exited with ${rc}")
+  endif()
+  string(FIND "${out}" "${RS_EXPECTED_VERSION}" pos)
+  if(pos EQUAL -1)
+    message(FATAL_ERROR
+      "consumer test: output of ${name} does not contain version '${RS_EXPECTED_VERSION}'")
   endif()
 endforeach()
-if(NOT exe)
-  message(FATAL_ERROR "consumer test: built consumer executable not found in ${build}")
-endif()
-
-execute_process(COMMAND "${exe}"
-  RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
-message("${out}${err}")
-if(NOT rc EQUAL 0)
-  message(FATAL_ERROR "consumer test: ${exe} exited with ${rc}")
-endif()
-string(FIND "${out}" "${RS_EXPECTED_VERSION}" pos)
-if(pos EQUAL -1)
-  message(FATAL_ERROR
-    "consumer test: output does not contain version '${RS_EXPECTED_VERSION}'")
-endif()
-message("consumer test: OK (installed package found, built, ran)")
