@@ -6,7 +6,7 @@
 
 namespace roughscope::cli {
 
-void register_model(CLI::App& app);     // cli/model.cpp    — evaluate models (issue: foundation)
+void register_model(CLI::App& app);     // cli/model.cpp    — evaluate models (§3, §5)
 void register_estimate(CLI::App& app);  // cli/estimate.cpp — roughness estimation (§4)
 void register_paper(CLI::App& app);     // cli/paper.cpp    — paper tables recomputed
 void register_curet(CLI::App& app);     // cli/curet.cpp    — CUReT comparison (§5.3)

@@ -1,31 +1,28 @@
 // `roughscope curet`: models against measured BRDFs (paper §5.3, Tables 3–4, Fig. 10) for one
 // CUReT sample, every sample, or any BRDF table in CSV. See docs/curet.md.
 //
-// Figures (--plot) are drawn by the Python package (roughscope.curet_figures, matplotlib): the
-// command writes the comparison as JSON to a temporary file and runs
-// `$ROUGHSCOPE_PYTHON -m roughscope.curet_figures` (default /usr/bin/python3), with the package
-// beside the executable (<bin>/../python) put first on PYTHONPATH.
+// The options become a ComparisonOptions and the results JSON/CSV/Markdown in the library
+// (roughscope/serialize/comparison.hpp), as for the Python module. Figures (--plot) are drawn by
+// the Python package: the comparison document is piped into `python3 -m roughscope.plot curet
+// --out FILE` (python_runner.hpp); its error message, if any, becomes this command's error.
 #include "roughscope/brdf/curet.hpp"
 
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
 #include <filesystem>
-#include <fstream>
-#include <iostream>
 #include <memory>
 #include <optional>
 #include <sstream>
 #include <string>
 #include <vector>
 
-#include <unistd.h>
-
 #include "commands.hpp"
 #include "common.hpp"
+#include "python_runner.hpp"
 #include "roughscope/brdf/comparison.hpp"
 #include "roughscope/brdf/table.hpp"
 #include "roughscope/core/errors.hpp"
+#include "roughscope/serialize/comparison.hpp"
 
 namespace roughscope::cli {
 namespace {
@@ -89,21 +86,6 @@ std::string short_number(double v, std::string_view name) {
     char buf[64];
     std::snprintf(buf, sizeof buf, "%.6g", v);
     return buf;
-}
-
-// Rounds every floating-point number of a JSON document to kPrintDigits significant digits.
-void round_json(json& j) {
-    if (j.is_number_float()) {
-        j = finite_number(j.get<double>());
-    } else if (j.is_structured()) {
-        for (auto& item : j) round_json(item);
-    }
-}
-
-std::string json_text(const std::string& library_json) {
-    json j = json::parse(library_json);
-    round_json(j);
-    return dump_json(j);
 }
 
 std::string text_report(const Comparison& c) {
@@ -205,94 +187,12 @@ std::string text_report_all(const std::vector<Comparison>& all) {
     return out.str();
 }
 
-// Quotes a path for /bin/sh.
-std::string shell_quote(const std::string& s) {
-    std::string out = "'";
-    for (char ch : s) {
-        if (ch == '\'')
-            out += "'\\''";
-        else
-            out += ch;
-    }
-    return out + "'";
-}
-
-std::string python_interpreter() {
-    if (const char* p = std::getenv("ROUGHSCOPE_PYTHON"); p && *p) return p;
-    std::error_code ec;
-    if (fs::exists("/usr/bin/python3", ec)) return "/usr/bin/python3";
-    return "python3";
-}
-
-std::optional<fs::path> package_dir_beside_executable() {
-    std::error_code ec;
-    const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
-    if (ec) return std::nullopt;
-    for (const fs::path& candidate :
-         {exe.parent_path().parent_path() / "python",
-          exe.parent_path().parent_path() / "lib" / "roughscope" / "python"}) {
-        if (fs::exists(candidate / "roughscope" / "curet_figures.py", ec)) return candidate;
-    }
-    return std::nullopt;
-}
-
-// A temporary file that is removed when it goes out of scope.
-struct TempFile {
-    fs::path path;
-    explicit TempFile(const std::string& suffix) {
-        std::string tmpl =
-            (fs::temp_directory_path() / ("roughscope-curet-XXXXXX" + suffix)).string();
-        std::vector<char> buf(tmpl.begin(), tmpl.end());
-        buf.push_back('\0');
-        const int fd = mkstemps(buf.data(), static_cast<int>(suffix.size()));
-        if (fd < 0)
-            throw roughscope::DataError("cannot create a temporary file in " +
-                                        fs::temp_directory_path().string());
-        ::close(fd);
-        path = buf.data();
-    }
-    ~TempFile() {
-        std::error_code ec;
-        fs::remove(path, ec);
-    }
-    TempFile(const TempFile&) = delete;
-    TempFile& operator=(const TempFile&) = delete;
-};
-
-void draw_plot(const std::string& comparison_json, const std::string& kind,
-               const fs::path& out_png) {
+void draw_plot(const json& document, const fs::path& out_png) {
     if (out_png.extension() != ".png")
         throw roughscope::InvalidArgument("--plot: '" + out_png.string() +
                                           "' must end in .png (the figure is a PNG)");
-    TempFile input(".json");
-    TempFile log(".log");
-    {
-        std::ofstream f(input.path);
-        f << comparison_json;
-        if (!f) throw roughscope::DataError("cannot write " + input.path.string());
-    }
-    if (const auto pkg = package_dir_beside_executable()) {
-        const char* old = std::getenv("PYTHONPATH");
-        const std::string value =
-            pkg->string() + (old && *old ? ":" + std::string(old) : std::string());
-        ::setenv("PYTHONPATH", value.c_str(), 1);
-    }
-    const std::string cmd = shell_quote(python_interpreter()) + " -m roughscope.curet_figures " +
-                            kind + " --input " + shell_quote(input.path.string()) + " --out " +
-                            shell_quote(fs::absolute(out_png).string()) + " >" +
-                            shell_quote(log.path.string()) + " 2>&1";
-    std::cout.flush();
-    const int status = std::system(cmd.c_str());
-    if (status != 0) {
-        std::ifstream f(log.path);
-        std::string line, last;
-        while (std::getline(f, line))
-            if (!line.empty()) last = line;
-        throw roughscope::DataError(
-            "--plot: drawing the figure failed (" + (last.empty() ? "no message" : last) +
-            "); it needs Python 3 with matplotlib and the roughscope package (set "
-            "ROUGHSCOPE_PYTHON and PYTHONPATH)");
-    }
+    run_python_module("roughscope.plot", {"curet", "--out", fs::absolute(out_png).string()},
+                      serialize::dump(document, -1), "--plot");
 }
 
 void run(Args& a) {
@@ -317,29 +217,26 @@ void run(Args& a) {
     if (given(a.o_threads) && !a.all) throw UsageError("--threads applies to --all only");
     if (a.series && a.format != Format::Json) throw UsageError("--series needs --json");
 
-    ComparisonOptions o;
-    o.radiometry = a.radiometry;
-    o.fits = !a.no_fits;
+    // Named options → ComparisonOptions by the library (the Python module does the same).
+    json options = {{"fits", !a.no_fits}, {"radiometry", std::string(to_string(a.radiometry))}};
     if (given(a.o_theta1)) {
-        o.theta1_rad = deg_to_rad(a.theta1_deg);
-        o.theta2_rad = deg_to_rad(a.theta2_deg);
+        options["theta1_deg"] = a.theta1_deg;
+        options["theta2_deg"] = a.theta2_deg;
     }
     if (given(a.o_pair)) {
-        if (a.pair.size() != 2 || a.pair[0] < 1 || a.pair[1] < 1)
+        if (a.pair.size() != 2)
             throw roughscope::InvalidArgument("--pair: expected two measurement numbers I,J >= 1");
-        o.measurement1 = a.pair[0];
-        o.measurement2 = a.pair[1];
+        options["pair"] = a.pair;
     }
     if (given(a.o_on_sigma)) {
-        o.oren_nayar = OrenNayarParams{a.on_sigma_rad, a.on_albedo};
-        o.oren_nayar_source = "given on the command line";
+        options["on_sigma_rad"] = a.on_sigma_rad;
+        options["on_albedo"] = a.on_albedo;
     }
-    if (given(a.o_max_overflow)) o.max_overflow_fraction = a.max_overflow;
-    validate(o);
+    if (given(a.o_max_overflow)) options["max_overflow"] = a.max_overflow;
+    const ComparisonOptions o = serialize::comparison_options_from(options);
 
     std::string text;
-    std::string plot_json;
-    std::string plot_kind = "fig10";
+    json plot_document;  // one comparison with its series (Fig. 10), or the list (summary)
     if (a.all) {
         const fs::path dir = find_curet_directory(
             given(a.o_data) ? std::optional<fs::path>(a.data_dir) : std::nullopt);
@@ -347,22 +244,19 @@ void run(Args& a) {
         const std::vector<Comparison> all = compare_curet_all(db, o, a.threads);
         switch (a.format) {
             case Format::Json:
-                text = json_text(to_json(all, a.series));
+                text = serialize::dump(serialize::to_json(all, a.series));
                 break;
             case Format::Csv:
-                text = to_csv(all);
+                text = serialize::to_csv(all);
                 break;
             case Format::Markdown:
-                text = to_markdown(all);
+                text = serialize::to_markdown(all);
                 break;
             case Format::Text:
                 text = text_report_all(all);
                 break;
         }
-        if (!a.plot_path.empty()) {
-            plot_json = to_json(all, false, -1);
-            plot_kind = "summary";
-        }
+        if (!a.plot_path.empty()) plot_document = serialize::to_json(all, false);
     } else {
         Comparison c;
         if (given(a.o_table)) {
@@ -377,22 +271,22 @@ void run(Args& a) {
         }
         switch (a.format) {
             case Format::Json:
-                text = json_text(to_json(c, a.series));
+                text = serialize::dump(serialize::to_json(c, a.series));
                 break;
             case Format::Csv:
-                text = to_csv({c});
+                text = serialize::to_csv({c});
                 break;
             case Format::Markdown:
-                text = to_markdown({c});
+                text = serialize::to_markdown({c});
                 break;
             case Format::Text:
                 text = text_report(c);
                 break;
         }
-        if (!a.plot_path.empty()) plot_json = to_json(c, true, -1);
+        if (!a.plot_path.empty()) plot_document = serialize::to_json(c, true);
     }
     // The figure first: if it fails, nothing has been written.
-    if (!a.plot_path.empty()) draw_plot(plot_json, plot_kind, a.plot_path);
+    if (!a.plot_path.empty()) draw_plot(plot_document, a.plot_path);
     write_output(a.output_path.empty() ? std::nullopt : std::optional<fs::path>(a.output_path),
                  text);
 }

@@ -5,7 +5,9 @@
 //   estimate slope               σ/T from a brightness ratio (Eq. 16–19), very rough surfaces
 //   estimate fit                 least squares to N ≥ 3 measurements from a CSV file
 //
-// Angles in degrees, lengths in µm. See docs/estimation.md and docs/cli.md.
+// Angles in degrees, lengths in µm. See docs/estimation.md and docs/cli.md. The JSON documents
+// are built by the library (roughscope/serialize/estimation.hpp), the same as the Python
+// module's dicts; this file parses flags, calls the estimators and prints.
 #include <cmath>
 #include <filesystem>
 #include <memory>
@@ -23,6 +25,7 @@
 #include "roughscope/scattering/factors.hpp"
 #include "roughscope/scattering/geometry.hpp"
 #include "roughscope/scattering/validity.hpp"
+#include "roughscope/serialize/estimation.hpp"
 
 namespace roughscope::cli {
 namespace {
@@ -105,8 +108,6 @@ std::pair<Geometry, Geometry> geometries_from(const PairArgs& p) {
                           deg_to_rad(p.phi_s2_deg))};
 }
 
-bool normal_view(const Geometry& g) { return g.theta_s_rad == 0.0; }
-
 struct OutputArgs {
     bool json_output = false;
     std::string output_path;
@@ -140,7 +141,7 @@ CLI::Option* add_pair_radiometry_option(CLI::App& cmd, Radiometry& radiometry) {
 void emit(const OutputArgs& o, const json& record) {
     std::string text;
     if (o.json_output) {
-        text = dump_json(record);
+        text = serialize::dump(record);
     } else {
         std::vector<std::pair<std::string, std::string>> items;
         for (const auto& [key, value] : record.items()) {
@@ -182,43 +183,6 @@ void emit(const OutputArgs& o, const json& record) {
         text);
 }
 
-// An estimate's value and (when computed) its standard error.
-void put(json& out, const std::string& key, const std::optional<Estimate>& e, bool with_error,
-         double scale = 1.0) {
-    out[key] = e ? finite_number(e->value * scale, key) : json(nullptr);
-    if (with_error)
-        out[key + "_stderr"] =
-            e ? finite_number(e->std_error * scale, key + "_stderr") : json(nullptr);
-}
-
-// The keys every estimate carries (§3.5 derived quantities, class, g, warnings).
-void put_derived(json& out, const RoughnessEstimate& e, bool with_error) {
-    put(out, "theta_K_deg", e.theta_K_rad, with_error, 180.0 / kPi);
-    put(out, "xi_K", e.xi_K, with_error);
-    put(out, "rms_slope", e.rms_slope, with_error);
-    out["roughness_class"] = std::string(to_string(e.roughness_class));
-    out["roughness_class_assumed"] = e.roughness_class_assumed;
-    if (e.g.empty()) {
-        out["g"] = nullptr;
-    } else {
-        json g = json::array();
-        for (double x : e.g) g.push_back(finite_number(x, "g"));
-        out["g"] = g;
-    }
-}
-
-json warnings_json(const std::vector<std::string>& ws) {
-    json w = json::array();
-    for (const auto& s : ws) w.push_back(s);
-    return w;
-}
-
-json geometry_json(const Geometry& g) {
-    return {{"theta_i_deg", finite_number(rad_to_deg(g.theta_i_rad))},
-            {"theta_s_deg", finite_number(rad_to_deg(g.theta_s_rad))},
-            {"phi_s_deg", finite_number(rad_to_deg(g.phi_s_rad))}};
-}
-
 // ---------------------------------------------------------------------------------------------
 // estimate specular
 
@@ -253,21 +217,8 @@ void run_specular(const SpecularArgs& a) {
     in.wavelength_um = a.wavelength_um;
     in.R0 = a.r0;
     in.relative_noise_tot = in.relative_noise_dif = a.noise;
-    const RoughnessEstimate e = estimate_sigma_specular(in);
-    const bool err = given(a.o_noise);
-    const double R =
-        in.E_tot ? specular_reflectance_from_brightness(*in.E_tot, *in.E_dif) : in.R_spec;
-
-    json out;
-    out["estimator"] = "specular (Eq. 12-13)";
-    put(out, "sigma_um", e.sigma_um, err);
-    out["R_spec"] = finite_number(R, "R_spec");
-    out["R0"] = finite_number(a.r0, "R0");
-    out["theta_deg"] = finite_number(a.theta_deg, "theta_deg");
-    out["wavelength_um"] = finite_number(a.wavelength_um, "wavelength_um");
-    put_derived(out, e, err);
-    out["warnings"] = warnings_json(e.warnings);
-    emit(a.out, out);
+    emit(a.out,
+         serialize::specular_estimate_json(in, estimate_sigma_specular(in), given(a.o_noise)));
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -307,27 +258,9 @@ void run_correlation_length(const CorrelationLengthArgs& a) {
     in.options.regime = a.regime;
     in.options.wavelength_um = a.wavelength_um;
     in.noise = {a.noise, a.noise};
-    const RoughnessEstimate e = estimate_correlation_length(in);
-    const bool err = given(a.o_noise) || given(a.o_sigma_stderr);
-    const bool closed = normal_view(g1) && normal_view(g2) &&
-                        a.correlation == Correlation::Gaussian && a.regime == Regime::SlightlyRough;
-
-    json out;
-    out["estimator"] = closed ? "correlation length (Eq. 14-15)"
-                              : "correlation length (two-geometry solver, TOMS 748)";
-    put(out, "sigma_um", e.sigma_um, err);
-    put(out, "T_um", e.T_um, err);
-    put(out, "sigma_over_T", e.sigma_over_T, err);
-    put_derived(out, e, err);
-    out["E1_over_E2"] = finite_number(in.E1_over_E2, "E1_over_E2");
-    out["geometry1"] = geometry_json(g1);
-    out["geometry2"] = geometry_json(g2);
-    out["correlation"] = std::string(to_string(a.correlation));
-    out["factor"] = std::string(to_string(a.factor));
-    out["regime"] = std::string(to_string(a.regime));
-    out["wavelength_um"] = finite_number(a.wavelength_um, "wavelength_um");
-    out["warnings"] = warnings_json(e.warnings);
-    emit(a.out, out);
+    emit(a.out,
+         serialize::correlation_length_estimate_json(in, estimate_correlation_length(in),
+                                                     given(a.o_noise) || given(a.o_sigma_stderr)));
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -344,18 +277,21 @@ struct SlopeArgs {
     OutputArgs out;
 };
 
-RoughnessEstimate slope_for(const SlopeArgs& a, const Geometry& g1, const Geometry& g2,
-                            double ratio, Correlation c) {
+SlopeInput slope_input(const SlopeArgs& a, const Geometry& g1, const Geometry& g2, double ratio) {
     SlopeInput in;
     in.E1_over_E2 = ratio;
     in.geom1 = g1;
     in.geom2 = g2;
-    in.correlation = c;
     in.options.factor = a.factor;
     in.options.radiometry = a.radiometry;
     in.options.wavelength_um = a.wavelength_um;
     in.noise = {a.noise, a.noise};
     if (given(a.o_sigma)) in.sigma_um = a.sigma_um;
+    return in;
+}
+
+RoughnessEstimate slope_for(const SlopeArgs& a, SlopeInput in, Correlation c) {
+    in.correlation = c;
     try {
         return estimate_slope(in);
     } catch (const NoSolution& e) {
@@ -368,53 +304,13 @@ RoughnessEstimate slope_for(const SlopeArgs& a, const Geometry& g1, const Geomet
 
 void run_slope(const SlopeArgs& a) {
     const auto [g1, g2] = geometries_from(a.pair);
-    const double ratio = ratio_from(a.ratio);
-    const bool err = given(a.o_noise);
+    const SlopeInput in = slope_input(a, g1, g2, ratio_from(a.ratio));
     std::optional<RoughnessEstimate> eg, ee;
     if (a.correlation != CorrelationChoice::Exponential)
-        eg = slope_for(a, g1, g2, ratio, Correlation::Gaussian);
+        eg = slope_for(a, in, Correlation::Gaussian);
     if (a.correlation != CorrelationChoice::Gaussian)
-        ee = slope_for(a, g1, g2, ratio, Correlation::Exponential);
-    // θK, ξK, m as in Table 2: from the Gaussian estimate when there is one.
-    const RoughnessEstimate& primary = eg ? *eg : *ee;
-
-    json out;
-    const bool closed = normal_view(g1) && normal_view(g2);
-    out["estimator"] =
-        closed ? "slope ratio (Eq. 16-19)" : "slope ratio (two-geometry solver, TOMS 748)";
-    put(out, "sigma_over_T", primary.sigma_over_T, err);
-    put(out, "sigma_over_T_gaussian", eg ? eg->sigma_over_T : std::nullopt, err);
-    put(out, "sigma_over_T_exponential", ee ? ee->sigma_over_T : std::nullopt, err);
-    put(out, "sigma_um", primary.sigma_um, false);
-    put(out, "T_um", primary.T_um, err);
-    if (eg && ee && given(a.o_sigma)) {
-        put(out, "T_um_gaussian", eg->T_um, err);
-        put(out, "T_um_exponential", ee->T_um, err);
-    }
-    put_derived(out, primary, err);
-    out["E1_over_E2"] = finite_number(ratio, "E1_over_E2");
-    const auto range = [&](Correlation c) -> json {
-        if (!closed) return nullptr;
-        const RatioRange r =
-            c == Correlation::Gaussian
-                ? ratio_range_gaussian(g1.theta_i_rad, g2.theta_i_rad, a.factor)
-                : ratio_range_exponential(g1.theta_i_rad, g2.theta_i_rad, a.factor);
-        return json::array(
-            {finite_number(r.lower), std::isinf(r.upper) ? json(nullptr) : finite_number(r.upper)});
-    };
-    if (eg) out["valid_ratio_range_gaussian"] = range(Correlation::Gaussian);
-    if (ee) out["valid_ratio_range_exponential"] = range(Correlation::Exponential);
-    out["geometry1"] = geometry_json(g1);
-    out["geometry2"] = geometry_json(g2);
-    out["factor"] = std::string(to_string(a.factor));
-    out["radiometry"] = std::string(to_string(a.radiometry));
-    std::vector<std::string> ws;
-    if (eg)
-        for (const auto& w : eg->warnings) ws.push_back((ee ? "gaussian: " : "") + w);
-    if (ee)
-        for (const auto& w : ee->warnings) ws.push_back((eg ? "exponential: " : "") + w);
-    out["warnings"] = warnings_json(ws);
-    emit(a.out, out);
+        ee = slope_for(a, in, Correlation::Exponential);
+    emit(a.out, serialize::slope_estimate_json(in, eg, ee, given(a.o_noise)));
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -475,57 +371,6 @@ std::vector<Measurement> read_measurements(const std::filesystem::path& path) {
     return ms;
 }
 
-json fit_json(const FitResult& r, bool with_residuals) {
-    json out;
-    out["correlation"] = std::string(to_string(r.options.correlation));
-    out["status"] = std::string(to_string(r.status));
-    const auto& e = r.estimate;
-    const bool err = r.covariance_available;
-    put(out, "sigma_over_T", e.sigma_over_T, err);
-    if (r.options.model == FitModel::SlightlyRough) {
-        put(out, "sigma_um", e.sigma_um, err);
-        put(out, "T_um", e.T_um, err);
-    }
-    const FitParameter& gain = r.parameter("gain");
-    out["gain"] = finite_number(gain.value, "gain");
-    out["gain_stderr"] = err ? finite_number(gain.std_error, "gain_stderr") : json(nullptr);
-    put_derived(out, e, err);
-    out["sse"] = finite_number(r.sse, "sse");
-    out["aic"] = finite_number(r.aic, "aic");
-    out["aicc"] = std::isfinite(r.aicc) ? finite_number(r.aicc, "aicc") : json(nullptr);
-    out["n"] = r.num_measurements;
-    out["parameters"] = r.num_parameters;
-    out["iterations"] = r.iterations;
-    json params = json::array();
-    for (const auto& p : r.parameters)
-        params.push_back({{"name", p.name},
-                          {"value", finite_number(p.value, p.name)},
-                          {"stderr", err ? finite_number(p.std_error, p.name) : json(nullptr)},
-                          {"at_bound", p.at_bound}});
-    out["parameter_table"] = params;
-    if (err) {
-        json cov = json::array();
-        for (int a = 0; a < r.covariance.rows(); ++a) {
-            json row = json::array();
-            for (int b = 0; b < r.covariance.cols(); ++b)
-                row.push_back(finite_number(r.covariance(a, b), "covariance"));
-            cov.push_back(row);
-        }
-        out["covariance"] = cov;
-    } else {
-        out["covariance"] = nullptr;
-    }
-    if (with_residuals) {
-        json res = json::array();
-        for (double x : r.residuals) res.push_back(finite_number(x, "residual"));
-        out["residuals"] = res;
-    }
-    out["message"] = r.message;
-    out["report"] = r.brief_report();
-    out["warnings"] = warnings_json(e.warnings);
-    return out;
-}
-
 void run_fit(const FitArgs& a) {
     if (!given(a.o_measurements))
         throw UsageError(
@@ -543,64 +388,34 @@ void run_fit(const FitArgs& a) {
     }
     const auto ms = read_measurements(a.measurements_path);
 
-    FitOptions o;
-    o.model = a.model;
-    o.factor = a.factor;
-    o.radiometry = a.radiometry;
-    o.regime = a.regime;
-    o.wavelength_um = a.wavelength_um;
-    o.residual = a.residual;
-    o.loss = a.loss;
-    o.loss_scale = a.loss_scale;
-    o.max_iterations = a.max_iterations;
-    if (given(a.o_initial_sigma_over_T)) o.initial_sigma_over_T = a.initial_sigma_over_T;
-    if (given(a.o_initial_sigma)) o.initial_sigma_um = a.initial_sigma_um;
-    if (given(a.o_initial_T)) o.initial_T_um = a.initial_T_um;
+    // FitOptions are built by the library from named options, as for the Python module.
+    json options = {{"model", std::string(to_string(a.model))},
+                    {"factor", std::string(to_string(a.factor))},
+                    {"radiometry", std::string(to_string(a.radiometry))},
+                    {"regime", std::string(to_string(a.regime))},
+                    {"wavelength_um", a.wavelength_um},
+                    {"residual", std::string(to_string(a.residual))},
+                    {"loss", std::string(to_string(a.loss))},
+                    {"loss_scale", a.loss_scale},
+                    {"max_iterations", a.max_iterations}};
+    if (given(a.o_initial_sigma_over_T)) options["initial_sigma_over_T"] = a.initial_sigma_over_T;
+    if (given(a.o_initial_sigma)) options["initial_sigma_um"] = a.initial_sigma_um;
+    if (given(a.o_initial_T)) options["initial_T_um"] = a.initial_T_um;
+    if (a.correlation != CorrelationChoice::Both)
+        options["correlation"] =
+            a.correlation == CorrelationChoice::Gaussian ? "gaussian" : "exponential";
+    const FitOptions o = serialize::fit_options_from(options);
 
     json out;
-    out["estimator"] = "least squares (Ceres), " + std::string(to_string(a.model));
-    out["measurements"] = static_cast<int>(ms.size());
-    out["factor"] = std::string(to_string(a.factor));
-    out["radiometry"] = std::string(to_string(a.radiometry));
-    out["residual"] = std::string(to_string(a.residual));
-    out["loss"] = std::string(to_string(a.loss));
     if (a.correlation == CorrelationChoice::Both) {
         const CorrelationComparison c = compare_correlations(ms, o);
-        const FitResult& best = c.preferred == Correlation::Gaussian ? c.gaussian : c.exponential;
-        const json jg = fit_json(c.gaussian, a.residuals);
-        const json je = fit_json(c.exponential, a.residuals);
-        const json jb = fit_json(best, false);
-        out["preferred_correlation"] = std::string(to_string(c.preferred));
-        out["delta_aic"] = finite_number(c.delta_aic, "delta_aic");
-        for (const char* k : {"sigma_over_T", "sigma_over_T_stderr"}) out[k] = jb[k];
-        out["sigma_over_T_gaussian"] = jg["sigma_over_T"];
-        out["sigma_over_T_gaussian_stderr"] = jg["sigma_over_T_stderr"];
-        out["sigma_over_T_exponential"] = je["sigma_over_T"];
-        out["sigma_over_T_exponential_stderr"] = je["sigma_over_T_stderr"];
-        if (a.model == FitModel::SlightlyRough)
-            for (const char* k : {"sigma_um", "sigma_um_stderr", "T_um", "T_um_stderr"})
-                out[k] = jb[k];
-        // Caron's θK, ξK, m from the Gaussian fit (they are Gaussian-correlation quantities).
-        for (const char* k :
-             {"theta_K_deg", "theta_K_deg_stderr", "xi_K", "xi_K_stderr", "rms_slope",
-              "rms_slope_stderr", "roughness_class", "roughness_class_assumed", "g"})
-            out[k] = jg[k];
-        out["gaussian"] = jg;
-        out["exponential"] = je;
-        std::vector<std::string> ws;
-        for (const auto& w : c.gaussian.estimate.warnings) ws.push_back("gaussian: " + w);
-        for (const auto& w : c.exponential.estimate.warnings) ws.push_back("exponential: " + w);
-        out["warnings"] = warnings_json(ws);
+        out = serialize::fit_estimate_json(o, ms.size(), c, a.residuals);
         if (!a.out.json_output) {
             out["gaussian_fit"] = c.gaussian.brief_report();
             out["exponential_fit"] = c.exponential.brief_report();
         }
     } else {
-        o.correlation = a.correlation == CorrelationChoice::Gaussian ? Correlation::Gaussian
-                                                                     : Correlation::Exponential;
-        const FitResult r = fit_roughness(ms, o);
-        const json jr = fit_json(r, a.residuals);
-        for (const auto& [k, v] : jr.items()) out[k] = v;
+        out = serialize::fit_estimate_json(o, ms.size(), fit_roughness(ms, o), a.residuals);
     }
     emit(a.out, out);
 }

@@ -1,7 +1,11 @@
 // `roughscope model`: evaluates a reflectance model (the B–K theory of §3 or a comparison model
 // of §5) at one geometry given on the command line, or at every row of a CSV file.
 //
-// Angles are degrees here and radians in the library; lengths are µm. See docs/cli.md.
+// Angles are degrees here and radians in the library; lengths are µm. See docs/cli.md. Numbers
+// go into JSON unrounded (round-trip precision; serialize/json.hpp); text and CSV show
+// kPrintDigits significant digits.
+#include "roughscope/serialize/model.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
@@ -22,6 +26,7 @@
 #include "roughscope/scattering/geometry.hpp"
 #include "roughscope/scattering/reflectance_models.hpp"
 #include "roughscope/scattering/validity.hpp"
+#include "roughscope/serialize/json.hpp"
 
 namespace roughscope::cli {
 namespace {
@@ -278,9 +283,7 @@ std::vector<LafortuneLobe> lafortune_lobes(const Args& a) {
     return lobes;
 }
 
-json to_json_number(const std::optional<double>& v, const char* name) {
-    return number_or_null(v, name);
-}
+json to_json_number(const std::optional<double>& v) { return serialize::number(v); }
 
 // B–K model (Eq. 1–5, §3.2–3.3) at one point: adds its keys to `out`, returns the brightness.
 double evaluate_bk(const Args& a, const Point& p, const Roughness& r, json& out) {
@@ -301,14 +304,10 @@ double evaluate_bk(const Args& a, const Point& p, const Roughness& r, json& out)
         options.patch_x_um = a.patch_x_um;
         options.patch_y_um = a.patch_y_um;
         if (p.geom) {
-            const ScatteredPower power = mean_scattered_power(*p.geom, surface, options);
-            coherent = power.coherent;
-            diffuse = power.diffuse;
-            total = power.total;
-            brightness = power.brightness;
-            g = power.g;
-            regime = std::string(to_string(power.regime));
-            roughness_class = std::string(to_string(power.roughness_class));
+            const json power = serialize::to_json(mean_scattered_power(*p.geom, surface, options));
+            brightness = power["brightness"].get<double>();
+            for (const char* k : {"coherent", "diffuse", "total", "g", "regime", "roughness_class"})
+                out[k] = power[k];
         } else {
             coherent = diffuse = total = 0.0;  // light or viewer below the horizon
         }
@@ -327,38 +326,39 @@ double evaluate_bk(const Args& a, const Point& p, const Roughness& r, json& out)
             to_string(series_limit_ok ? Regime::VeryRoughSeriesLimit : Regime::VeryRough));
         if (p.geom) {
             brightness = very_rough_brightness(*p.geom, *m, a.correlation, a.factor, a.radiometry);
-            const double F2 = geometric_factor_squared(a.factor, *p.geom);
-            const ScatteringDirection q = scattering_direction(*p.geom);
-            diffuse = a.correlation == Correlation::Gaussian
-                          ? very_rough_shape_gaussian(F2, q, *m)
-                          : very_rough_shape_exponential(F2, q, *m);
+            // D itself is the shape of Eq. 4 / Eq. 5 before the radiometric factor of §3.3,
+            // i.e. the brightness under the radiance interpretation (factor 1).
+            diffuse =
+                very_rough_brightness(*p.geom, *m, a.correlation, a.factor, Radiometry::Radiance);
         } else {
             diffuse = 0.0;
         }
     }
 
-    out["coherent"] = to_json_number(coherent, "coherent");
-    out["diffuse"] = to_json_number(diffuse, "diffuse");
-    out["total"] = to_json_number(total, "total");
-    out["g"] = to_json_number(g, "g");
-    out["regime"] = regime ? json(*regime) : json(nullptr);
-    out["roughness_class"] = roughness_class ? json(*roughness_class) : json(nullptr);
+    if (!out.contains("coherent")) {  // not from the serialized ScatteredPower
+        out["coherent"] = to_json_number(coherent);
+        out["diffuse"] = to_json_number(diffuse);
+        out["total"] = to_json_number(total);
+        out["g"] = to_json_number(g);
+        out["regime"] = regime ? json(*regime) : json(nullptr);
+        out["roughness_class"] = roughness_class ? json(*roughness_class) : json(nullptr);
+    }
     out["scale"] = absolute ? "absolute" : "relative";
     out["correlation"] = std::string(to_string(a.correlation));
     out["factor"] = std::string(to_string(a.factor));
     out["radiometry"] = std::string(to_string(a.radiometry));
-    out["wavelength_um"] = finite_number(a.wavelength_um, "wavelength_um");
-    out["patch_x_um"] = finite_number(a.patch_x_um, "patch_x_um");
-    out["patch_y_um"] = finite_number(a.patch_y_um, "patch_y_um");
-    out["sigma_um"] = to_json_number(r.sigma_um, "sigma_um");
-    out["T_um"] = to_json_number(r.T_um, "T_um");
-    out["sigma_over_T"] = to_json_number(m, "sigma_over_T");
+    out["wavelength_um"] = serialize::number(a.wavelength_um);
+    out["patch_x_um"] = serialize::number(a.patch_x_um);
+    out["patch_y_um"] = serialize::number(a.patch_y_um);
+    out["sigma_um"] = to_json_number(r.sigma_um);
+    out["T_um"] = to_json_number(r.T_um);
+    out["sigma_over_T"] = to_json_number(m);
     // §3.5: Caron's angle of RMS slope (Gaussian height distribution and correlation only).
     std::optional<double> theta_K_deg;
     if (a.correlation == Correlation::Gaussian && m) {
         theta_K_deg = rad_to_deg(caron_theta_K_rad(*m));
     }
-    out["caron_theta_K_deg"] = to_json_number(theta_K_deg, "caron_theta_K_deg");
+    out["caron_theta_K_deg"] = to_json_number(theta_K_deg);
     return brightness;
 }
 
@@ -366,9 +366,15 @@ double evaluate_bk(const Args& a, const Point& p, const Roughness& r, json& out)
 json evaluate(const Args& a, const Point& p, const Roughness& r) {
     json out;
     out["model"] = model_name(a.model);
-    out["theta_i_deg"] = finite_number(p.theta_i_deg, "theta_i_deg");
-    out["theta_s_deg"] = finite_number(p.theta_s_deg, "theta_s_deg");
-    out["phi_s_deg"] = to_json_number(p.phi_s_deg, "phi_s_deg");
+    // Angles of a geometry echoed as the shortest degrees that map to the same radians.
+    const auto angle = [&](double deg, const std::optional<double> rad) {
+        return rad ? serialize::degrees(*rad) : serialize::number(deg);
+    };
+    out["theta_i_deg"] =
+        angle(p.theta_i_deg, p.geom ? std::optional(p.geom->theta_i_rad) : std::nullopt);
+    out["theta_s_deg"] =
+        angle(p.theta_s_deg, p.geom ? std::optional(p.geom->theta_s_rad) : std::nullopt);
+    out["phi_s_deg"] = p.geom ? serialize::degrees(p.geom->phi_s_rad) : json(nullptr);
     out["visible"] = p.geom.has_value();
     out["brightness"] = nullptr;  // placeholder keeps the key order
 
@@ -388,8 +394,8 @@ json evaluate(const Args& a, const Point& p, const Roughness& r) {
                                  ? oren_nayar_radiance(*p.geom, params)
                                  : oren_nayar_qualitative_radiance(*p.geom, params);
             }
-            out["on_sigma_rad"] = finite_number(a.on_sigma_rad, "on_sigma_rad");
-            out["albedo"] = finite_number(a.albedo, "albedo");
+            out["on_sigma_rad"] = serialize::number(a.on_sigma_rad);
+            out["albedo"] = serialize::number(a.albedo);
             break;
         }
         case ModelKind::Lafortune: {
@@ -403,18 +409,18 @@ json evaluate(const Args& a, const Point& p, const Roughness& r) {
             }
             json lobes_json = json::array();
             for (const auto& l : lobes) {
-                lobes_json.push_back({{"Cx", finite_number(l.Cx)},
-                                      {"Cy", finite_number(l.Cy)},
-                                      {"Cz", finite_number(l.Cz)},
-                                      {"n", finite_number(l.n)},
-                                      {"rho", finite_number(l.albedo)}});
+                lobes_json.push_back({{"Cx", serialize::number(l.Cx)},
+                                      {"Cy", serialize::number(l.Cy)},
+                                      {"Cz", serialize::number(l.Cz)},
+                                      {"n", serialize::number(l.n)},
+                                      {"rho", serialize::number(l.albedo)}});
             }
-            out["rho_d"] = finite_number(a.rho_d, "rho_d");
+            out["rho_d"] = serialize::number(a.rho_d);
             out["lobes"] = lobes_json;
             break;
         }
     }
-    out["brightness"] = finite_number(brightness, "brightness");
+    out["brightness"] = serialize::number(brightness);
     return out;
 }
 
@@ -524,7 +530,7 @@ void run_model(const Args& a) {
         const json record = evaluate(a, p, roughness_from_flags(a));
         std::string text;
         if (a.json_output) {
-            text = dump_json(record);
+            text = serialize::dump(record);
         } else if (output) {
             text = csv_text({record});
         } else {
@@ -558,7 +564,7 @@ void run_model(const Args& a) {
             throw roughscope::DataError(where + e.what());
         }
     }
-    write_output(output, a.json_output ? dump_json(json(records)) : csv_text(records));
+    write_output(output, a.json_output ? serialize::dump(json(records)) : csv_text(records));
 }
 
 }  // namespace

@@ -26,6 +26,7 @@
 #include "roughscope/estimation/estimation.hpp"
 #include "roughscope/scattering/geometry.hpp"
 #include "roughscope/scattering/validity.hpp"
+#include "roughscope/serialize/json.hpp"
 
 namespace roughscope::cli {
 namespace {
@@ -58,9 +59,9 @@ struct Check {
         return "differs";
     }
     json to_json() const {
-        return {{"printed", finite_number(printed, "printed")},
-                {"recomputed", finite_number(recomputed, "recomputed")},
-                {"rounding_interval", json::array({finite_number(lo), finite_number(hi)})},
+        return {{"printed", serialize::number(printed)},
+                {"recomputed", serialize::number(recomputed)},
+                {"rounding_interval", json::array({serialize::number(lo), serialize::number(hi)})},
                 {"agreement", agreement()}};
     }
 };
@@ -274,7 +275,7 @@ void run_tables(const Args& a) {
             "rounding of the printed inputs;  DIFFERS otherwise.\n";
 
     write_output(given(a.o_output) ? std::optional<fs::path>(a.output_path) : std::nullopt,
-                 a.json_output ? dump_json(out) : text.str());
+                 a.json_output ? serialize::dump(out) : text.str());
 }
 
 }  // namespace

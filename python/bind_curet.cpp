@@ -1,6 +1,8 @@
 // Bindings for measured BRDFs (CUReT and any BRDF table) and the model comparison of §5.3.
-// Angles cross this boundary in degrees. Comparisons are returned as JSON text (the same document
-// as `roughscope curet --json --series`); the pure-Python roughscope.curet parses it.
+// Angles cross this boundary in degrees. Comparisons are returned as dicts built by the library's
+// serializer (roughscope/serialize/comparison.hpp): the document of `roughscope curet --json`
+// as Python objects. The options become a ComparisonOptions in one place,
+// serialize::comparison_options_from, which the CLI calls too.
 #include <optional>
 #include <string>
 #include <vector>
@@ -15,6 +17,7 @@
 #include "roughscope/brdf/curet.hpp"
 #include "roughscope/brdf/table.hpp"
 #include "roughscope/core/errors.hpp"
+#include "roughscope/serialize/comparison.hpp"
 
 namespace py = pybind11;
 
@@ -36,36 +39,15 @@ py::array_t<double> matrix_array(const std::vector<std::vector<double>>& rows) {
     return out;
 }
 
-ComparisonOptions make_options(std::optional<double> theta1_deg, std::optional<double> theta2_deg,
-                               std::optional<std::vector<int>> pair,
-                               std::optional<double> on_sigma_rad, std::optional<double> on_albedo,
-                               bool fits, const std::string& radiometry,
-                               std::optional<double> max_overflow) {
-    ComparisonOptions o;
-    if (theta1_deg.has_value() != theta2_deg.has_value())
-        throw InvalidArgument("give both theta1_deg and theta2_deg or neither");
-    if (theta1_deg) {
-        o.theta1_rad = deg_to_rad(*theta1_deg);
-        o.theta2_rad = deg_to_rad(*theta2_deg);
-    }
-    if (pair) {
-        if (pair->size() != 2)
-            throw InvalidArgument("pair must hold two measurement numbers, got " +
-                                  std::to_string(pair->size()));
-        o.measurement1 = (*pair)[0];
-        o.measurement2 = (*pair)[1];
-    }
-    if (on_sigma_rad.has_value() != on_albedo.has_value())
-        throw InvalidArgument("give both on_sigma_rad and on_albedo or neither");
-    if (on_sigma_rad) {
-        o.oren_nayar = OrenNayarParams{*on_sigma_rad, *on_albedo};
-        o.oren_nayar_source = "given";
-    }
-    o.fits = fits;
-    o.radiometry = parse_radiometry(radiometry);
-    o.max_overflow_fraction = max_overflow;
-    validate(o);
-    return o;
+// Named comparison options (None = default) → ComparisonOptions, by the library.
+ComparisonOptions make_options(py::object theta1_deg, py::object theta2_deg, py::object pair,
+                               py::object on_sigma_rad, py::object on_albedo, bool fits,
+                               const std::string& radiometry, py::object max_overflow) {
+    using namespace py::literals;
+    const py::dict o("theta1_deg"_a = theta1_deg, "theta2_deg"_a = theta2_deg, "pair"_a = pair,
+                     "on_sigma_rad"_a = on_sigma_rad, "on_albedo"_a = on_albedo, "fits"_a = fits,
+                     "radiometry"_a = radiometry, "max_overflow"_a = max_overflow);
+    return serialize::comparison_options_from(from_python(o, "comparison option"));
 }
 
 py::dict table_dict(const BrdfTable& t) {
@@ -185,42 +167,48 @@ void bind_curet(py::module_& m) {
             py::arg("sample"), "One sample's measurements as a dict of numpy arrays (degrees)")
         .def(
             "compare",
-            [](const CuretDatabase& db, int sample, std::optional<double> theta1_deg,
-               std::optional<double> theta2_deg, std::optional<std::vector<int>> pair,
-               std::optional<double> on_sigma_rad, std::optional<double> on_albedo, bool fits,
-               const std::string& radiometry, std::optional<double> max_overflow, bool series) {
+            [](const CuretDatabase& db, int sample, py::object theta1_deg, py::object theta2_deg,
+               py::object pair, py::object on_sigma_rad, py::object on_albedo, bool fits,
+               const std::string& radiometry, py::object max_overflow, bool series) {
                 const ComparisonOptions o = make_options(theta1_deg, theta2_deg, pair, on_sigma_rad,
                                                          on_albedo, fits, radiometry, max_overflow);
-                py::gil_scoped_release release;
-                return to_json(compare_curet_sample(db, sample, o), series, -1);
+                serialize::Json doc;
+                {
+                    py::gil_scoped_release release;
+                    doc = serialize::to_json(compare_curet_sample(db, sample, o), series);
+                }
+                return to_python(doc);
             },
             py::arg("sample"), py::kw_only(), py::arg("theta1_deg") = py::none(),
             py::arg("theta2_deg") = py::none(), py::arg("pair") = py::none(),
             py::arg("on_sigma_rad") = py::none(), py::arg("on_albedo") = py::none(),
             py::arg("fits") = true, py::arg("radiometry") = "radiance",
             py::arg("max_overflow") = py::none(), py::arg("series") = true,
-            "Compare every model with one sample (JSON text; see roughscope.curet.compare)")
+            "Compare every model with one sample: a dict (see roughscope.curet.compare)")
         .def(
             "compare_all",
             [](const CuretDatabase& db, bool fits, const std::string& radiometry,
-               std::optional<double> max_overflow, int threads, const std::string& format,
-               bool series) {
+               py::object max_overflow, int threads, const std::string& format,
+               bool series) -> py::object {
                 const ComparisonOptions o =
-                    make_options(std::nullopt, std::nullopt, std::nullopt, std::nullopt,
-                                 std::nullopt, fits, radiometry, max_overflow);
-                if (format != "json" && format != "csv" && format != "markdown")
+                    make_options(py::none(), py::none(), py::none(), py::none(), py::none(), fits,
+                                 radiometry, max_overflow);
+                if (format != "dict" && format != "csv" && format != "markdown")
                     throw InvalidArgument("format '" + format +
-                                          "' is not one of: json, csv, markdown");
-                py::gil_scoped_release release;
-                const std::vector<Comparison> all = compare_curet_all(db, o, threads);
-                if (format == "csv") return to_csv(all);
-                if (format == "markdown") return to_markdown(all);
-                return to_json(all, series, -1);
+                                          "' is not one of: dict, csv, markdown");
+                std::vector<Comparison> all;
+                {
+                    py::gil_scoped_release release;
+                    all = compare_curet_all(db, o, threads);
+                }
+                if (format == "csv") return py::str(serialize::to_csv(all));
+                if (format == "markdown") return py::str(serialize::to_markdown(all));
+                return to_python(serialize::to_json(all, series));
             },
             py::kw_only(), py::arg("fits") = true, py::arg("radiometry") = "radiance",
             py::arg("max_overflow") = py::none(), py::arg("threads") = 0,
-            py::arg("format") = "json", py::arg("series") = false,
-            "Compare every sample (JSON, CSV or Markdown text)");
+            py::arg("format") = "dict", py::arg("series") = false,
+            "Compare every sample: a list of dicts (format='dict'), or CSV or Markdown text");
 
     m.def(
         "curet_find_directory",
@@ -265,22 +253,21 @@ void bind_curet(py::module_& m) {
         "weight, channel, measurement) into a dict of numpy arrays");
     m.def(
         "brdf_compare_csv",
-        [](const std::string& path, std::optional<std::string> channel,
-           std::optional<double> theta1_deg, std::optional<double> theta2_deg,
-           std::optional<std::vector<int>> pair, std::optional<double> on_sigma_rad,
-           std::optional<double> on_albedo, bool fits, const std::string& radiometry, bool series) {
+        [](const std::string& path, std::optional<std::string> channel, py::object theta1_deg,
+           py::object theta2_deg, py::object pair, py::object on_sigma_rad, py::object on_albedo,
+           bool fits, const std::string& radiometry, bool series) {
             BrdfCsvOptions co;
             co.channel = channel;
             const ComparisonOptions o = make_options(theta1_deg, theta2_deg, pair, on_sigma_rad,
-                                                     on_albedo, fits, radiometry, std::nullopt);
-            return to_json(compare_brdf(read_brdf_csv(path, co), o), series, -1);
+                                                     on_albedo, fits, radiometry, py::none());
+            return to_python(serialize::to_json(compare_brdf(read_brdf_csv(path, co), o), series));
         },
         py::arg("path"), py::kw_only(), py::arg("channel") = py::none(),
         py::arg("theta1_deg") = py::none(), py::arg("theta2_deg") = py::none(),
         py::arg("pair") = py::none(), py::arg("on_sigma_rad") = py::none(),
         py::arg("on_albedo") = py::none(), py::arg("fits") = true,
         py::arg("radiometry") = "radiance", py::arg("series") = true,
-        "Compare every model with a BRDF table read from CSV (JSON text)");
+        "Compare every model with a BRDF table read from CSV (a dict)");
     m.def(
         "brdf_compare_arrays",
         [](py::array_t<double, py::array::c_style | py::array::forcecast> theta_i_deg,
@@ -289,15 +276,14 @@ void bind_curet(py::module_& m) {
            py::array_t<double, py::array::c_style | py::array::forcecast> phi_s_deg,
            py::array_t<double, py::array::c_style | py::array::forcecast> value,
            std::optional<py::array_t<double, py::array::c_style | py::array::forcecast>> weight,
-           const std::string& name, std::optional<double> theta1_deg,
-           std::optional<double> theta2_deg, std::optional<std::vector<int>> pair,
-           std::optional<double> on_sigma_rad, std::optional<double> on_albedo, bool fits,
-           const std::string& radiometry, bool series) {
+           const std::string& name, py::object theta1_deg, py::object theta2_deg, py::object pair,
+           py::object on_sigma_rad, py::object on_albedo, bool fits, const std::string& radiometry,
+           bool series) {
             const BrdfTable t = table_from_arrays(theta_i_deg, phi_i_deg, theta_s_deg, phi_s_deg,
                                                   value, weight, name);
             const ComparisonOptions o = make_options(theta1_deg, theta2_deg, pair, on_sigma_rad,
-                                                     on_albedo, fits, radiometry, std::nullopt);
-            return to_json(compare_brdf(t, o), series, -1);
+                                                     on_albedo, fits, radiometry, py::none());
+            return to_python(serialize::to_json(compare_brdf(t, o), series));
         },
         py::arg("theta_i_deg"), py::arg("phi_i_deg"), py::arg("theta_s_deg"), py::arg("phi_s_deg"),
         py::arg("value"), py::kw_only(), py::arg("weight") = py::none(), py::arg("name") = "table",
@@ -306,7 +292,7 @@ void bind_curet(py::module_& m) {
         py::arg("on_albedo") = py::none(), py::arg("fits") = true,
         py::arg("radiometry") = "radiance", py::arg("series") = true,
         "Compare every model with a BRDF table given as arrays (degrees; measurement j+1 is "
-        "element j). JSON text.");
+        "element j). A dict.");
     m.def(
         "comparison_error_measures",
         [](std::vector<double> model, std::vector<double> data,

@@ -4,8 +4,9 @@
 // in µm (`_um`). The closed forms and the two-geometry solvers are vectorised: every numeric
 // argument is array-like and broadcast with NumPy's rules; all-scalar input gives a float. A bad
 // element raises a roughscope.Error subclass (ValueError) whose message starts with its index.
-// The estimate_* functions and the fits take scalars / 1-d arrays and return dicts whose keys are
-// those of the CLI's --json output.
+// The estimate_* functions and the fits take scalars / 1-d arrays and return dicts built by the
+// library's serializer (roughscope/serialize/estimation.hpp): the same document as the CLI's
+// `roughscope estimate ... --json`, as Python objects (tests/python/test_parity.py checks it).
 #include <array>
 #include <cmath>
 #include <optional>
@@ -26,6 +27,7 @@
 #include "roughscope/scattering/factors.hpp"
 #include "roughscope/scattering/geometry.hpp"
 #include "roughscope/scattering/validity.hpp"
+#include "roughscope/serialize/estimation.hpp"
 
 namespace py = pybind11;
 using namespace py::literals;
@@ -114,41 +116,8 @@ Geometry geometry_deg(double ti, double ts, double ps) {
 
 py::tuple range_tuple(const RatioRange& r) { return py::make_tuple(r.lower, r.upper); }
 
-// ---------------------------------------------------------------------------------------------
-// RoughnessEstimate → dict with the CLI's JSON keys.
-
-void put(py::dict& d, const std::string& key, const std::optional<Estimate>& e,
-         double scale = 1.0) {
-    if (e) {
-        d[key.c_str()] = e->value * scale;
-        d[(key + "_stderr").c_str()] = e->std_error * scale;
-    } else {
-        d[key.c_str()] = py::none();
-        d[(key + "_stderr").c_str()] = py::none();
-    }
-}
-
-py::dict estimate_dict(const RoughnessEstimate& e) {
-    py::dict d;
-    put(d, "sigma_um", e.sigma_um);
-    put(d, "T_um", e.T_um);
-    put(d, "sigma_over_T", e.sigma_over_T);
-    d["correlation"] = std::string(to_string(e.correlation));
-    put(d, "theta_K_deg", e.theta_K_rad, 180.0 / kPi);
-    put(d, "xi_K", e.xi_K);
-    put(d, "rms_slope", e.rms_slope);
-    d["roughness_class"] = std::string(to_string(e.roughness_class));
-    d["roughness_class_assumed"] = e.roughness_class_assumed;
-    if (e.g.empty())
-        d["g"] = py::none();
-    else
-        d["g"] = py::array_t<double>(static_cast<py::ssize_t>(e.g.size()), e.g.data());
-    d["warnings"] = e.warnings;
-    return d;
-}
-
 std::pair<double, double> noise_pair(py::handle noise) {
-    if (noise.is_none()) return {0.0, 0.0};
+    if (noise.is_none()) return {0.0, 0.0};  // no noise given: no standard errors
     if (py::isinstance<py::sequence>(noise) && !py::isinstance<py::str>(noise)) {
         auto v = noise.cast<std::vector<double>>();
         if (v.size() != 2)
@@ -196,84 +165,6 @@ std::vector<Measurement> measurements_from(py::handle theta_i_deg, py::handle th
                       w ? at(*w, i, "weight") : 1.0});
     }
     return ms;
-}
-
-FitOptions fit_options_from(const std::string& model, const std::string& correlation,
-                            const std::string& factor, const std::string& radiometry,
-                            const std::string& regime, double wavelength_um,
-                            const std::string& residual, const std::string& loss, double loss_scale,
-                            std::optional<double> initial_sigma_over_T,
-                            std::optional<double> initial_sigma_um,
-                            std::optional<double> initial_T_um, py::handle sigma_over_T_bounds,
-                            py::handle sigma_bounds_um, py::handle T_bounds_um, int max_iterations,
-                            bool scale_covariance) {
-    FitOptions o;
-    o.model = parse_fit_model(model);
-    o.correlation = correlation_of(correlation);
-    o.factor = factor_of(factor);
-    o.radiometry = radiometry_of(radiometry);
-    o.regime = parse_regime(regime);
-    o.wavelength_um = wavelength_um;
-    o.residual = parse_residual_type(residual);
-    o.loss = parse_loss_type(loss);
-    o.loss_scale = loss_scale;
-    o.initial_sigma_over_T = initial_sigma_over_T;
-    o.initial_sigma_um = initial_sigma_um;
-    o.initial_T_um = initial_T_um;
-    auto bounds = [](const char* name, py::handle h, double& lo, double& hi) {
-        if (h.is_none()) return;
-        auto v = h.cast<std::vector<double>>();
-        if (v.size() != 2)
-            throw InvalidArgument(std::string(name) + " must be a pair (lower, upper)");
-        lo = v[0];
-        hi = v[1];
-    };
-    bounds("sigma_over_T_bounds", sigma_over_T_bounds, o.sigma_over_T_min, o.sigma_over_T_max);
-    bounds("sigma_bounds_um", sigma_bounds_um, o.sigma_min_um, o.sigma_max_um);
-    bounds("T_bounds_um", T_bounds_um, o.T_min_um, o.T_max_um);
-    o.max_iterations = max_iterations;
-    o.scale_covariance = scale_covariance;
-    return o;
-}
-
-py::dict fit_dict(const FitResult& r) {
-    py::dict d = estimate_dict(r.estimate);
-    d["status"] = std::string(to_string(r.status));
-    d["message"] = r.message;
-    py::dict params;
-    for (const auto& p : r.parameters) {
-        params[p.name.c_str()] =
-            py::dict("value"_a = p.value,
-                     "stderr"_a = r.covariance_available ? py::object(py::float_(p.std_error))
-                                                         : py::object(py::none()),
-                     "lower"_a = p.lower, "upper"_a = p.upper, "at_bound"_a = p.at_bound);
-    }
-    d["parameters"] = params;
-    const FitParameter& gain = r.parameter("gain");
-    d["gain"] = gain.value;
-    d["gain_stderr"] =
-        r.covariance_available ? py::object(py::float_(gain.std_error)) : py::object(py::none());
-    if (!r.covariance_available) {
-        for (const char* k : {"sigma_um_stderr", "T_um_stderr", "sigma_over_T_stderr",
-                              "theta_K_deg_stderr", "xi_K_stderr", "rms_slope_stderr"})
-            if (d.contains(k)) d[k] = py::none();
-    }
-    d["covariance_available"] = r.covariance_available;
-    d["covariance"] =
-        r.covariance_available ? py::object(py::cast(r.covariance)) : py::object(py::none());
-    d["residuals"] =
-        py::array_t<double>(static_cast<py::ssize_t>(r.residuals.size()), r.residuals.data());
-    d["predicted"] =
-        py::array_t<double>(static_cast<py::ssize_t>(r.predicted.size()), r.predicted.data());
-    d["sse"] = r.sse;
-    d["aic"] = r.aic;
-    d["aicc"] = r.aicc;
-    d["n"] = r.num_measurements;
-    d["num_parameters"] = r.num_parameters;
-    d["iterations"] = r.iterations;
-    d["model"] = std::string(to_string(r.options.model));
-    d["report"] = r.brief_report();
-    return d;
 }
 
 }  // namespace
@@ -433,6 +324,8 @@ void bind_estimation(py::module_& m) {
         "series; both correlations). TOMS 748 root finding. Vectorised.");
 
     // ---- Estimates with uncertainty and derived quantities (scalar, dict) -------------------
+    // Standard errors (`*_stderr` keys) are reported when a noise level (or sigma_um_stderr) is
+    // given, as with the CLI's --noise / --sigma-stderr.
     m.def(
         "estimate_slope",
         [](double ratio, double theta1_deg, double theta2_deg, const std::string& correlation,
@@ -443,27 +336,39 @@ void bind_estimation(py::module_& m) {
             in.E1_over_E2 = ratio;
             in.geom1 = geometry_deg(theta1_deg, theta_s1_deg, phi_s1_deg);
             in.geom2 = geometry_deg(theta2_deg, theta_s2_deg, phi_s2_deg);
-            in.correlation = correlation_of(correlation);
             in.options.factor = factor_of(factor);
             in.options.radiometry = radiometry_of(radiometry);
             in.options.wavelength_um = wavelength_um;
             const auto [n1, n2] = noise_pair(noise);
             in.noise = {n1, n2};
             in.sigma_um = sigma_um;
-            return estimate_dict(estimate_slope(in));
+            const bool both = correlation == "both";
+            const Correlation c = both ? Correlation::Gaussian : correlation_of(correlation);
+            std::optional<RoughnessEstimate> eg, ee;
+            if (both || c == Correlation::Gaussian) {
+                in.correlation = Correlation::Gaussian;
+                eg = estimate_slope(in);
+            }
+            if (both || c == Correlation::Exponential) {
+                in.correlation = Correlation::Exponential;
+                ee = estimate_slope(in);
+            }
+            return to_python(serialize::slope_estimate_json(in, eg, ee, !noise.is_none()));
         },
         arg("ratio"), arg("theta1_deg"), arg("theta2_deg"), arg("correlation") = "gaussian",
-        arg("factor") = "vh", arg("radiometry") = "radiance", arg("noise") = 0.0,
+        arg("factor") = "vh", arg("radiometry") = "radiance", arg("noise") = py::none(),
         arg("sigma_um") = py::none(), arg("wavelength_um") = 0.555, arg("theta_s1_deg") = 0.0,
         arg("phi_s1_deg") = 0.0, arg("theta_s2_deg") = 0.0, arg("phi_s2_deg") = 0.0,
-        "sigma/T (Eq. 17/19, or the two-geometry solver when theta_s != 0) with its standard "
-        "error from the relative brightness noise (a number or a pair), and the derived "
-        "quantities: theta_K_deg, xi_K, rms_slope, roughness_class, g (when sigma_um is known), "
-        "warnings. Returns a dict with the keys of `roughscope estimate slope --json`.");
+        "sigma/T (Eq. 17/19, or the two-geometry solver when theta_s != 0) for correlation "
+        "'gaussian', 'exponential' or 'both', with standard errors (*_stderr) when the relative "
+        "brightness noise is given (a number or a pair), and the derived quantities: "
+        "theta_K_deg, xi_K, rms_slope, roughness_class, g (when sigma_um is known), warnings. "
+        "Returns the dict of `roughscope estimate slope --json` (docs/estimation.md).");
     m.def(
         "estimate_sigma_specular",
         [](std::optional<double> R_spec, double theta_deg, std::optional<double> E_tot,
-           std::optional<double> E_dif, double wavelength_um, double R0, double noise) {
+           std::optional<double> E_dif, double wavelength_um, double R0,
+           std::optional<double> noise) {
             SpecularInput in;
             if (R_spec && (E_tot || E_dif))
                 throw InvalidArgument("give R_spec or (E_tot, E_dif), not both");
@@ -475,25 +380,27 @@ void bind_estimation(py::module_& m) {
             in.theta_rad = rad(theta_deg);
             in.wavelength_um = wavelength_um;
             in.R0 = R0;
-            in.relative_noise_tot = in.relative_noise_dif = noise;
-            return estimate_dict(estimate_sigma_specular(in));
+            in.relative_noise_tot = in.relative_noise_dif = noise.value_or(0.0);
+            return to_python(serialize::specular_estimate_json(in, estimate_sigma_specular(in),
+                                                               noise.has_value()));
         },
         arg("R_spec") = py::none(), arg("theta_deg") = 0.0, arg("E_tot") = py::none(),
         arg("E_dif") = py::none(), arg("wavelength_um") = 0.555, arg("R0") = 1.0,
-        arg("noise") = 0.0,
-        "sigma (Eq. 13) with its standard error from the relative noise of E_tot and E_dif, g at "
-        "the specular geometry and the roughness class. Returns a dict.");
+        arg("noise") = py::none(),
+        "sigma (Eq. 13), with its standard error when the relative noise of E_tot and E_dif is "
+        "given, g at the specular geometry and the roughness class. Returns the dict of "
+        "`roughscope estimate specular --json`.");
     m.def(
         "estimate_correlation_length",
         [](double ratio, double sigma_um, double theta1_deg, double theta2_deg,
-           double sigma_um_stderr, const std::string& correlation, const std::string& factor,
-           const std::string& radiometry, const std::string& regime, double wavelength_um,
-           py::handle noise, double theta_s1_deg, double phi_s1_deg, double theta_s2_deg,
-           double phi_s2_deg) {
+           std::optional<double> sigma_um_stderr, const std::string& correlation,
+           const std::string& factor, const std::string& radiometry, const std::string& regime,
+           double wavelength_um, py::handle noise, double theta_s1_deg, double phi_s1_deg,
+           double theta_s2_deg, double phi_s2_deg) {
             CorrelationLengthInput in;
             in.E1_over_E2 = ratio;
             in.sigma_um = sigma_um;
-            in.sigma_um_std_error = sigma_um_stderr;
+            in.sigma_um_std_error = sigma_um_stderr.value_or(0.0);
             in.geom1 = geometry_deg(theta1_deg, theta_s1_deg, phi_s1_deg);
             in.geom2 = geometry_deg(theta2_deg, theta_s2_deg, phi_s2_deg);
             in.correlation = correlation_of(correlation);
@@ -503,67 +410,68 @@ void bind_estimation(py::module_& m) {
             in.options.wavelength_um = wavelength_um;
             const auto [n1, n2] = noise_pair(noise);
             in.noise = {n1, n2};
-            return estimate_dict(estimate_correlation_length(in));
+            return to_python(serialize::correlation_length_estimate_json(
+                in, estimate_correlation_length(in),
+                !noise.is_none() || sigma_um_stderr.has_value()));
         },
         arg("ratio"), arg("sigma_um"), arg("theta1_deg"), arg("theta2_deg"),
-        arg("sigma_um_stderr") = 0.0, arg("correlation") = "gaussian", arg("factor") = "vh",
+        arg("sigma_um_stderr") = py::none(), arg("correlation") = "gaussian", arg("factor") = "vh",
         arg("radiometry") = "radiance", arg("regime") = "slightly_rough",
-        arg("wavelength_um") = 0.555, arg("noise") = 0.0, arg("theta_s1_deg") = 0.0,
+        arg("wavelength_um") = 0.555, arg("noise") = py::none(), arg("theta_s1_deg") = 0.0,
         arg("phi_s1_deg") = 0.0, arg("theta_s2_deg") = 0.0, arg("phi_s2_deg") = 0.0,
-        "T (Eq. 15, or the two-geometry solver) with sigma known, with standard errors from the "
-        "brightness noise and sigma_um_stderr; sigma/T, theta_K, xi_K, g, class, warnings.");
+        "T (Eq. 15, or the two-geometry solver) with sigma known, with standard errors when the "
+        "brightness noise or sigma_um_stderr is given; sigma/T, theta_K, xi_K, g, class, "
+        "warnings. Returns the dict of `roughscope estimate correlation-length --json`.");
 
     // ---- Least-squares fits -----------------------------------------------------------------
+    // The options become a FitOptions in one place: serialize::fit_options_from (the CLI calls
+    // it too).
     auto fit_doc =
         "Least-squares fit (Ceres) of sigma/T (model='very_rough') or sigma and T "
         "(model='slightly_rough') and the gain K to N brightness values at geometries "
         "theta_i_deg, theta_s_deg, phi_s_deg (1-d arrays; phi_s = 0 is the specular plane). "
-        "Returns a dict: status, message, parameters (value, stderr, bounds, at_bound), "
-        "sigma_over_T(_stderr), gain, covariance (natural units), residuals, predicted, sse, aic, "
-        "aicc, n, iterations, report, theta_K_deg, xi_K, rms_slope, roughness_class, g, warnings.";
-    auto fit_fn =
-        [](py::handle ti, py::handle ts, py::handle ps, py::handle brightness, py::handle weight,
-           const std::string& model, const std::string& correlation, const std::string& factor,
-           const std::string& radiometry, const std::string& regime, double wavelength_um,
-           const std::string& residual, const std::string& loss, double loss_scale,
-           std::optional<double> initial_sigma_over_T, std::optional<double> initial_sigma_um,
-           std::optional<double> initial_T_um, py::handle sigma_over_T_bounds,
-           py::handle sigma_bounds_um, py::handle T_bounds_um, int max_iterations,
-           bool scale_covariance, bool compare) -> py::dict {
+        "Returns the dict of `roughscope estimate fit --correlation C --json [--residuals]`: "
+        "status, message, sigma_over_T(_stderr), gain(_stderr), parameters (their number), "
+        "parameter_table (name, value, stderr, lower, upper, at_bound), covariance (natural "
+        "units, None when unavailable), residuals and predicted (residuals=True), sse, aic, aicc, "
+        "n, iterations, report, theta_K_deg, xi_K, rms_slope, roughness_class, g, warnings.";
+    auto fit_fn = [](py::handle ti, py::handle ts, py::handle ps, py::handle brightness,
+                     py::handle weight, const py::dict& options, bool residuals,
+                     bool compare) -> py::object {
         const auto ms = measurements_from(ti, ts, ps, brightness, weight);
-        FitOptions o = fit_options_from(
-            model, compare ? "gaussian" : correlation, factor, radiometry, regime, wavelength_um,
-            residual, loss, loss_scale, initial_sigma_over_T, initial_sigma_um, initial_T_um,
-            sigma_over_T_bounds, sigma_bounds_um, T_bounds_um, max_iterations, scale_covariance);
+        const FitOptions o = serialize::fit_options_from(from_python(options, "fit option"));
         if (!compare) {
             FitResult r;
             {
                 py::gil_scoped_release release;
                 r = fit_roughness(ms, o);
             }
-            return fit_dict(r);
+            return to_python(serialize::fit_estimate_json(o, ms.size(), r, residuals));
         }
         CorrelationComparison c;
         {
             py::gil_scoped_release release;
             c = compare_correlations(ms, o);
         }
-        return py::dict(
-            "gaussian"_a = fit_dict(c.gaussian), "exponential"_a = fit_dict(c.exponential),
-            "preferred"_a = std::string(to_string(c.preferred)), "delta_aic"_a = c.delta_aic);
+        return to_python(serialize::fit_estimate_json(o, ms.size(), c, residuals));
     };
     m.def(
         "fit_roughness",
         [fit_fn](py::handle ti, py::handle ts, py::handle ps, py::handle b, py::handle w,
-                 const std::string& model, const std::string& correlation,
-                 const std::string& factor, const std::string& radiometry,
-                 const std::string& regime, double wavelength_um, const std::string& residual,
-                 const std::string& loss, double loss_scale, std::optional<double> i_s,
-                 std::optional<double> i_sigma, std::optional<double> i_T, py::handle sb,
-                 py::handle sigb, py::handle tb, int max_iterations, bool scale_covariance) {
-            return fit_fn(ti, ts, ps, b, w, model, correlation, factor, radiometry, regime,
-                          wavelength_um, residual, loss, loss_scale, i_s, i_sigma, i_T, sb, sigb,
-                          tb, max_iterations, scale_covariance, false);
+                 py::object model, py::object correlation, py::object factor, py::object radiometry,
+                 py::object regime, py::object wavelength_um, py::object residual, py::object loss,
+                 py::object loss_scale, py::object i_s, py::object i_sigma, py::object i_T,
+                 py::object sb, py::object sigb, py::object tb, py::object max_iterations,
+                 py::object scale_covariance, bool residuals) {
+            const py::dict o(
+                "model"_a = model, "correlation"_a = correlation, "factor"_a = factor,
+                "radiometry"_a = radiometry, "regime"_a = regime, "wavelength_um"_a = wavelength_um,
+                "residual"_a = residual, "loss"_a = loss, "loss_scale"_a = loss_scale,
+                "initial_sigma_over_T"_a = i_s, "initial_sigma_um"_a = i_sigma,
+                "initial_T_um"_a = i_T, "sigma_over_T_bounds"_a = sb, "sigma_bounds_um"_a = sigb,
+                "T_bounds_um"_a = tb, "max_iterations"_a = max_iterations,
+                "scale_covariance"_a = scale_covariance);
+            return fit_fn(ti, ts, ps, b, w, o, residuals, false);
         },
         arg("theta_i_deg"), arg("theta_s_deg"), arg("phi_s_deg"), arg("brightness"),
         arg("weight") = py::none(), arg("model") = "very_rough", arg("correlation") = "gaussian",
@@ -573,25 +481,28 @@ void bind_estimation(py::module_& m) {
         arg("initial_sigma_um") = py::none(), arg("initial_T_um") = py::none(),
         arg("sigma_over_T_bounds") = py::none(), arg("sigma_bounds_um") = py::none(),
         arg("T_bounds_um") = py::none(), arg("max_iterations") = 200,
-        arg("scale_covariance") = true, fit_doc);
+        arg("scale_covariance") = true, arg("residuals") = true, fit_doc);
     m.def(
         "compare_correlations",
         [fit_fn](py::handle ti, py::handle ts, py::handle ps, py::handle b, py::handle w,
-                 const std::string& model, const std::string& factor, const std::string& radiometry,
-                 const std::string& regime, double wavelength_um, const std::string& residual,
-                 const std::string& loss, double loss_scale) {
-            return fit_fn(ti, ts, ps, b, w, model, "gaussian", factor, radiometry, regime,
-                          wavelength_um, residual, loss, loss_scale, std::nullopt, std::nullopt,
-                          std::nullopt, py::none(), py::none(), py::none(), 200, true, true);
+                 py::object model, py::object factor, py::object radiometry, py::object regime,
+                 py::object wavelength_um, py::object residual, py::object loss,
+                 py::object loss_scale, bool residuals) {
+            const py::dict o("model"_a = model, "factor"_a = factor, "radiometry"_a = radiometry,
+                             "regime"_a = regime, "wavelength_um"_a = wavelength_um,
+                             "residual"_a = residual, "loss"_a = loss, "loss_scale"_a = loss_scale);
+            return fit_fn(ti, ts, ps, b, w, o, residuals, true);
         },
         arg("theta_i_deg"), arg("theta_s_deg"), arg("phi_s_deg"), arg("brightness"),
         arg("weight") = py::none(), arg("model") = "very_rough", arg("factor") = "vh",
         arg("radiometry") = "radiance", arg("regime") = "slightly_rough",
         arg("wavelength_um") = 0.555, arg("residual") = "relative", arg("loss") = "none",
-        arg("loss_scale") = 0.05,
-        "Fits both correlation functions (see fit_roughness) and compares them by AIC: returns "
-        "{'gaussian': fit, 'exponential': fit, 'preferred': name, 'delta_aic': AIC(other) - "
-        "AIC(preferred)}.");
+        arg("loss_scale") = 0.05, arg("residuals") = true,
+        "Fits both correlation functions (see fit_roughness) and compares them by AIC. Returns "
+        "the dict of `roughscope estimate fit --correlation both --json`: "
+        "preferred_correlation, delta_aic = AIC(other) - AIC(preferred), the preferred fit's "
+        "sigma_over_T, sigma_over_T_gaussian/_exponential, and each fit under 'gaussian' and "
+        "'exponential'.");
 }
 
 }  // namespace roughscope::python

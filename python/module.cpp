@@ -6,6 +6,9 @@
 //     ├── roughscope.InvalidArgument   (an input out of range, NaN, or inconsistent)
 //     ├── roughscope.NoSolution        (an inversion with no solution for valid inputs)
 //     └── roughscope.DataError         (a malformed or missing file or table)
+#include <cstdint>
+#include <string>
+
 #include <pybind11/pybind11.h>
 
 #include "bindings.hpp"
@@ -13,6 +16,68 @@
 #include "roughscope/version.hpp"
 
 namespace py = pybind11;
+
+namespace roughscope::python {
+
+py::object to_python(const serialize::Json& value) {
+    using Json = serialize::Json;
+    switch (value.type()) {
+        case Json::value_t::null:
+        case Json::value_t::discarded:
+            return py::none();
+        case Json::value_t::boolean:
+            return py::bool_(value.get<bool>());
+        case Json::value_t::number_integer:
+            return py::int_(value.get<std::int64_t>());
+        case Json::value_t::number_unsigned:
+            return py::int_(value.get<std::uint64_t>());
+        case Json::value_t::number_float:
+            return py::float_(value.get<double>());
+        case Json::value_t::string:
+            return py::str(value.get_ref<const std::string&>());
+        case Json::value_t::array: {
+            py::list out;
+            for (const Json& item : value) out.append(to_python(item));
+            return out;
+        }
+        case Json::value_t::object: {
+            py::dict out;
+            for (const auto& [key, item] : value.items()) out[py::str(key)] = to_python(item);
+            return out;
+        }
+        case Json::value_t::binary:
+            break;
+    }
+    throw Error("to_python: unsupported JSON value");
+}
+
+serialize::Json from_python(py::handle value, const std::string& where) {
+    using Json = serialize::Json;
+    if (value.is_none()) return nullptr;
+    if (py::isinstance<py::bool_>(value)) return value.cast<bool>();
+    if (py::isinstance<py::int_>(value)) return value.cast<std::int64_t>();
+    if (py::isinstance<py::float_>(value)) return value.cast<double>();
+    if (py::isinstance<py::str>(value)) return value.cast<std::string>();
+    if (py::isinstance<py::dict>(value)) {
+        Json out = Json::object();
+        for (const auto& [k, v] : value.cast<py::dict>())
+            out[py::str(k).cast<std::string>()] =
+                from_python(v, where + " '" + py::str(k).cast<std::string>() + "'");
+        return out;
+    }
+    if (py::hasattr(value, "tolist") && !py::isinstance<py::str>(value))  // numpy
+        return from_python(value.attr("tolist")(), where);
+    if (py::isinstance<py::sequence>(value)) {
+        Json out = Json::array();
+        for (py::handle item : value.cast<py::sequence>()) out.push_back(from_python(item, where));
+        return out;
+    }
+    throw InvalidArgument(where + " has an unsupported type " +
+                          py::str(py::type::of(value).attr("__name__")).cast<std::string>() +
+                          " (expected None, bool, a number, a string or a sequence)");
+}
+
+}  // namespace roughscope::python
 
 PYBIND11_MODULE(_core, m) {
     m.doc() =

@@ -25,8 +25,6 @@ model), ``rmse``, ``sse_gain`` (after the optimal gain), ``winner``, ``winner_pa
 ``series=True``, ``series`` (per-measurement data and model brightness normalised by their maxima).
 """
 
-import json
-
 import numpy as np
 
 from . import _core
@@ -106,17 +104,13 @@ class CuretData:
         pair=(81, 112), on_sigma_rad and on_albedo (given Oren–Nayar parameters; default for 25,
         34, 41: the paper's Table 3), fits=True, radiometry="radiance", max_overflow=None.
         """
-        if "pair" in options and options["pair"] is not None:
-            options["pair"] = [int(v) for v in options["pair"]]
-        return json.loads(self._db.compare(int(sample), series=series, **options))
+        return self._db.compare(int(sample), series=series, **options)
 
     def compare_all(self, *, fits=True, radiometry="radiance", max_overflow=None, threads=0,
                     series=False):
         """Every sample: list of dicts in file order."""
-        return json.loads(
-            self._db.compare_all(fits=fits, radiometry=radiometry, max_overflow=max_overflow,
-                                 threads=threads, format="json", series=series)
-        )
+        return self._db.compare_all(fits=fits, radiometry=radiometry, max_overflow=max_overflow,
+                                    threads=threads, format="dict", series=series)
 
     def compare_all_text(self, format="markdown", *, fits=True, radiometry="radiance",
                          max_overflow=None, threads=0):
@@ -167,24 +161,19 @@ def compare_table(path=None, *, theta_i_deg=None, phi_i_deg=None, theta_s_deg=No
                   series=True, **options):
     """Compare every model with any BRDF table: a CSV file (path) or arrays (degrees, same frame
     as read_brdf_csv). Options as CuretData.compare. Returns a dict."""
-    if "pair" in options and options["pair"] is not None:
-        options["pair"] = [int(v) for v in options["pair"]]
     if path is not None:
         if value is not None:
             raise _core.InvalidArgument("give either a CSV path or arrays, not both")
-        return json.loads(_core.brdf_compare_csv(str(path), channel=channel, series=series,
-                                                 **options))
+        return _core.brdf_compare_csv(str(path), channel=channel, series=series, **options)
     if value is None:
         raise _core.InvalidArgument("give a CSV path or the arrays theta_i_deg, phi_i_deg, "
                                     "theta_s_deg, phi_s_deg and value")
-    return json.loads(
-        _core.brdf_compare_arrays(
-            np.asarray(theta_i_deg, float), np.asarray(phi_i_deg, float),
-            np.asarray(theta_s_deg, float), np.asarray(phi_s_deg, float),
-            np.asarray(value, float),
-            weight=None if weight is None else np.asarray(weight, float),
-            name=name, series=series, **options,
-        )
+    return _core.brdf_compare_arrays(
+        np.asarray(theta_i_deg, float), np.asarray(phi_i_deg, float),
+        np.asarray(theta_s_deg, float), np.asarray(phi_s_deg, float),
+        np.asarray(value, float),
+        weight=None if weight is None else np.asarray(weight, float),
+        name=name, series=series, **options,
     )
 
 

@@ -3,20 +3,14 @@
 Fig. 10: normalised brightness of each model (solid) and the data (dashed) against the
 measurement index sorted by increasing measured value, one panel per model.
 
-Used by ``roughscope curet --plot FILE.png`` through the command line of this module::
-
-    python -m roughscope.curet_figures fig10   --input comparison.json --out fig10.png
-    python -m roughscope.curet_figures summary --input all.json        --out summary.png
-
-Inputs are the JSON documents of ``roughscope curet --json --series`` (one sample) and
-``roughscope curet --all --json`` (a list). Figures are written atomically (temporary file, then
-rename). matplotlib is imported only here.
+Inputs are the comparison documents of ``roughscope curet --json --series`` (one sample) and
+``roughscope curet --all --json`` (a list), or the dicts of ``roughscope.curet.compare``. The
+command-line entry point (used by ``roughscope curet --plot FILE.png``) is
+``python3 -m roughscope.plot curet --out FILE.png`` (roughscope/plot.py). Figures are written
+atomically (temporary file, then rename). matplotlib is imported only here.
 """
 
-import argparse
-import json
 import os
-import sys
 import tempfile
 
 import numpy as np
@@ -206,29 +200,3 @@ def summary(results, path):
     _save(fig, path)
     plt.close(fig)
     return path
-
-
-def main(argv=None):
-    parser = argparse.ArgumentParser(prog="python -m roughscope.curet_figures",
-                                     description=__doc__.splitlines()[0])
-    parser.add_argument("kind", choices=("fig10", "summary"))
-    parser.add_argument("--input", required=True, help="JSON from roughscope curet --json")
-    parser.add_argument("--out", required=True, help="PNG file to write")
-    args = parser.parse_args(argv)
-    try:
-        with open(args.input, encoding="utf-8") as f:
-            doc = json.load(f)
-        if args.kind == "fig10":
-            if isinstance(doc, list):
-                raise ValueError("fig10 needs one comparison, got a list")
-            fig10(doc, args.out)
-        else:
-            summary(doc if isinstance(doc, list) else [doc], args.out)
-    except Exception as e:  # one line for the CLI to show
-        print(f"{type(e).__name__}: {e}", file=sys.stderr)
-        return 1
-    return 0
-
-
-if __name__ == "__main__":
-    sys.exit(main())

@@ -222,18 +222,4 @@ Comparison compare_curet_sample(const CuretDatabase& db, int sample,
 std::vector<Comparison> compare_curet_all(const CuretDatabase& db,
                                           const ComparisonOptions& options = {}, int threads = 0);
 
-// ---------------------------------------------------------------------------------------------
-// Output (JSON keys in docs/curet.md). Unknown values are null, never NaN.
-
-// One comparison as a JSON object; `series` adds the per-measurement data and model brightness
-// (normalised by their maxima) used by Fig. 10.
-std::string to_json(const Comparison& comparison, bool series = false, int indent = 2);
-// Every comparison as a JSON array.
-std::string to_json(const std::vector<Comparison>& comparisons, bool series = false,
-                    int indent = 2);
-// One row per comparison: estimates, the three error measures per model, winners, exclusions.
-std::string to_csv(const std::vector<Comparison>& comparisons);
-// A Markdown table of the paper's Table 3–4 quantities plus the best fit and the exclusions.
-std::string to_markdown(const std::vector<Comparison>& comparisons);
-
 }  // namespace roughscope

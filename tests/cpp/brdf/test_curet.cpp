@@ -417,34 +417,3 @@ TEST(CuretAll, EverySampleIsProcessedAndSample61ExplainsItsMissingEstimate) {
                   all[k].result(ComparisonModel::VhExponentialFit).errors.gain_sse);
     EXPECT_THROW(compare_curet_all(database(), {}, -1), InvalidArgument);
 }
-
-TEST(CuretAll, OutputsCarryTheDocumentedKeysAndNeverNaN) {
-    REQUIRE_CURET();
-    ComparisonOptions o;
-    o.fits = false;
-    std::vector<Comparison> some = {compare_curet_sample(database(), 25, o),
-                                    compare_curet_sample(database(), 61, o)};
-    const std::string text = to_json(some, true);
-    EXPECT_EQ(text.find("nan"), std::string::npos);
-    EXPECT_EQ(text.find("NaN"), std::string::npos);
-    const nlohmann::json j = nlohmann::json::parse(text);
-    ASSERT_EQ(j.size(), 2u);
-    for (const char* key :
-         {"sample", "E1_over_E2", "sigma_over_T_gaussian", "sigma_over_T_exponential", "sse",
-          "rmse", "sse_gain", "winner", "data_issues", "series"})
-        EXPECT_TRUE(j[0].contains(key)) << key;
-    for (const char* key : {"oren_nayar", "lafortune", "bk_gaussian", "bk_exponential",
-                            "vh_gaussian", "vh_exponential"})
-        EXPECT_TRUE(j[0]["sse"][key].is_number()) << key;
-    EXPECT_EQ(j[0]["sample"], 25);
-    EXPECT_TRUE(j[1]["E1_over_E2"].is_null());
-    EXPECT_TRUE(j[1]["sse"]["vh_gaussian"].is_null());
-    EXPECT_EQ(j[0]["series"]["data"].size(), 205u);
-
-    const std::string csv = to_csv(some);
-    EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 3);
-    EXPECT_NE(csv.find("sse_vh_exponential"), std::string::npos);
-    const std::string md = to_markdown(some);
-    EXPECT_NE(md.find("| 25 | Quarry tile | 1.880180 | 0.3957 | 0.7982 |"), std::string::npos)
-        << md;
-}

@@ -1,0 +1,318 @@
+// Output of the model comparison (serialize/comparison.hpp): JSON, CSV and Markdown.
+#include "roughscope/serialize/comparison.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <optional>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "options.hpp"
+#include "roughscope/core/errors.hpp"
+#include "roughscope/scattering/geometry.hpp"
+#include "roughscope/scattering/validity.hpp"
+
+namespace roughscope::serialize {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+std::string key(ComparisonModel m) { return std::string(to_string(m)); }
+
+std::string fmt(double x, const char* spec = "%.6g") {
+    char buf[64];
+    std::snprintf(buf, sizeof buf, spec, x);
+    return buf;
+}
+
+std::vector<double> normalised(const std::vector<double>& v) {
+    double mx = -kInf;
+    for (double x : v) mx = std::max(mx, x);
+    std::vector<double> out(v.size(), 0.0);
+    if (mx > 0.0)
+        for (std::size_t j = 0; j < v.size(); ++j) out[j] = v[j] / mx;
+    return out;
+}
+
+Json comparison_json(const Comparison& c, bool series) {
+    Json j;
+    j["sample"] = c.sample > 0 ? Json(c.sample) : Json(nullptr);
+    j["name"] = text_or_null(c.name);
+    j["channel"] = text_or_null(c.channel);
+    j["measurements"] = c.total_measurements;
+    j["used"] = c.measurement.size();
+    const TwoPointEstimate& t = c.two_point;
+    j["E1_over_E2"] = number(t.E1_over_E2);
+    j["sigma_over_T_gaussian"] = number(t.sigma_over_T_gaussian);
+    j["sigma_over_T_exponential"] = number(t.sigma_over_T_exponential);
+    Json tp;
+    tp["available"] = t.available;
+    tp["reason"] = text_or_null(t.reason);
+    tp["measurement1"] = t.measurement1;
+    tp["measurement2"] = t.measurement2;
+    tp["theta1_deg"] = t.E1 ? degrees(t.theta1_rad) : Json(nullptr);
+    tp["theta2_deg"] = t.E2 ? degrees(t.theta2_rad) : Json(nullptr);
+    tp["E1"] = number(t.E1);
+    tp["E2"] = number(t.E2);
+    tp["factor"] = "vh";
+    tp["gaussian_reason"] = text_or_null(t.gaussian_reason);
+    tp["exponential_reason"] = text_or_null(t.exponential_reason);
+    if (t.sigma_over_T_gaussian) {
+        tp["theta_K_deg_gaussian"] =
+            number(rad_to_deg(caron_theta_K_rad(*t.sigma_over_T_gaussian)));
+        tp["rms_slope_gaussian"] = number(rms_slope(*t.sigma_over_T_gaussian));
+    }
+    j["two_point"] = tp;
+    Json sse, rmse, gsse;
+    for (const ModelResult& r : c.models) {
+        const std::string k = key(r.model);
+        sse[k] = r.available ? number(r.errors.paper_sse) : Json(nullptr);
+        rmse[k] = r.available ? number(r.errors.rmse) : Json(nullptr);
+        gsse[k] = r.available ? number(r.errors.gain_sse) : Json(nullptr);
+    }
+    j["sse"] = sse;
+    j["rmse"] = rmse;
+    j["sse_gain"] = gsse;
+    j["winner"] = c.winner ? Json(to_string(*c.winner)) : Json(nullptr);
+    j["winner_paper_metric"] =
+        c.winner_paper_metric ? Json(to_string(*c.winner_paper_metric)) : Json(nullptr);
+    Json models;
+    for (const ModelResult& r : c.models) {
+        Json m;
+        m["label"] = std::string(display_name(r.model));
+        m["available"] = r.available;
+        m["reason"] = text_or_null(r.reason);
+        m["method"] = text_or_null(r.method);
+        Json params = Json::object(), errs = Json::object();
+        for (const ModelParameter& p : r.parameters) {
+            params[p.name] = number(p.value);
+            if (p.standard_error) errs[p.name] = number(*p.standard_error);
+        }
+        m["parameters"] = params;
+        m["standard_errors"] = errs;
+        m["fit_status"] = r.fit_status ? Json(to_string(*r.fit_status)) : Json(nullptr);
+        m["fit_message"] = text_or_null(r.fit_message);
+        m["evaluations"] = r.evaluations;
+        m["sse"] = r.available ? number(r.errors.paper_sse) : Json(nullptr);
+        m["rmse"] = r.available ? number(r.errors.rmse) : Json(nullptr);
+        m["sse_gain"] = r.available ? number(r.errors.gain_sse) : Json(nullptr);
+        m["gain"] = r.available ? number(r.errors.gain) : Json(nullptr);
+        models[key(r.model)] = m;
+    }
+    j["models"] = models;
+    Json issues = Json::array();
+    for (const DataIssue& d : c.data_issues) {
+        Json i;
+        i["measurement"] = d.measurement;
+        i["f"] = number(d.value);
+        i["issue"] = d.issue;
+        i["excluded_from"] = d.excluded_from;
+        i["note"] = d.note;
+        issues.push_back(i);
+    }
+    j["data_issues"] = issues;
+    if (series) {
+        Json s;
+        s["measurement"] = c.measurement;
+        std::vector<double> ti, ts, ps;
+        for (const Geometry& g : c.geometry) {
+            ti.push_back(rad_to_deg(g.theta_i_rad));
+            ts.push_back(rad_to_deg(g.theta_s_rad));
+            ps.push_back(rad_to_deg(g.phi_s_rad));
+        }
+        s["theta_i_deg"] = ti;
+        s["theta_s_deg"] = ts;
+        s["phi_s_deg"] = ps;
+        s["data"] = normalised(c.brightness);
+        Json ms, mg;
+        for (const ModelResult& r : c.models) {
+            ms[key(r.model)] = r.available ? Json(normalised(r.prediction)) : Json(nullptr);
+            if (!r.available) {
+                mg[key(r.model)] = nullptr;
+                continue;
+            }
+            std::vector<double> scaled(r.prediction.size());
+            for (std::size_t k = 0; k < scaled.size(); ++k)
+                scaled[k] = r.errors.gain * r.prediction[k];
+            mg[key(r.model)] = scaled;
+        }
+        s["models"] = ms;       // each model / its maximum (the paper's Fig. 10)
+        s["models_gain"] = mg;  // K · model with the optimal gain K (compare with `data`)
+        j["series"] = s;
+    }
+    return j;
+}
+
+std::string csv_number(double v) { return std::isfinite(v) ? fmt(v, "%.10g") : ""; }
+std::string csv_number(const std::optional<double>& v) { return v ? csv_number(*v) : ""; }
+
+std::string csv_text(const std::string& s) {
+    if (s.find_first_of(",\"\n") == std::string::npos) return s;
+    std::string out = "\"";
+    for (char ch : s) {
+        if (ch == '"') out += '"';
+        out += ch;
+    }
+    return out + "\"";
+}
+
+std::string issues_summary(const Comparison& c) {
+    std::string s;
+    for (const DataIssue& d : c.data_issues) {
+        if (!s.empty()) s += "; ";
+        s += std::to_string(d.measurement) + ":" + d.issue;
+        if (!d.excluded_from.empty()) {
+            s += " (excluded from";
+            for (const std::string& e : d.excluded_from) s += " " + e;
+            s += ")";
+        }
+    }
+    return s;
+}
+
+std::string md_escape(std::string s) {
+    std::string out;
+    for (char ch : s) {
+        if (ch == '|')
+            out += "\\|";
+        else if (ch == '\n')
+            out += ' ';
+        else
+            out += ch;
+    }
+    return out;
+}
+
+}  // namespace
+
+ComparisonOptions comparison_options_from(const Json& options) {
+    using namespace detail;
+    check_keys(options, "comparison option",
+               {"theta1_deg", "theta2_deg", "pair", "on_sigma_rad", "on_albedo", "fits",
+                "radiometry", "max_overflow"});
+    ComparisonOptions o;
+    const auto theta1 = get_number(options, "theta1_deg");
+    const auto theta2 = get_number(options, "theta2_deg");
+    if (theta1.has_value() != theta2.has_value())
+        throw InvalidArgument("give both theta1_deg and theta2_deg (degrees) or neither");
+    if (theta1) {
+        o.theta1_rad = deg_to_rad(*theta1);
+        o.theta2_rad = deg_to_rad(*theta2);
+    }
+    if (const auto pair = get_int_pair(options, "pair")) {
+        if (pair->first < 1 || pair->second < 1)
+            throw InvalidArgument("pair = [" + std::to_string(pair->first) + ", " +
+                                  std::to_string(pair->second) +
+                                  "]: expected two measurement numbers >= 1");
+        o.measurement1 = pair->first;
+        o.measurement2 = pair->second;
+    }
+    const auto on_sigma = get_number(options, "on_sigma_rad");
+    const auto on_albedo = get_number(options, "on_albedo");
+    if (on_sigma.has_value() != on_albedo.has_value())
+        throw InvalidArgument("give both on_sigma_rad and on_albedo (Oren-Nayar) or neither");
+    if (on_sigma) {
+        o.oren_nayar = OrenNayarParams{*on_sigma, *on_albedo};
+        o.oren_nayar_source = "given";
+    }
+    if (const auto fits = get_bool(options, "fits")) o.fits = *fits;
+    if (const auto r = get_string(options, "radiometry")) o.radiometry = parse_radiometry(*r);
+    o.max_overflow_fraction = get_number(options, "max_overflow");
+    validate(o);
+    return o;
+}
+
+Json to_json(const Comparison& comparison, bool series) {
+    return comparison_json(comparison, series);
+}
+
+Json to_json(const std::vector<Comparison>& comparisons, bool series) {
+    Json arr = Json::array();
+    for (const Comparison& c : comparisons) arr.push_back(comparison_json(c, series));
+    return arr;
+}
+
+std::string csv_header() {
+    std::ostringstream out;
+    out << "sample,name,channel,used,E1_over_E2,sigma_over_T_gaussian,sigma_over_T_exponential";
+    for (const char* measure : {"sse", "rmse", "sse_gain"})
+        for (ComparisonModel m : kComparisonModels) out << "," << measure << "_" << to_string(m);
+    out << ",lafortune_n,winner,winner_paper_metric,two_point_reason,nonpositive_count,"
+           "data_issues\n";
+    return out.str();
+}
+
+std::string csv_row(const Comparison& c) {
+    std::ostringstream out;
+    out << (c.sample > 0 ? std::to_string(c.sample) : "") << "," << csv_text(c.name) << ","
+        << csv_text(c.channel) << "," << c.measurement.size() << ","
+        << csv_number(c.two_point.E1_over_E2) << ","
+        << csv_number(c.two_point.sigma_over_T_gaussian) << ","
+        << csv_number(c.two_point.sigma_over_T_exponential);
+    for (int measure = 0; measure < 3; ++measure)
+        for (const ModelResult& r : c.models) {
+            out << ",";
+            if (!r.available) continue;
+            out << csv_number(measure == 0   ? r.errors.paper_sse
+                              : measure == 1 ? r.errors.rmse
+                                             : r.errors.gain_sse);
+        }
+    std::size_t nonpositive = 0;
+    for (const DataIssue& d : c.data_issues) nonpositive += d.issue == "non_positive";
+    out << "," << csv_number(c.result(ComparisonModel::Lafortune).parameter("n")) << ","
+        << (c.winner ? std::string(to_string(*c.winner)) : "") << ","
+        << (c.winner_paper_metric ? std::string(to_string(*c.winner_paper_metric)) : "") << ","
+        << csv_text(c.two_point.available ? "" : c.two_point.reason) << "," << nonpositive << ","
+        << csv_text(issues_summary(c)) << "\n";
+    return out.str();
+}
+
+std::string to_csv(const std::vector<Comparison>& comparisons) {
+    std::string out = csv_header();
+    for (const Comparison& c : comparisons) out += csv_row(c);
+    return out;
+}
+
+std::string to_markdown(const std::vector<Comparison>& comparisons) {
+    std::ostringstream out;
+    out << "| sample | name | E1/E2 | σ/T_G | σ/T_E";
+    for (ComparisonModel m : kPaperComparisonModels) out << " | " << display_name(m);
+    out << " | n_d | best fit (gain SSE) | winner, Table-4 metric | notes |\n";
+    out << "|---:|---|---:|---:|---:";
+    for (std::size_t k = 0; k < kPaperComparisonModels.size(); ++k) out << "|---:";
+    out << "|---:|---|---|---|\n";
+    auto cell = [](const std::optional<double>& v, const char* spec) {
+        return v && std::isfinite(*v) ? fmt(*v, spec) : std::string("—");
+    };
+    for (const Comparison& c : comparisons) {
+        out << "| " << (c.sample > 0 ? std::to_string(c.sample) : "") << " | " << md_escape(c.name)
+            << " | " << cell(c.two_point.E1_over_E2, "%.6f") << " | "
+            << cell(c.two_point.sigma_over_T_gaussian, "%.4f") << " | "
+            << cell(c.two_point.sigma_over_T_exponential, "%.4f");
+        for (ComparisonModel m : kPaperComparisonModels) {
+            const ModelResult& r = c.result(m);
+            out << " | " << (r.available ? cell(r.errors.paper_sse, "%.3f") : std::string("—"));
+        }
+        out << " | " << cell(c.result(ComparisonModel::Lafortune).parameter("n"), "%.2f");
+        out << " | "
+            << (c.winner ? std::string(display_name(*c.winner)) + " (" +
+                               fmt(c.result(*c.winner).errors.gain_sse, "%.3f") + ")"
+                         : std::string("—"));
+        out << " | "
+            << (c.winner_paper_metric ? std::string(display_name(*c.winner_paper_metric))
+                                      : std::string("—"));
+        std::string notes;
+        if (!c.two_point.available) notes = "two-point estimate unavailable: " + c.two_point.reason;
+        std::size_t nonpositive = 0;
+        for (const DataIssue& d : c.data_issues) nonpositive += d.issue == "non_positive";
+        if (nonpositive)
+            notes += (notes.empty() ? "" : "; ") + std::to_string(nonpositive) +
+                     " non-positive value(s) kept in the sums";
+        out << " | " << md_escape(notes) << " |\n";
+    }
+    return out.str();
+}
+}  // namespace roughscope::serialize

@@ -1,0 +1,296 @@
+// JSON schemas of the §4 estimates and the fits (serialize/estimation.hpp).
+#include "roughscope/serialize/estimation.hpp"
+
+#include <string>
+#include <vector>
+
+#include "options.hpp"
+#include "roughscope/core/errors.hpp"
+#include "roughscope/scattering/geometry.hpp"
+#include "roughscope/scattering/validity.hpp"
+
+namespace roughscope::serialize {
+namespace {
+
+// An estimate's value and, when asked, its standard error (scaled, e.g. rad → deg).
+void put(Json& out, const std::string& key, const std::optional<Estimate>& e, bool with_stderr,
+         double scale = 1.0) {
+    out[key] = e ? number(e->value * scale) : Json(nullptr);
+    if (with_stderr) out[key + "_stderr"] = e ? number(e->std_error * scale) : Json(nullptr);
+}
+
+// §3.5 derived quantities, the class and g, present in every estimate.
+void put_derived(Json& out, const RoughnessEstimate& e, bool with_stderr) {
+    put(out, "theta_K_deg", e.theta_K_rad, with_stderr, 180.0 / kPi);
+    put(out, "xi_K", e.xi_K, with_stderr);
+    put(out, "rms_slope", e.rms_slope, with_stderr);
+    out["roughness_class"] = std::string(to_string(e.roughness_class));
+    out["roughness_class_assumed"] = e.roughness_class_assumed;
+    out["g"] = e.g.empty() ? Json(nullptr) : numbers(e.g);
+}
+
+Json strings(const std::vector<std::string>& items) {
+    Json out = Json::array();
+    for (const auto& s : items) out.push_back(s);
+    return out;
+}
+
+Json geometry_json(const Geometry& g) {
+    return {{"theta_i_deg", degrees(g.theta_i_rad)},
+            {"theta_s_deg", degrees(g.theta_s_rad)},
+            {"phi_s_deg", degrees(g.phi_s_rad)}};
+}
+
+// The closed forms of §4 need the viewer on the normal (Fig. 5b); estimation.hpp: "normal view
+// (θs = φs = 0) selects the closed form", otherwise the two-geometry solver.
+bool normal_view(const Geometry& g) { return g.theta_s_rad == 0.0; }
+
+Json ratio_range_json(const RatioRange& r) {
+    return Json::array({number(r.lower), number(r.upper)});  // upper = inf → null
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------------
+
+FitOptions fit_options_from(const Json& options) {
+    using namespace detail;
+    check_keys(options, "fit option",
+               {"model", "correlation", "factor", "radiometry", "regime", "wavelength_um",
+                "residual", "loss", "loss_scale", "initial_sigma_over_T", "initial_sigma_um",
+                "initial_T_um", "sigma_over_T_bounds", "sigma_bounds_um", "T_bounds_um",
+                "max_iterations", "scale_covariance"});
+    FitOptions o;
+    if (auto v = get_string(options, "model")) o.model = parse_fit_model(*v);
+    if (auto v = get_string(options, "correlation")) o.correlation = parse_correlation(*v);
+    if (auto v = get_string(options, "factor")) o.factor = parse_geometric_factor(*v);
+    if (auto v = get_string(options, "radiometry")) o.radiometry = parse_radiometry(*v);
+    if (auto v = get_string(options, "regime")) o.regime = parse_regime(*v);
+    if (auto v = get_number(options, "wavelength_um")) o.wavelength_um = *v;
+    if (auto v = get_string(options, "residual")) o.residual = parse_residual_type(*v);
+    if (auto v = get_string(options, "loss")) o.loss = parse_loss_type(*v);
+    if (auto v = get_number(options, "loss_scale")) o.loss_scale = *v;
+    o.initial_sigma_over_T = get_number(options, "initial_sigma_over_T");
+    o.initial_sigma_um = get_number(options, "initial_sigma_um");
+    o.initial_T_um = get_number(options, "initial_T_um");
+    if (auto v = get_number_pair(options, "sigma_over_T_bounds"))
+        std::tie(o.sigma_over_T_min, o.sigma_over_T_max) = *v;
+    if (auto v = get_number_pair(options, "sigma_bounds_um"))
+        std::tie(o.sigma_min_um, o.sigma_max_um) = *v;
+    if (auto v = get_number_pair(options, "T_bounds_um")) std::tie(o.T_min_um, o.T_max_um) = *v;
+    if (auto v = get_int(options, "max_iterations")) o.max_iterations = *v;
+    if (auto v = get_bool(options, "scale_covariance")) o.scale_covariance = *v;
+    return o;
+}
+
+Json to_json(const RoughnessEstimate& e, bool with_stderr) {
+    Json out;
+    put(out, "sigma_um", e.sigma_um, with_stderr);
+    put(out, "T_um", e.T_um, with_stderr);
+    put(out, "sigma_over_T", e.sigma_over_T, with_stderr);
+    put_derived(out, e, with_stderr);
+    out["warnings"] = strings(e.warnings);
+    return out;
+}
+
+Json specular_estimate_json(const SpecularInput& in, const RoughnessEstimate& e, bool with_stderr) {
+    const double R = in.E_tot && in.E_dif
+                         ? specular_reflectance_from_brightness(*in.E_tot, *in.E_dif)
+                         : in.R_spec;
+    Json out;
+    out["estimator"] = "specular (Eq. 12-13)";
+    put(out, "sigma_um", e.sigma_um, with_stderr);
+    out["R_spec"] = number(R);
+    out["R0"] = number(in.R0);
+    out["theta_deg"] = degrees(in.theta_rad);
+    out["wavelength_um"] = number(in.wavelength_um);
+    put_derived(out, e, with_stderr);
+    out["warnings"] = strings(e.warnings);
+    return out;
+}
+
+Json correlation_length_estimate_json(const CorrelationLengthInput& in, const RoughnessEstimate& e,
+                                      bool with_stderr) {
+    // CorrelationLengthInput: Eq. 15 at normal view for Gaussian correlation and Eq. 3.
+    const bool closed = normal_view(in.geom1) && normal_view(in.geom2) &&
+                        in.correlation == Correlation::Gaussian &&
+                        in.options.regime == Regime::SlightlyRough;
+    Json out;
+    out["estimator"] = closed ? "correlation length (Eq. 14-15)"
+                              : "correlation length (two-geometry solver, TOMS 748)";
+    put(out, "sigma_um", e.sigma_um, with_stderr);
+    put(out, "T_um", e.T_um, with_stderr);
+    put(out, "sigma_over_T", e.sigma_over_T, with_stderr);
+    put_derived(out, e, with_stderr);
+    out["E1_over_E2"] = number(in.E1_over_E2);
+    out["geometry1"] = geometry_json(in.geom1);
+    out["geometry2"] = geometry_json(in.geom2);
+    out["correlation"] = std::string(to_string(in.correlation));
+    out["factor"] = std::string(to_string(in.options.factor));
+    out["regime"] = std::string(to_string(in.options.regime));
+    out["wavelength_um"] = number(in.options.wavelength_um);
+    out["warnings"] = strings(e.warnings);
+    return out;
+}
+
+Json slope_estimate_json(const SlopeInput& in, const std::optional<RoughnessEstimate>& eg,
+                         const std::optional<RoughnessEstimate>& ee, bool with_stderr) {
+    if (!eg && !ee)
+        throw InvalidArgument("slope_estimate_json: give the Gaussian or the exponential estimate");
+    // θK, ξK, m as in Table 2: from the Gaussian estimate when there is one.
+    const RoughnessEstimate& primary = eg ? *eg : *ee;
+    const bool closed = normal_view(in.geom1) && normal_view(in.geom2);  // Eq. 17 / 19
+    Json out;
+    out["estimator"] =
+        closed ? "slope ratio (Eq. 16-19)" : "slope ratio (two-geometry solver, TOMS 748)";
+    put(out, "sigma_over_T", primary.sigma_over_T, with_stderr);
+    put(out, "sigma_over_T_gaussian", eg ? eg->sigma_over_T : std::nullopt, with_stderr);
+    put(out, "sigma_over_T_exponential", ee ? ee->sigma_over_T : std::nullopt, with_stderr);
+    put(out, "sigma_um", primary.sigma_um, false);  // given, not estimated
+    put(out, "T_um", primary.T_um, with_stderr);
+    if (eg && ee && in.sigma_um) {
+        put(out, "T_um_gaussian", eg->T_um, with_stderr);
+        put(out, "T_um_exponential", ee->T_um, with_stderr);
+    }
+    put_derived(out, primary, with_stderr);
+    out["E1_over_E2"] = number(in.E1_over_E2);
+    const double t1 = in.geom1.theta_i_rad, t2 = in.geom2.theta_i_rad;
+    if (eg)
+        out["valid_ratio_range_gaussian"] =
+            closed ? ratio_range_json(ratio_range_gaussian(t1, t2, in.options.factor))
+                   : Json(nullptr);
+    if (ee)
+        out["valid_ratio_range_exponential"] =
+            closed ? ratio_range_json(ratio_range_exponential(t1, t2, in.options.factor))
+                   : Json(nullptr);
+    out["geometry1"] = geometry_json(in.geom1);
+    out["geometry2"] = geometry_json(in.geom2);
+    out["factor"] = std::string(to_string(in.options.factor));
+    out["radiometry"] = std::string(to_string(in.options.radiometry));
+    std::vector<std::string> ws;
+    if (eg)
+        for (const auto& w : eg->warnings) ws.push_back((ee ? "gaussian: " : "") + w);
+    if (ee)
+        for (const auto& w : ee->warnings) ws.push_back((eg ? "exponential: " : "") + w);
+    out["warnings"] = strings(ws);
+    return out;
+}
+
+// ---------------------------------------------------------------------------------------------
+
+Json to_json(const FitResult& r, bool with_residuals) {
+    Json out;
+    const RoughnessEstimate& e = r.estimate;
+    const bool err = r.covariance_available;
+    out["correlation"] = std::string(to_string(r.options.correlation));
+    out["status"] = std::string(to_string(r.status));
+    put(out, "sigma_over_T", e.sigma_over_T, true);
+    if (!err) out["sigma_over_T_stderr"] = nullptr;
+    if (r.options.model == FitModel::SlightlyRough) {
+        put(out, "sigma_um", e.sigma_um, true);
+        put(out, "T_um", e.T_um, true);
+        if (!err) out["sigma_um_stderr"] = out["T_um_stderr"] = nullptr;
+    }
+    const FitParameter* gain = nullptr;
+    for (const auto& p : r.parameters)
+        if (p.name == "gain") gain = &p;
+    out["gain"] = gain ? number(gain->value) : Json(nullptr);
+    out["gain_stderr"] = gain && err ? number(gain->std_error) : Json(nullptr);
+    put_derived(out, e, true);
+    if (!err)
+        for (const char* k : {"theta_K_deg_stderr", "xi_K_stderr", "rms_slope_stderr"})
+            out[k] = nullptr;
+    out["sse"] = number(r.sse);
+    out["aic"] = number(r.aic);
+    out["aicc"] = number(r.aicc);  // inf when N <= p + 1 → null
+    out["n"] = r.num_measurements;
+    out["parameters"] = r.num_parameters;
+    out["iterations"] = r.iterations;
+    Json table = Json::array();
+    for (const auto& p : r.parameters)
+        table.push_back({{"name", p.name},
+                         {"value", number(p.value)},
+                         {"stderr", err ? number(p.std_error) : Json(nullptr)},
+                         {"lower", number(p.lower)},
+                         {"upper", number(p.upper)},
+                         {"at_bound", p.at_bound}});
+    out["parameter_table"] = table;
+    if (err) {
+        Json cov = Json::array();
+        for (Eigen::Index a = 0; a < r.covariance.rows(); ++a) {
+            Json row = Json::array();
+            for (Eigen::Index b = 0; b < r.covariance.cols(); ++b)
+                row.push_back(number(r.covariance(a, b)));
+            cov.push_back(row);
+        }
+        out["covariance"] = cov;
+    } else {
+        out["covariance"] = nullptr;
+    }
+    if (with_residuals) {
+        out["residuals"] = numbers(r.residuals);
+        out["predicted"] = numbers(r.predicted);
+    }
+    out["message"] = r.message;
+    out["report"] = r.brief_report();
+    out["warnings"] = strings(e.warnings);
+    return out;
+}
+
+Json to_json(const CorrelationComparison& c, bool with_residuals) {
+    const Json jg = to_json(c.gaussian, with_residuals);
+    const Json je = to_json(c.exponential, with_residuals);
+    const Json& jb = c.preferred == Correlation::Gaussian ? jg : je;
+    Json out;
+    out["preferred_correlation"] = std::string(to_string(c.preferred));
+    out["delta_aic"] = number(c.delta_aic);
+    for (const char* k : {"sigma_over_T", "sigma_over_T_stderr"}) out[k] = jb[k];
+    out["sigma_over_T_gaussian"] = jg["sigma_over_T"];
+    out["sigma_over_T_gaussian_stderr"] = jg["sigma_over_T_stderr"];
+    out["sigma_over_T_exponential"] = je["sigma_over_T"];
+    out["sigma_over_T_exponential_stderr"] = je["sigma_over_T_stderr"];
+    if (c.gaussian.options.model == FitModel::SlightlyRough)
+        for (const char* k : {"sigma_um", "sigma_um_stderr", "T_um", "T_um_stderr"}) out[k] = jb[k];
+    // Caron's θK, ξK, m from the Gaussian fit (they are Gaussian-correlation quantities, §3.5).
+    for (const char* k : {"theta_K_deg", "theta_K_deg_stderr", "xi_K", "xi_K_stderr", "rms_slope",
+                          "rms_slope_stderr", "roughness_class", "roughness_class_assumed", "g"})
+        out[k] = jg[k];
+    out["gaussian"] = jg;
+    out["exponential"] = je;
+    std::vector<std::string> ws;
+    for (const auto& w : c.gaussian.estimate.warnings) ws.push_back("gaussian: " + w);
+    for (const auto& w : c.exponential.estimate.warnings) ws.push_back("exponential: " + w);
+    out["warnings"] = strings(ws);
+    return out;
+}
+
+namespace {
+Json fit_header(const FitOptions& o, std::size_t measurements) {
+    Json out;
+    out["estimator"] = "least squares (Ceres), " + std::string(to_string(o.model));
+    out["measurements"] = measurements;
+    out["factor"] = std::string(to_string(o.factor));
+    out["radiometry"] = std::string(to_string(o.radiometry));
+    out["residual"] = std::string(to_string(o.residual));
+    out["loss"] = std::string(to_string(o.loss));
+    return out;
+}
+}  // namespace
+
+Json fit_estimate_json(const FitOptions& options, std::size_t measurements, const FitResult& fit,
+                       bool with_residuals) {
+    Json out = fit_header(options, measurements);
+    const Json body = to_json(fit, with_residuals);
+    for (const auto& [k, v] : body.items()) out[k] = v;
+    return out;
+}
+
+Json fit_estimate_json(const FitOptions& options, std::size_t measurements,
+                       const CorrelationComparison& comparison, bool with_residuals) {
+    Json out = fit_header(options, measurements);
+    const Json body = to_json(comparison, with_residuals);
+    for (const auto& [k, v] : body.items()) out[k] = v;
+    return out;
+}
+
+}  // namespace roughscope::serialize

@@ -1,0 +1,41 @@
+// JSON building blocks (serialize/json.hpp).
+#include "roughscope/serialize/json.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+
+#include "roughscope/scattering/geometry.hpp"
+
+namespace roughscope::serialize {
+
+Json number(double value) { return std::isfinite(value) ? Json(value) : Json(nullptr); }
+
+Json number(const std::optional<double>& value) { return value ? number(*value) : Json(nullptr); }
+
+Json degrees(double radians) {
+    const double deg = rad_to_deg(radians);
+    if (!std::isfinite(deg)) return nullptr;
+    char buf[40];
+    for (int digits = 1; digits <= 17; ++digits) {
+        std::snprintf(buf, sizeof buf, "%.*g", digits, deg);
+        const double candidate = std::strtod(buf, nullptr);
+        if (deg_to_rad(candidate) == radians) return candidate;
+    }
+    return deg;
+}
+
+Json numbers(const std::vector<double>& values) {
+    Json out = Json::array();
+    for (double v : values) out.push_back(number(v));
+    return out;
+}
+
+Json text_or_null(const std::string& text) { return text.empty() ? Json(nullptr) : Json(text); }
+
+std::string dump(const Json& value, int indent) {
+    // error_handler::replace: invalid UTF-8 in a name read from a file cannot abort the output.
+    return value.dump(indent, ' ', false, Json::error_handler_t::replace) + "\n";
+}
+
+}  // namespace roughscope::serialize

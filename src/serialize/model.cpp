@@ -1,0 +1,20 @@
+// JSON schema of the model outputs (serialize/model.hpp).
+#include "roughscope/serialize/model.hpp"
+
+#include <string>
+
+#include "roughscope/scattering/validity.hpp"
+
+namespace roughscope::serialize {
+
+Json to_json(const ScatteredPower& p) {
+    return {{"brightness", number(p.brightness)},
+            {"coherent", number(p.coherent)},
+            {"diffuse", number(p.diffuse)},
+            {"total", number(p.total)},
+            {"g", number(p.g)},
+            {"regime", std::string(to_string(p.regime))},
+            {"roughness_class", std::string(to_string(p.roughness_class))}};
+}
+
+}  // namespace roughscope::serialize

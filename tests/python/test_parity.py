@@ -1,0 +1,200 @@
+"""Parity of the two front ends: every `roughscope ... --json` subcommand with a matching Python
+function gives the same document for the same inputs, because both print what the library's
+serializer (roughscope/serialize) builds. Same keys (recursively, in any order), numbers equal to
+1e-12 relative, strings and booleans equal, null ↔ None.
+
+CUReT cases need <repo>/../shared/data/curet and skip, saying so, without it. `roughscope model`
+and `roughscope paper tables` have no Python counterpart and are not compared.
+"""
+
+import json
+import math
+import os
+import subprocess
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import roughscope as rs
+from roughscope import curet
+
+REPO = Path(__file__).resolve().parents[2]
+CURET_DIR = REPO.parent / "shared" / "data" / "curet"
+
+
+def _cli():
+    env = os.environ.get("ROUGHSCOPE_CLI")
+    path = Path(env) if env else REPO / "build" / "bin" / "roughscope"
+    if not path.is_file():
+        pytest.fail(f"roughscope CLI not found at {path} (set ROUGHSCOPE_CLI or build build/)")
+    return str(path)
+
+
+def cli_json(*args):
+    proc = subprocess.run([_cli(), *map(str, args), "--json"], capture_output=True, text=True,
+                          timeout=600)
+    assert proc.returncode == 0, f"exit {proc.returncode}: {proc.stderr}"
+    return json.loads(proc.stdout)
+
+
+def assert_same(cli, py, path="$"):
+    """Recursive comparison; the message names the first differing path."""
+    if isinstance(cli, dict):
+        assert isinstance(py, dict), f"{path}: CLI has an object, Python {type(py).__name__}"
+        assert set(cli) == set(py), (f"{path}: keys differ: only CLI {sorted(set(cli) - set(py))}, "
+                                     f"only Python {sorted(set(py) - set(cli))}")
+        for k in cli:
+            assert_same(cli[k], py[k], f"{path}.{k}")
+    elif isinstance(cli, list):
+        assert isinstance(py, list), f"{path}: CLI has a list, Python {type(py).__name__}"
+        assert len(cli) == len(py), f"{path}: lengths {len(cli)} != {len(py)}"
+        for k, (a, b) in enumerate(zip(cli, py)):
+            assert_same(a, b, f"{path}[{k}]")
+    elif isinstance(cli, bool) or cli is None or isinstance(cli, str):
+        assert cli == py and type(cli) is type(py), f"{path}: {cli!r} != {py!r}"
+    else:
+        assert isinstance(py, (int, float)) and not isinstance(py, bool), f"{path}: {py!r}"
+        assert math.isclose(cli, py, rel_tol=1e-12, abs_tol=0.0 if cli else 1e-300), \
+            f"{path}: {cli!r} != {py!r}"
+
+
+def test_assert_same_detects_differences():
+    assert_same({"a": [1.0, None, "x"]}, {"a": [1.0 + 1e-15, None, "x"]})
+    for py in ({"a": [1.0, None, "x"], "b": 1}, {"a": [1.1, None, "x"]},
+               {"a": [1.0, 0.0, "x"]}, {"a": [1.0, None, "y"]}):
+        with pytest.raises(AssertionError):
+            assert_same({"a": [1.0, None, "x"]}, py)
+
+
+# ---- estimate specular ---------------------------------------------------------------------------
+
+@pytest.mark.parametrize("cli_args, kwargs", [
+    (["--r-spec", "0.014", "--theta", "14"], dict(R_spec=0.014, theta_deg=14)),
+    (["--e-tot", "100", "--e-dif", "98.6", "--theta", "14", "--noise", "0.01"],
+     dict(E_tot=100.0, E_dif=98.6, theta_deg=14, noise=0.01)),
+    (["--r-spec", "0.2", "--theta", "30", "--wavelength", "0.6", "--r0", "0.9"],
+     dict(R_spec=0.2, theta_deg=30, wavelength_um=0.6, R0=0.9)),
+])
+def test_estimate_specular(cli_args, kwargs):
+    assert_same(cli_json("estimate", "specular", *cli_args), rs.estimate_sigma_specular(**kwargs))
+
+
+# ---- estimate correlation-length -----------------------------------------------------------------
+
+BASE_T = ["--sigma", "0.094", "--ratio", "1.043", "--theta1", "30", "--theta2", "45"]
+
+
+@pytest.mark.parametrize("cli_args, kwargs", [
+    ([], {}),
+    (["--noise", "0.005", "--sigma-stderr", "0.01"], dict(noise=0.005, sigma_um_stderr=0.01)),
+    (["--sigma-stderr", "0.01"], dict(sigma_um_stderr=0.01)),
+    (["--correlation", "exponential", "--regime", "series"],
+     dict(correlation="exponential", regime="series")),
+    (["--theta-s1", "20", "--phi-s1", "90", "--factor", "beckmann"],
+     dict(theta_s1_deg=20, phi_s1_deg=90, factor="beckmann")),
+])
+def test_estimate_correlation_length(cli_args, kwargs):
+    assert_same(cli_json("estimate", "correlation-length", *BASE_T, *cli_args),
+                rs.estimate_correlation_length(1.043, 0.094, 30, 45, **kwargs))
+
+
+# ---- estimate slope ------------------------------------------------------------------------------
+
+@pytest.mark.parametrize("cli_args, args, kwargs", [
+    (["--ratio", "1.880176", "--theta1", "45", "--theta2", "67.5"], (1.880176, 45, 67.5),
+     dict(correlation="both")),
+    (["--ratio", "1.880176", "--theta1", "45", "--theta2", "67.5", "--correlation", "gaussian",
+      "--noise", "0.01"], (1.880176, 45, 67.5), dict(correlation="gaussian", noise=0.01)),
+    (["--ratio", "1.091", "--theta1", "30", "--theta2", "45", "--sigma", "5"], (1.091, 30, 45),
+     dict(correlation="both", sigma_um=5.0)),
+    (["--ratio", "1.3", "--theta1", "30", "--theta2", "45", "--correlation", "exponential",
+      "--radiometry", "intensity"], (1.3, 30, 45),
+     dict(correlation="exponential", radiometry="intensity")),
+    (["--e1", "130", "--e2", "110", "--theta1", "30", "--theta2", "45", "--theta-s1", "20",
+      "--phi-s1", "90", "--correlation", "gaussian"], (130.0 / 110.0, 30, 45),
+     dict(correlation="gaussian", theta_s1_deg=20, phi_s1_deg=90)),
+])
+def test_estimate_slope(cli_args, args, kwargs):
+    assert_same(cli_json("estimate", "slope", *cli_args), rs.estimate_slope(*args, **kwargs))
+
+
+# ---- estimate fit --------------------------------------------------------------------------------
+
+def _measurements(tmp_path, correlation, n=20, seed=7, noise=0.01):
+    """A CSV in the paper's frame (phi_i = 180, so the CSV's phi_s is the paper's φs) and the same
+    measurements as arrays. Integer angles keep both front ends on the same doubles."""
+    rng = np.random.default_rng(seed)
+    ti = rng.integers(0, 70, n).astype(float)
+    ts = rng.integers(0, 70, n).astype(float)
+    ps = rng.integers(90, 271, n).astype(float)  # φv − 180° + 180° is exact in radians here
+    b = 3.0 * rs.very_rough_brightness(ti, ts, ps, 0.5, correlation=correlation)
+    b = b * (1 + noise * rng.standard_normal(n))
+    path = tmp_path / f"m_{correlation}_{seed}.csv"
+    rows = ["theta_i,phi_i,theta_s,phi_s,brightness"]
+    rows += [f"{a!r},180,{c!r},{d!r},{e!r}" for a, c, d, e in zip(ti, ts, ps, b)]
+    path.write_text("\n".join(rows) + "\n")
+    return path, (ti, ts, ps, np.array([float(repr(x)) for x in b]))
+
+
+@pytest.mark.parametrize("correlation", ["gaussian", "exponential"])
+def test_fit_one_correlation(tmp_path, correlation):
+    path, arrays = _measurements(tmp_path, correlation)
+    assert_same(cli_json("estimate", "fit", "--measurements", path, "--correlation", correlation,
+                         "--residuals"),
+                rs.fit_roughness(*arrays, correlation=correlation, residuals=True))
+    assert_same(cli_json("estimate", "fit", "--measurements", path, "--correlation", correlation,
+                         "--loss", "huber", "--residual", "log"),
+                rs.fit_roughness(*arrays, correlation=correlation, loss="huber", residual="log",
+                                 residuals=False))
+
+
+def test_fit_both_correlations(tmp_path):
+    path, arrays = _measurements(tmp_path, "exponential", n=30, seed=3)
+    assert_same(cli_json("estimate", "fit", "--measurements", path),
+                rs.compare_correlations(*arrays, residuals=False))
+
+
+# ---- curet ---------------------------------------------------------------------------------------
+
+def _table(tmp_path):
+    rng = np.random.default_rng(11)
+    n = 40
+    ti = rng.integers(0, 70, n).astype(float)
+    ts = rng.integers(0, 70, n).astype(float)
+    ps = rng.integers(0, 360, n).astype(float)
+    f = rs.very_rough_brightness(ti, ts, ps, 0.7, correlation="exponential") / np.cos(
+        np.radians(ti))
+    path = tmp_path / "brdf.csv"
+    rows = ["theta_i,phi_i,theta_s,phi_s,value"]
+    rows += [f"{a!r},180,{c!r},{d!r},{e!r}" for a, c, d, e in zip(ti, ts, ps, f)]
+    path.write_text("\n".join(rows) + "\n")
+    return path
+
+
+def test_curet_table(tmp_path):
+    path = _table(tmp_path)
+    assert_same(cli_json("curet", "--table", path, "--pair", "1,2", "--no-fits"),
+                curet.compare_table(path, pair=(1, 2), fits=False, series=False))
+    assert_same(cli_json("curet", "--table", path, "--pair", "1,2", "--series"),
+                curet.compare_table(path, pair=[1, 2], series=True))
+
+
+needs_curet = pytest.mark.skipif(
+    not (CURET_DIR / "abrdf.dat").is_file(),
+    reason=f"CUReT data not found at {CURET_DIR} (abrdf.dat, table.txt); not part of the repo",
+)
+
+
+@needs_curet
+@pytest.mark.parametrize("sample, cli_args, kwargs", [
+    (25, ["--no-fits"], dict(fits=False, series=False)),
+    (41, ["--no-fits", "--series", "--radiometry", "intensity"],
+     dict(fits=False, series=True, radiometry="intensity")),
+    (61, ["--on-sigma", "0.3", "--on-albedo", "0.8", "--no-fits"],
+     dict(fits=False, series=False, on_sigma_rad=0.3, on_albedo=0.8)),
+    (34, [], dict(series=False)),
+])
+def test_curet_sample(sample, cli_args, kwargs):
+    assert_same(cli_json("curet", "--sample", sample, "--data", CURET_DIR, *cli_args),
+                curet.compare(sample, data_dir=CURET_DIR, **kwargs))
