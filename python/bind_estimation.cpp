@@ -28,6 +28,7 @@
 #include "roughscope/scattering/geometry.hpp"
 #include "roughscope/scattering/validity.hpp"
 #include "roughscope/serialize/estimation.hpp"
+#include "roughscope/serialize/paper_tables.hpp"
 
 namespace py = pybind11;
 using namespace py::literals;
@@ -170,6 +171,17 @@ std::vector<Measurement> measurements_from(py::handle theta_i_deg, py::handle th
 }  // namespace
 
 void bind_estimation(py::module_& m) {
+    m.def(
+        "recompute_paper_tables",
+        [](py::handle reference, const std::string& where) {
+            return to_python(
+                serialize::recompute_paper_tables(from_python(reference, where), where));
+        },
+        py::arg("reference"), py::arg("where") = "paper tables",
+        "The paper's Tables 1-3 recomputed from their printed inputs (a dict with the layout of "
+        "paper-tables.json) with the section-4 estimators: for each quantity {printed, "
+        "recomputed, rounding_interval, agreement} with agreement 'exact', 'within_rounding' or "
+        "'differs'. The document of `roughscope paper tables --json` (without 'reference').");
     using py::arg;
 
     // ---- §4.2 closed forms (vectorised) -----------------------------------------------------

@@ -10,9 +10,7 @@ and Eq. 19 and the Table 2 surfaces.
 """
 
 import html
-import itertools
 import json
-import math
 import os
 from pathlib import Path
 
@@ -42,79 +40,24 @@ def find_paper_tables():
     return None
 
 
-def _check(printed, decimals, inputs, input_decimals, f):
-    """(recomputed, mark, lo, hi): f at the printed inputs and over their rounding box."""
-    value = f(*inputs)
-    lo = hi = value
-    for signs in itertools.product((-1.0, 1.0), repeat=len(inputs)):
-        x = [v + s * 0.5 * 10.0 ** -d for v, s, d in zip(inputs, signs, input_decimals)]
-        try:
-            y = f(*x)
-        except ValueError:
-            continue
-        lo, hi = min(lo, y), max(hi, y)
-    h = 0.5 * 10.0 ** -decimals
-    if round(value * 10**decimals) == round(printed * 10**decimals):
-        mark = "="
-    elif lo - h <= printed <= hi + h:
-        mark = "≈"
-    else:
-        mark = "≠"
-    return value, mark, lo, hi
+_MARKS = {"exact": "=", "within_rounding": "≈", "differs": "≠"}
+
+
+def _entry(check):
+    """(printed, recomputed, mark, lo, hi) of one checked quantity of the library's document."""
+    lo, hi = check["rounding_interval"]
+    return (check["printed"], check["recomputed"], _MARKS[check["agreement"]], lo, hi)
 
 
 def recompute_tables(tables):
-    """The three tables recomputed: dict of lists of row dicts (used by the report and tests)."""
-    out = {"table1": [], "table2": [], "table3": []}
-    t = tables["table1_slightly_rough"]
-    c = t["conditions"]
-    th, t1, t2, lam = c["specular_theta_deg"], c["theta1_deg"], c["theta2_deg"], c["lambda_um"]
-
-    def T_of(s, r):
-        return _core.correlation_length_from_ratio(r, s, t1, t2, lam)
-
-    for row in t["rows"]:
-        s, r = row["sigma_um"], row["E1_over_E2"]
-        out["table1"].append({
-            "surface": row["surface"], "R_spec": row["R_spec"], "E1_over_E2": r,
-            "sigma_um": (row["sigma_um"], *_check(row["sigma_um"], 3, [row["R_spec"]], [3],
-                                                  lambda R: _core.sigma_from_specular(R, th, lam))),
-            "T_um": (row["T_um"], *_check(row["T_um"], 3, [s, r], [3, 3], T_of)),
-            "sigma_over_T": (row["sigma_over_T"],
-                             *_check(row["sigma_over_T"], 3, [s, r], [3, 3],
-                                     lambda a, b: a / T_of(a, b))),
-        })
-    t = tables["table2_very_rough"]
-    t1, t2 = t["conditions"]["theta1_deg"], t["conditions"]["theta2_deg"]
-    for row in t["rows"]:
-        r, sG = row["E1_over_E2"], row["sigma_over_T_G"]
-        out["table2"].append({
-            "surface": row["surface"], "E1_over_E2": r,
-            "sigma_over_T_G": (sG, *_check(sG, 4, [r], [3],
-                                           lambda x: _core.sigma_over_T_gaussian(x, t1, t2))),
-            "sigma_over_T_E": (row["sigma_over_T_E"],
-                               *_check(row["sigma_over_T_E"], 4, [r], [3],
-                                       lambda x: _core.sigma_over_T_exponential(x, t1, t2))),
-            "theta_K_deg": (row["theta_K_deg"],
-                            *_check(row["theta_K_deg"], 0, [sG], [4],
-                                    lambda s: 90 - math.degrees(math.atan(math.sqrt(2) * s)))),
-            "xi_K_percent": (row["xi_K_percent"],
-                             *_check(row["xi_K_percent"], 1, [sG], [4],
-                                     lambda s: 100 * (1 - math.exp(-1 / (4 * s * s))))),
-        })
-    t = tables["table3_curet_parameters"]
-    t1, t2 = t["conditions"]["theta1_deg"], t["conditions"]["theta2_deg"]
-    for row in t["rows"]:
-        r = row["E1_over_E2"]
-        out["table3"].append({
-            "sample": f'{row["name"]} ({row["sample"]})', "E1_over_E2": r,
-            "sigma_over_T_G": (row["sigma_over_T_G"],
-                               *_check(row["sigma_over_T_G"], 4, [r], [6],
-                                       lambda x: _core.sigma_over_T_gaussian(x, t1, t2))),
-            "sigma_over_T_E": (row["sigma_over_T_E"],
-                               *_check(row["sigma_over_T_E"], 4, [r], [6],
-                                       lambda x: _core.sigma_over_T_exponential(x, t1, t2))),
-        })
+    """The three tables recomputed by the library (``_core.recompute_paper_tables``, the same
+    document as ``roughscope paper tables --json``): dict of lists of row dicts whose checked
+    quantities are (printed, recomputed, mark, lo, hi) tuples (used by the report and tests)."""
+    doc = _core.recompute_paper_tables(tables)
+    out = {}
+    for key in ("table1", "table2", "table3"):
+        out[key] = [{k: (_entry(v) if isinstance(v, dict) else v) for k, v in row.items()}
+                    for row in doc[key]["rows"]]
     return out
 
 

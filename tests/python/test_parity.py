@@ -3,8 +3,9 @@ function gives the same document for the same inputs, because both print what th
 serializer (roughscope/serialize) builds. Same keys (recursively, in any order), numbers equal to
 1e-12 relative, strings and booleans equal, null ↔ None.
 
-CUReT cases need <repo>/../shared/data/curet and skip, saying so, without it. `roughscope model`
-and `roughscope paper tables` have no Python counterpart and are not compared.
+CUReT cases need <repo>/../shared/data/curet and skip, saying so, without it (the paper tables
+likewise need ../shared/reference/paper-tables.json, through the `paper_tables` fixture).
+`roughscope model` has no Python counterpart and is not compared.
 """
 
 import json
@@ -198,3 +199,24 @@ needs_curet = pytest.mark.skipif(
 def test_curet_sample(sample, cli_args, kwargs):
     assert_same(cli_json("curet", "--sample", sample, "--data", CURET_DIR, *cli_args),
                 curet.compare(sample, data_dir=CURET_DIR, **kwargs))
+
+
+# ---- paper tables --------------------------------------------------------------------------------
+
+def test_paper_tables(paper_tables, tmp_path):
+    ref = tmp_path / "paper-tables.json"
+    ref.write_text(json.dumps(paper_tables), encoding="utf-8")
+    cli = cli_json("paper", "tables", "--reference", ref)
+    assert cli.pop("reference") == str(ref)
+    assert_same(cli, rs.recompute_paper_tables(paper_tables))
+
+
+def test_paper_tables_bad_reference_fails_in_both(paper_tables, tmp_path):
+    broken = {k: v for k, v in paper_tables.items() if k != "table2_very_rough"}
+    ref = tmp_path / "broken.json"
+    ref.write_text(json.dumps(broken), encoding="utf-8")
+    proc = subprocess.run([_cli(), "paper", "tables", "--reference", str(ref)],
+                          capture_output=True, text=True, timeout=60)
+    assert proc.returncode == 4 and "missing key 'table2_very_rough'" in proc.stderr
+    with pytest.raises(rs.DataError, match="missing key 'table2_very_rough'"):
+        rs.recompute_paper_tables(broken)
