@@ -229,7 +229,7 @@ TEST(Comparison, FitsRecoverKnownParametersAndGain) {
         ASSERT_TRUE(r.available);
         EXPECT_NEAR(*r.parameter("sigma_over_T"), 0.45, 1e-6);
         EXPECT_LT(r.errors.gain_sse, 1e-12);
-        EXPECT_EQ(*r.fit_status, FitStatus::Converged);
+        EXPECT_EQ(*r.fit_status, SolverStatus::Converged);
     }
     {
         const BrdfTable t = synthetic_table(
