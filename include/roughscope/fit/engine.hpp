@@ -115,10 +115,12 @@ struct LeastSquaresOptions {
     int grid_points = 25;          // default points per parameter of the grid start
     int num_starts = 1;            // solver runs from the best grid points
     // Identifiability: the Jacobian of the free parameters (columns scaled to unit norm) is
-    // rank deficient when its smallest singular value is below rank_tolerance × the largest, or
-    // a column norm is below rank_tolerance × the largest column norm (a parameter with no
-    // effect).
-    double rank_tolerance = 1e-8;
+    // rank deficient when its smallest singular value is below rank_tolerance × the largest (two
+    // parameters whose effects are parallel to within ~1e-6 rad), or a column norm is below
+    // rank_tolerance × the largest column norm (a parameter with no effect: an e-fold change of a
+    // Log parameter, a unit change of a Linear one, moves the predictions by less than 1e-6 of
+    // what the strongest parameter does — e.g. a lobe width run off to where the lobe is flat).
+    double rank_tolerance = 1e-6;
 };
 
 // One fitted parameter (the model's, then "gain").
