@@ -9,6 +9,7 @@
 #include <exception>
 #include <functional>
 #include <limits>
+#include <memory>
 #include <mutex>
 #include <numeric>
 #include <sstream>
@@ -252,12 +253,35 @@ void fit_lafortune(const Prepared& p, ModelResult& r, double lower, double upper
 // is Lambert's, ρ_ON · (first term), so ρ_ON and the gain trade off exactly: NotIdentifiable.
 void fit_oren_nayar(const Prepared& p, ModelResult& r, double sigma_max) {
     constexpr double kRhoMin = 1e-3;
+    // L = ρ A(σ) + ρ² B(σ) (L1 ∝ ρ, L2 ∝ ρ², models.hpp): A and B from two calls of the core model
+    // at ρ = 1 and ρ = 1/2, cached for the last σ, so that a change of ρ alone (the grid's inner
+    // axis, the ρ column of the Jacobian) costs no model call.
+    struct Components {
+        double sigma = -1.0;
+        std::vector<double> A, B, L1, Lh;
+    };
+    auto cache = std::make_shared<Components>();
     run_fit(p, r,
             fit_problem(p,
                         {fit_parameter("sigma_rad", 0.0, sigma_max, Transform::Linear, 16),
                          fit_parameter("albedo", kRhoMin, 1.0, Transform::Linear, 21)},
-                        [&p](std::span<const double> theta, std::vector<double>& out) {
-                            oren_nayar_prediction(p, {theta[0], theta[1]}, out);
+                        [&p, cache](std::span<const double> theta, std::vector<double>& out) {
+                            Components& c = *cache;
+                            if (theta[0] != c.sigma) {
+                                oren_nayar_prediction(p, {theta[0], 1.0}, c.L1);
+                                oren_nayar_prediction(p, {theta[0], 0.5}, c.Lh);
+                                c.A.resize(p.size());
+                                c.B.resize(p.size());
+                                for (std::size_t j = 0; j < p.size(); ++j) {
+                                    c.B[j] = 2.0 * (c.L1[j] - 2.0 * c.Lh[j]);
+                                    c.A[j] = c.L1[j] - c.B[j];
+                                }
+                                c.sigma = theta[0];
+                            }
+                            const double rho = theta[1];
+                            out.resize(p.size());
+                            for (std::size_t j = 0; j < p.size(); ++j)
+                                out[j] = rho * c.A[j] + rho * rho * c.B[j];
                         }));
 }
 
