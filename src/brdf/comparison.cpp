@@ -3,6 +3,7 @@
 #include "roughscope/brdf/comparison.hpp"
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <cmath>
 #include <cstdio>
@@ -254,30 +255,40 @@ void fit_lafortune(const Prepared& p, ModelResult& r, double lower, double upper
 void fit_oren_nayar(const Prepared& p, ModelResult& r, double sigma_max) {
     constexpr double kRhoMin = 1e-3;
     // L = ρ A(σ) + ρ² B(σ) (L1 ∝ ρ, L2 ∝ ρ², models.hpp): A and B from two calls of the core model
-    // at ρ = 1 and ρ = 1/2, cached for the last σ, so that a change of ρ alone (the grid's inner
-    // axis, the ρ column of the Jacobian) costs no model call.
+    // at ρ = 1 and ρ = 1/2, cached for the last few σ (the Jacobian perturbs σ and ρ in turn), so
+    // that a change of ρ alone (the grid's inner axis, the ρ column) costs no model call.
     struct Components {
         double sigma = -1.0;
-        std::vector<double> A, B, L1, Lh;
+        std::vector<double> A, B;
     };
-    auto cache = std::make_shared<Components>();
+    struct Cache {
+        std::array<Components, 4> entries;
+        std::size_t next = 0;
+        std::vector<double> L1, Lh;
+    };
+    auto cache = std::make_shared<Cache>();
+    auto components = [&p, cache](double sigma) -> const Components& {
+        for (const Components& c : cache->entries)
+            if (c.sigma == sigma) return c;
+        Components& c = cache->entries[cache->next];
+        cache->next = (cache->next + 1) % cache->entries.size();
+        oren_nayar_prediction(p, {sigma, 1.0}, cache->L1);
+        oren_nayar_prediction(p, {sigma, 0.5}, cache->Lh);
+        c.A.resize(p.size());
+        c.B.resize(p.size());
+        for (std::size_t j = 0; j < p.size(); ++j) {
+            c.B[j] = 2.0 * (cache->L1[j] - 2.0 * cache->Lh[j]);
+            c.A[j] = cache->L1[j] - c.B[j];
+        }
+        c.sigma = sigma;
+        return c;
+    };
     run_fit(p, r,
             fit_problem(p,
                         {fit_parameter("sigma_rad", 0.0, sigma_max, Transform::Linear, 16),
                          fit_parameter("albedo", kRhoMin, 1.0, Transform::Linear, 21)},
-                        [&p, cache](std::span<const double> theta, std::vector<double>& out) {
-                            Components& c = *cache;
-                            if (theta[0] != c.sigma) {
-                                oren_nayar_prediction(p, {theta[0], 1.0}, c.L1);
-                                oren_nayar_prediction(p, {theta[0], 0.5}, c.Lh);
-                                c.A.resize(p.size());
-                                c.B.resize(p.size());
-                                for (std::size_t j = 0; j < p.size(); ++j) {
-                                    c.B[j] = 2.0 * (c.L1[j] - 2.0 * c.Lh[j]);
-                                    c.A[j] = c.L1[j] - c.B[j];
-                                }
-                                c.sigma = theta[0];
-                            }
+                        [&p, components](std::span<const double> theta, std::vector<double>& out) {
+                            const Components& c = components(theta[0]);
                             const double rho = theta[1];
                             out.resize(p.size());
                             for (std::size_t j = 0; j < p.size(); ++j)
