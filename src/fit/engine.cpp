@@ -350,7 +350,16 @@ class EngineCost final : public ceres::CostFunction {
     bool Evaluate(double const* const* x, double* r, double** J) const override {
         const int size = parameter_block_sizes()[0];
         const std::size_t N = e_.size();
-        if (!e_.residuals(x[0], e_.gain(), true, r)) return false;
+        // Ceres evaluates a candidate point without, then (once accepted) with the Jacobian: the
+        // residuals of the last point are reused.
+        if (last_x_.size() == static_cast<std::size_t>(size) &&
+            std::equal(last_x_.begin(), last_x_.end(), x[0])) {
+            std::copy(last_r_.begin(), last_r_.end(), r);
+        } else {
+            if (!e_.residuals(x[0], e_.gain(), true, r)) return false;
+            last_x_.assign(x[0], x[0] + size);
+            last_r_.assign(r, r + N);
+        }
         if (J == nullptr || J[0] == nullptr) return true;
         std::vector<double> xv(x[0], x[0] + size), r0(r, r + N), d;
         auto f = [this, N](const double* xx, std::vector<double>& out) {
@@ -369,6 +378,7 @@ class EngineCost final : public ceres::CostFunction {
 
   private:
     const Evaluator& e_;
+    mutable std::vector<double> last_x_, last_r_;
 };
 
 // Ceres solve from start x (size n, or n + 1 with a free gain).
