@@ -424,17 +424,15 @@ Run solve_from(const Evaluator& e, const LeastSquaresOptions& O, std::vector<dou
     auto count = [&](const ceres::Solver::Summary& sm) {
         iterations += std::max(0, static_cast<int>(sm.iterations.size()) - 1);
     };
-    std::vector<int> held_before;
-    for (int pass = 0; pass < 4; ++pass) {
-        const bool usable = run.summary.termination_type == ceres::CONVERGENCE ||
-                            run.summary.termination_type == ceres::NO_CONVERGENCE;
-        // Held: on a bound with the gradient of the cost pointing out of the box.
+    // Held: on a bound with the gradient of the cost pointing out of the box (a KKT multiplier
+    // of the right sign). False when the cost cannot be evaluated.
+    auto held_set = [&](std::vector<int>& held) {
         double cost = 0.0;
         std::vector<double> gradient;
         if (!problem.Evaluate(ceres::Problem::EvaluateOptions(), &cost, nullptr, &gradient,
                               nullptr))
-            break;
-        std::vector<int> held;
+            return false;
+        held.clear();
         for (int j = 0; j < e.n(); ++j) {
             const double u = run.x[static_cast<std::size_t>(j)];
             const double g = gradient[static_cast<std::size_t>(j)];
@@ -442,7 +440,14 @@ Run solve_from(const Evaluator& e, const LeastSquaresOptions& O, std::vector<dou
             const bool at_lower = std::abs(u - e.lower(j)) <= 1e-9 * std::max(1.0, std::abs(u));
             if (at_lower ? g > 0.0 : g < 0.0) held.push_back(j);
         }
-        if (!usable || held.empty() || static_cast<int>(held.size()) == size || held == held_before)
+        return true;
+    };
+    std::vector<int> held, held_before;
+    for (int pass = 0; pass < 4; ++pass) {
+        const bool usable = run.summary.termination_type == ceres::CONVERGENCE ||
+                            run.summary.termination_type == ceres::NO_CONVERGENCE;
+        if (!usable || !held_set(held) || held.empty() || static_cast<int>(held.size()) == size ||
+            held == held_before)
             break;
         held_before = held;
         ceres::Solver::Summary polished;
@@ -450,6 +455,13 @@ Run solve_from(const Evaluator& e, const LeastSquaresOptions& O, std::vector<dou
         ceres::Solve(so, &problem, &polished);
         count(polished);
         problem.SetManifold(run.x.data(), nullptr);
+        // The same parameters still held (KKT holds at the polished point): done, without a
+        // free solve that would only crawl against the bounds again.
+        std::vector<int> held_after;
+        if (held_set(held_after) && held_after == held) {
+            run.summary = polished;
+            break;
+        }
         ceres::Solve(so, &problem, &run.summary);
         count(run.summary);
     }
