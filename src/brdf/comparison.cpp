@@ -3,21 +3,24 @@
 #include "roughscope/brdf/comparison.hpp"
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <cmath>
 #include <cstdio>
 #include <exception>
+#include <functional>
 #include <limits>
+#include <memory>
 #include <mutex>
 #include <numeric>
 #include <sstream>
 #include <thread>
 
 #include <Eigen/Dense>
-#include <boost/math/tools/minima.hpp>
 
 #include "roughscope/core/errors.hpp"
 #include "roughscope/estimation/estimation.hpp"
+#include "roughscope/fit/engine.hpp"
 #include "roughscope/scattering/beckmann.hpp"
 
 namespace roughscope {
@@ -67,9 +70,8 @@ struct Prepared {
     std::vector<double> w;
     double sum_w = 0.0;
     double sum_wdd = 0.0;
-    std::vector<ScatteringDirection> q;  // very-rough shapes (beckmann.hpp)
-    std::vector<double> F2_beck, F2_vh, radiometric;
-    std::vector<double> cos_i, log_cos_i_cos_s;  // Lafortune diffuse lobe
+    Radiometry radiometry = Radiometry::Radiance;  // §3.3 interpretation of the B–K models
+    std::vector<double> cos_i, log_cos_i_cos_s;    // Lafortune diffuse lobe
 
     std::size_t size() const { return geom.size(); }
 };
@@ -81,18 +83,11 @@ Prepared prepare(const std::vector<Geometry>& geom, const std::vector<double>& d
     p.d = d_normalised;
     p.w = w;
     const std::size_t n = geom.size();
-    p.q.resize(n);
-    p.F2_beck.resize(n);
-    p.F2_vh.resize(n);
-    p.radiometric.resize(n);
+    p.radiometry = radiometry;
     p.cos_i.resize(n);
     p.log_cos_i_cos_s.resize(n);
     for (std::size_t j = 0; j < n; ++j) {
         const Geometry& g = geom[j];
-        p.q[j] = scattering_direction(g);
-        p.F2_beck[j] = geometric_factor_squared(GeometricFactor::Beckmann, g);
-        p.F2_vh[j] = geometric_factor_squared(GeometricFactor::VernoldHarvey, g);
-        p.radiometric[j] = radiometric_factor(radiometry, g);
         p.cos_i[j] = std::cos(g.theta_i_rad);
         p.log_cos_i_cos_s[j] = std::log(p.cos_i[j] * std::cos(g.theta_s_rad));
         p.sum_w += w[j];
@@ -101,18 +96,13 @@ Prepared prepare(const std::vector<Geometry>& geom, const std::vector<double>& d
     return p;
 }
 
-// Eq. 4 (Gaussian) / Eq. 5 (exponential) very-rough brightness shapes with F_Beck or F_VH, times
-// the radiometric factor of §3.3: the same as very_rough_brightness, without per-call checks.
-void very_rough_prediction(const Prepared& p, GeometricFactor factor, Correlation c, double m,
-                           std::vector<double>& out) {
+// Very-rough brightness, Eq. 4 (Gaussian) / Eq. 5 (exponential) as published with F_Beck or F_VH,
+// times the radiometric factor of §3.3: the library's very_rough_brightness at each geometry.
+void very_rough_prediction(const Prepared& p, GeometricFactor factor, Correlation c,
+                           double sigma_over_T, std::vector<double>& out) {
     out.resize(p.size());
-    const std::vector<double>& F2 = factor == GeometricFactor::Beckmann ? p.F2_beck : p.F2_vh;
-    for (std::size_t j = 0; j < p.size(); ++j) {
-        const double shape = c == Correlation::Gaussian
-                                 ? very_rough_shape_gaussian(F2[j], p.q[j], m)
-                                 : very_rough_shape_exponential(F2[j], p.q[j], m);
-        out[j] = shape * p.radiometric[j];
-    }
+    for (std::size_t j = 0; j < p.size(); ++j)
+        out[j] = very_rough_brightness(p.geom[j], sigma_over_T, c, factor, p.radiometry);
 }
 
 // Lafortune diffuse lobe E = (cos θi cos θs)^n cos θi (models.hpp), via precomputed logarithms.
@@ -172,196 +162,137 @@ ErrorMeasures measures(const Prepared& p, const std::vector<double>& M) {
 }
 
 // ---------------------------------------------------------------------------------------------
-// Fits by variable projection: the gain K is eliminated in closed form, the remaining one or two
-// shape parameters are found by a grid (global) then Brent's method (local), so no start value
-// is needed and the bounds are honoured exactly.
+// Fits (the "+ fit" columns): min over (θ, gain) of Σ w (gain · M(θ) − d)² with d = data/max data,
+// on the library's least-squares engine (fit/engine.hpp): absolute residuals, the gain profiled out
+// by variable projection, a grid start over the bounds (no start value needed), Levenberg–Marquardt
+// with the bounds honoured, covariance of (θ, gain) from the Jacobian, identifiability checked.
 
-constexpr int kBrentBits = std::numeric_limits<double>::digits / 2;
-constexpr std::uintmax_t kBrentMaxIter = 200;
+using Prediction = std::function<void(std::span<const double> theta, std::vector<double>& out)>;
 
-struct Minimum1D {
-    double x = 0.0;
-    double f = kInf;
-    int evaluations = 0;
-    bool at_bound = false;
-};
-
-// Minimises f on [lo, hi] (in whatever variable the caller chose) with `grid` points then Brent.
-template <class F>
-Minimum1D minimise_1d(F&& f, double lo, double hi, int grid) {
-    Minimum1D best;
-    std::vector<double> xs(static_cast<std::size_t>(grid)), fs(xs.size());
-    std::size_t kbest = 0;
-    for (std::size_t k = 0; k < xs.size(); ++k) {
-        xs[k] = lo + (hi - lo) * static_cast<double>(k) / static_cast<double>(grid - 1);
-        fs[k] = f(xs[k]);
-        ++best.evaluations;
-        if (fs[k] < fs[kbest]) kbest = k;
-    }
-    const double a = xs[kbest == 0 ? 0 : kbest - 1];
-    const double b = xs[std::min(kbest + 1, xs.size() - 1)];
-    std::uintmax_t iter = kBrentMaxIter;
-    const auto [x, fx] = boost::math::tools::brent_find_minima(f, a, b, kBrentBits, iter);
-    best.evaluations += static_cast<int>(iter);
-    if (fx <= fs[kbest]) {
-        best.x = x;
-        best.f = fx;
-    } else {
-        best.x = xs[kbest];
-        best.f = fs[kbest];
-    }
-    const double tol = 1e-6 * (hi - lo);
-    best.at_bound = best.x - lo <= tol || hi - best.x <= tol;
-    return best;
-}
-
-// Covariance of (params…, K) from the Jacobian of r_j = √w_j (K M_j(θ) − d_j) at the optimum:
-// s² (JᵀJ)⁻¹ with s² = SSE/(N − k). Central differences (one-sided at a bound). Returns false
-// when N ≤ k or JᵀJ is singular.
-template <class Eval>
-bool covariance(const Prepared& p, Eval&& eval, const std::vector<double>& theta,
-                const std::vector<double>& lo, const std::vector<double>& hi, double K, double sse,
-                std::vector<double>& cov) {
-    const std::size_t np = theta.size(), k = np + 1;
-    std::size_t n_used = 0;
-    for (double w : p.w) n_used += w > 0.0 ? 1 : 0;
-    if (n_used <= k) return false;
-    Eigen::MatrixXd J(static_cast<Eigen::Index>(p.size()), static_cast<Eigen::Index>(k));
-    std::vector<double> M, Mp, Mm;
-    eval(theta, M);
-    for (std::size_t i = 0; i < np; ++i) {
-        const double h = 1e-6 * std::max(1.0, std::abs(theta[i]));
-        std::vector<double> tp = theta, tm = theta;
-        tp[i] = std::min(hi[i], theta[i] + h);
-        tm[i] = std::max(lo[i], theta[i] - h);
-        const double step = tp[i] - tm[i];
-        if (!(step > 0.0)) return false;
-        eval(tp, Mp);
-        eval(tm, Mm);
-        for (std::size_t j = 0; j < p.size(); ++j)
-            J(static_cast<Eigen::Index>(j), static_cast<Eigen::Index>(i)) =
-                std::sqrt(p.w[j]) * K * (Mp[j] - Mm[j]) / step;
-    }
-    for (std::size_t j = 0; j < p.size(); ++j)
-        J(static_cast<Eigen::Index>(j), static_cast<Eigen::Index>(np)) = std::sqrt(p.w[j]) * M[j];
-    const Eigen::MatrixXd JtJ = J.transpose() * J;
-    Eigen::FullPivLU<Eigen::MatrixXd> lu(JtJ);
-    if (!lu.isInvertible()) return false;
-    const double s2 = sse / static_cast<double>(n_used - k);
-    const Eigen::MatrixXd C = lu.inverse() * s2;
-    cov.assign(k * k, 0.0);
-    for (std::size_t a = 0; a < k; ++a)
-        for (std::size_t b = 0; b < k; ++b)
-            cov[a * k + b] = C(static_cast<Eigen::Index>(a), static_cast<Eigen::Index>(b));
-    for (std::size_t a = 0; a < k; ++a)
-        if (!(cov[a * k + a] >= 0.0) || !std::isfinite(cov[a * k + a])) return false;
-    return true;
-}
-
-void set_standard_errors(ModelResult& r) {
-    const std::size_t k = r.parameters.size();
-    if (r.covariance.size() != k * k) return;
-    for (std::size_t a = 0; a < k; ++a)
-        r.parameters[a].standard_error = std::sqrt(r.covariance[a * k + a]);
-}
-
-// The end of every fit at its minimum θ (gain K, SSE `sse`, prediction M): covariance and
-// standard errors when available, the prediction and its error measures.
-template <class Eval>
-void finish_fit(const Prepared& p, ModelResult& r, Eval&& eval, const std::vector<double>& theta,
-                const std::vector<double>& lo, const std::vector<double>& hi, double K, double sse,
-                const std::vector<double>& M) {
-    std::vector<double> cov;
-    if (covariance(p, eval, theta, lo, hi, K, sse, cov)) {
-        r.covariance = cov;
-        set_standard_errors(r);
-    } else {
-        r.fit_message += "; covariance unavailable (singular Jacobian or too few measurements)";
-    }
-    r.prediction = M;
-    r.errors = measures(p, M);
-}
-
-// One-parameter family (σ/T or n) with a positive parameter, searched in log space.
-template <class Eval>
-void fit_positive_parameter(const Prepared& p, ModelResult& r, const char* name, double lo,
-                            double hi, Eval&& eval_param) {
-    std::vector<double> M;
-    auto objective = [&](double u) {
-        eval_param(std::exp(u), M);
-        return gain_sse(p, M);
+// The engine's problem for one model family over the used measurements.
+LeastSquaresProblem fit_problem(const Prepared& p, std::vector<ParameterSpec> parameters,
+                                Prediction predict) {
+    LeastSquaresProblem P;
+    P.parameters = std::move(parameters);
+    P.data = p.d;
+    P.weights = p.w;
+    P.residual = ResidualType::Absolute;
+    P.gain = GainMode::Profiled;
+    P.model = [predict = std::move(predict), M = std::vector<double>()](
+                  std::span<const double> theta, std::span<double> out) mutable {
+        predict(theta, M);
+        std::copy(M.begin(), M.end(), out.begin());
+        return true;
     };
-    const Minimum1D m = minimise_1d(objective, std::log(lo), std::log(hi), 41);
-    const double value = std::exp(m.x);
-    eval_param(value, M);
-    double K = 0.0;
-    const double sse = gain_sse(p, M, &K);
+    return P;
+}
+
+ParameterSpec fit_parameter(const char* name, double lower, double upper, Transform transform,
+                            int grid_points) {
+    ParameterSpec s;
+    s.name = name;
+    s.lower = lower;
+    s.upper = upper;
+    s.transform = transform;
+    s.grid_points = grid_points;
+    return s;
+}
+
+// Solves and fills the model's result: parameters (gain last) with standard errors (none for a
+// parameter on a bound), status, covariance, prediction M(θ) at the solution and its errors.
+void run_fit(const Prepared& p, ModelResult& r, const LeastSquaresProblem& problem) {
+    LeastSquaresOptions options;
+    options.function_tolerance = 1e-15;  // flat minima: converge the parameters, not only the SSE
+    const LeastSquaresResult lsq = solve_least_squares(problem, options);
+    r.evaluations = lsq.evaluations;
+    r.fit_status = lsq.status;
+    r.fit_message = lsq.message;
+    if (lsq.model.empty()) {
+        r.reason = "the fit failed: " + lsq.message;
+        return;
+    }
     r.available = true;
-    r.evaluations = m.evaluations + 1;
-    r.fit_status = m.at_bound ? FitStatus::AtBound : FitStatus::Converged;
-    r.fit_message = m.at_bound ? std::string(name) + " = " + fmt(value) +
-                                     " lies on a bound of the search interval [" + fmt(lo) + ", " +
-                                     fmt(hi) + "]"
-                               : "minimum of the gain-optimal SSE found (grid of 41 + Brent)";
-    r.parameters = {{name, value, std::nullopt}, {"gain", K, std::nullopt}};
-    auto eval_vec = [&](const std::vector<double>& t, std::vector<double>& out) {
-        eval_param(t[0], out);
-    };
-    finish_fit(p, r, eval_vec, {value}, {lo}, {hi}, K, sse, M);
+    r.parameters.clear();
+    for (const FitParameter& fp : lsq.parameters)
+        r.parameters.push_back({fp.name, fp.value,
+                                lsq.covariance_available && !fp.at_bound
+                                    ? std::optional<double>(fp.std_error)
+                                    : std::nullopt});
+    if (lsq.covariance_available) {
+        const auto k = lsq.covariance.rows();
+        r.covariance.assign(static_cast<std::size_t>(k * k), 0.0);
+        for (Eigen::Index a = 0; a < k; ++a)
+            for (Eigen::Index b = 0; b < k; ++b)
+                r.covariance[static_cast<std::size_t>(a * k + b)] = lsq.covariance(a, b);
+    }
+    r.prediction = lsq.model;
+    r.errors = measures(p, r.prediction);
 }
 
-// Oren–Nayar (σ, ρ) with gain. L = ρ A(σ) + ρ² B(σ) (L1 ∝ ρ, L2 ∝ ρ², models.hpp); A and B
-// come from two calls of the core model, so the inner search over ρ costs no model calls.
+// σ/T (B–K or V–H, Gaussian or exponential): 41 log-spaced starts over the bounds.
+void fit_very_rough(const Prepared& p, ModelResult& r, GeometricFactor factor, Correlation c,
+                    double lower, double upper) {
+    run_fit(p, r,
+            fit_problem(p, {fit_parameter("sigma_over_T", lower, upper, Transform::Log, 41)},
+                        [&p, factor, c](std::span<const double> theta, std::vector<double>& out) {
+                            very_rough_prediction(p, factor, c, theta[0], out);
+                        }));
+}
+
+// Lafortune exponent n: 41 log-spaced starts over the bounds.
+void fit_lafortune(const Prepared& p, ModelResult& r, double lower, double upper) {
+    run_fit(p, r,
+            fit_problem(p, {fit_parameter("n", lower, upper, Transform::Log, 41)},
+                        [&p](std::span<const double> theta, std::vector<double>& out) {
+                            lafortune_prediction(p, theta[0], out);
+                        }));
+}
+
+// Oren–Nayar (σ_ON, ρ_ON): a 16 × 21 grid over σ_ON ∈ [0, sigma_max] rad, ρ_ON ∈ [0.001, 1]
+// (ρ → 0 leaves the shape of the first term alone with an infinite gain). At σ_ON = 0 the model
+// is Lambert's, ρ_ON · (first term), so ρ_ON and the gain trade off exactly: NotIdentifiable.
 void fit_oren_nayar(const Prepared& p, ModelResult& r, double sigma_max) {
-    constexpr double kRhoMin = 1e-3;  // ρ → 0 leaves the shape A alone with an infinite gain
-    std::vector<double> A(p.size()), B(p.size()), L1, Lh, S(p.size());
-    int evaluations = 0;
-    auto components = [&](double sigma) {
-        oren_nayar_prediction(p, {sigma, 1.0}, L1);
-        oren_nayar_prediction(p, {sigma, 0.5}, Lh);
-        evaluations += 2;
+    constexpr double kRhoMin = 1e-3;
+    // L = ρ A(σ) + ρ² B(σ) (L1 ∝ ρ, L2 ∝ ρ², models.hpp): A and B from two calls of the core model
+    // at ρ = 1 and ρ = 1/2, cached for the last few σ (the Jacobian perturbs σ and ρ in turn), so
+    // that a change of ρ alone (the grid's inner axis, the ρ column) costs no model call.
+    struct Components {
+        double sigma = -1.0;
+        std::vector<double> A, B;
+    };
+    struct Cache {
+        std::array<Components, 4> entries;
+        std::size_t next = 0;
+        std::vector<double> L1, Lh;
+    };
+    auto cache = std::make_shared<Cache>();
+    auto components = [&p, cache](double sigma) -> const Components& {
+        for (const Components& c : cache->entries)
+            if (c.sigma == sigma) return c;
+        Components& c = cache->entries[cache->next];
+        cache->next = (cache->next + 1) % cache->entries.size();
+        oren_nayar_prediction(p, {sigma, 1.0}, cache->L1);
+        oren_nayar_prediction(p, {sigma, 0.5}, cache->Lh);
+        c.A.resize(p.size());
+        c.B.resize(p.size());
         for (std::size_t j = 0; j < p.size(); ++j) {
-            B[j] = 2.0 * (L1[j] - 2.0 * Lh[j]);
-            A[j] = L1[j] - B[j];
+            c.B[j] = 2.0 * (cache->L1[j] - 2.0 * cache->Lh[j]);
+            c.A[j] = cache->L1[j] - c.B[j];
         }
+        c.sigma = sigma;
+        return c;
     };
-    auto inner = [&](double rho) {
-        for (std::size_t j = 0; j < p.size(); ++j) S[j] = rho * A[j] + rho * rho * B[j];
-        return gain_sse(p, S);
-    };
-    double best_rho = 1.0;
-    auto outer = [&](double sigma) {
-        components(sigma);
-        const Minimum1D m = minimise_1d(inner, kRhoMin, 1.0, 21);
-        best_rho = m.x;
-        return m.f;
-    };
-    const Minimum1D ms = minimise_1d(outer, 0.0, sigma_max, 16);
-    const double sigma = ms.x;
-    outer(sigma);
-    const double rho = best_rho;
-    std::vector<double> M;
-    oren_nayar_prediction(p, {sigma, rho}, M);
-    ++evaluations;
-    double K = 0.0;
-    const double sse = gain_sse(p, M, &K);
-    const bool rho_at_bound = rho - kRhoMin <= 1e-6 || 1.0 - rho <= 1e-6;
-    r.available = true;
-    r.evaluations = evaluations;
-    r.fit_status = (ms.at_bound || rho_at_bound) ? FitStatus::AtBound : FitStatus::Converged;
-    r.fit_message = (ms.at_bound || rho_at_bound)
-                        ? "sigma_rad = " + fmt(sigma) + ", albedo = " + fmt(rho) +
-                              ": on a bound of sigma_rad in [0, " + fmt(sigma_max) +
-                              "], albedo in [0.001, 1]"
-                        : "minimum of the gain-optimal SSE found (nested grid + Brent over "
-                          "sigma_rad and albedo)";
-    r.parameters = {{"sigma_rad", sigma, std::nullopt},
-                    {"albedo", rho, std::nullopt},
-                    {"gain", K, std::nullopt}};
-    auto eval_vec = [&](const std::vector<double>& t, std::vector<double>& out) {
-        oren_nayar_prediction(p, {t[0], t[1]}, out);
-    };
-    finish_fit(p, r, eval_vec, {sigma, rho}, {0.0, kRhoMin}, {sigma_max, 1.0}, K, sse, M);
+    run_fit(p, r,
+            fit_problem(p,
+                        {fit_parameter("sigma_rad", 0.0, sigma_max, Transform::Linear, 16),
+                         fit_parameter("albedo", kRhoMin, 1.0, Transform::Linear, 21)},
+                        [&p, components](std::span<const double> theta, std::vector<double>& out) {
+                            const Components& c = components(theta[0]);
+                            const double rho = theta[1];
+                            out.resize(p.size());
+                            for (std::size_t j = 0; j < p.size(); ++j)
+                                out[j] = rho * c.A[j] + rho * rho * c.B[j];
+                        }));
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -469,18 +400,6 @@ bool is_fit(ComparisonModel model) {
         default:
             return false;
     }
-}
-
-std::string_view to_string(FitStatus status) {
-    switch (status) {
-        case FitStatus::Converged:
-            return "converged";
-        case FitStatus::AtBound:
-            return "at_bound";
-        case FitStatus::Failed:
-            return "failed";
-    }
-    return "failed";
 }
 
 std::optional<double> ModelResult::parameter(std::string_view name) const {
@@ -707,7 +626,7 @@ Comparison compare_brdf(const BrdfTable& table, const ComparisonOptions& o) {
                    " for the lowest Table-4 error (" + std::to_string(steps + 1) + " values)";
         r.evaluations = static_cast<int>(steps + 1);
         const bool at_bound = best_k == 0 || best_k == steps;
-        r.fit_status = at_bound ? FitStatus::AtBound : FitStatus::Converged;
+        r.fit_status = at_bound ? SolverStatus::AtBound : SolverStatus::Converged;
         r.fit_message = at_bound ? "n_d = " + fmt(best_n) + " is an end of the search interval"
                                  : "interior minimum of the search";
         r.parameters = {{"n", best_n, std::nullopt}};
@@ -733,9 +652,9 @@ Comparison compare_brdf(const BrdfTable& table, const ComparisonOptions& o) {
     for (const VeryRoughVariant& v : variants) {
         ModelResult& r = result(v.model);
         const bool gaussian = v.correlation == Correlation::Gaussian;
-        const std::optional<double> m =
+        const std::optional<double> sigma_over_T =
             gaussian ? c.two_point.sigma_over_T_gaussian : c.two_point.sigma_over_T_exponential;
-        if (!m) {
+        if (!sigma_over_T) {
             r.reason = "two-point estimate unavailable: " +
                        (!c.two_point.available ? c.two_point.reason
                                                : (gaussian ? c.two_point.gaussian_reason
@@ -749,9 +668,9 @@ Comparison compare_brdf(const BrdfTable& table, const ComparisonOptions& o) {
                    "); " + (gaussian ? "Eq. 4" : "Eq. 5") + " with " +
                    (v.factor == GeometricFactor::Beckmann ? "F_Beck" : "F_VH") + ", " +
                    std::string(to_string(o.radiometry));
-        r.parameters = {{"sigma_over_T", *m, std::nullopt}};
+        r.parameters = {{"sigma_over_T", *sigma_over_T, std::nullopt}};
         r.evaluations = 1;
-        very_rough_prediction(p, v.factor, v.correlation, *m, r.prediction);
+        very_rough_prediction(p, v.factor, v.correlation, *sigma_over_T, r.prediction);
         r.errors = measures(p, r.prediction);
     }
 
@@ -764,9 +683,7 @@ Comparison compare_brdf(const BrdfTable& table, const ComparisonOptions& o) {
         {
             ModelResult& r = result(ComparisonModel::LafortuneFit);
             r.method = "least squares over n and the gain";
-            fit_positive_parameter(
-                p, r, "n", o.fit_lafortune_n_min, o.fit_lafortune_n_max,
-                [&](double n, std::vector<double>& out) { lafortune_prediction(p, n, out); });
+            fit_lafortune(p, r, o.fit_lafortune_n_min, o.fit_lafortune_n_max);
         }
         for (const VeryRoughVariant& v : variants) {
             ModelResult& r = result(v.fit);
@@ -774,10 +691,8 @@ Comparison compare_brdf(const BrdfTable& table, const ComparisonOptions& o) {
                        (v.correlation == Correlation::Gaussian ? "Eq. 4" : "Eq. 5") + " with " +
                        (v.factor == GeometricFactor::Beckmann ? "F_Beck" : "F_VH") + ", " +
                        std::string(to_string(o.radiometry));
-            fit_positive_parameter(p, r, "sigma_over_T", o.fit_sigma_over_T_min,
-                                   o.fit_sigma_over_T_max, [&](double m, std::vector<double>& out) {
-                                       very_rough_prediction(p, v.factor, v.correlation, m, out);
-                                   });
+            fit_very_rough(p, r, v.factor, v.correlation, o.fit_sigma_over_T_min,
+                           o.fit_sigma_over_T_max);
         }
     } else {
         for (ModelResult& r : c.models)

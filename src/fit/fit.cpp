@@ -1,4 +1,5 @@
-// Least-squares roughness fits with Ceres (paper §4, "least-square fitting techniques").
+// Least-squares roughness fits (paper §4, "least-square fitting techniques") on the engine
+// (engine.hpp).
 #include "roughscope/fit/fit.hpp"
 
 #include <algorithm>
@@ -7,10 +8,10 @@
 #include <cstdio>
 #include <limits>
 #include <memory>
+#include <span>
 #include <string>
 
 #include <Eigen/Dense>
-#include <ceres/ceres.h>
 
 #include "roughscope/core/errors.hpp"
 #include "roughscope/scattering/validity.hpp"
@@ -23,42 +24,6 @@ namespace roughscope {
 std::string_view to_string(FitModel m) {
     return m == FitModel::VeryRough ? "very_rough" : "slightly_rough";
 }
-std::string_view to_string(ResidualType r) {
-    switch (r) {
-        case ResidualType::Relative:
-            return "relative";
-        case ResidualType::Absolute:
-            return "absolute";
-        case ResidualType::Log:
-            return "log";
-    }
-    return "relative";
-}
-std::string_view to_string(LossType l) {
-    switch (l) {
-        case LossType::None:
-            return "none";
-        case LossType::Huber:
-            return "huber";
-        case LossType::Cauchy:
-            return "cauchy";
-        case LossType::SoftLOne:
-            return "soft_l_one";
-    }
-    return "none";
-}
-std::string_view to_string(SolverStatus s) {
-    switch (s) {
-        case SolverStatus::Converged:
-            return "converged";
-        case SolverStatus::NoConvergence:
-            return "no_convergence";
-        case SolverStatus::Failed:
-            return "failed";
-    }
-    return "failed";
-}
-
 namespace {
 template <class Enum, std::size_t N>
 Enum parse_enum(std::string_view what, std::string_view name, const std::array<Enum, N>& values) {
@@ -76,17 +41,6 @@ Enum parse_enum(std::string_view what, std::string_view name, const std::array<E
 FitModel parse_fit_model(std::string_view name) {
     return parse_enum("fit model", name, std::array{FitModel::VeryRough, FitModel::SlightlyRough});
 }
-ResidualType parse_residual_type(std::string_view name) {
-    return parse_enum(
-        "residual type", name,
-        std::array{ResidualType::Relative, ResidualType::Absolute, ResidualType::Log});
-}
-LossType parse_loss_type(std::string_view name) {
-    return parse_enum(
-        "loss", name,
-        std::array{LossType::None, LossType::Huber, LossType::Cauchy, LossType::SoftLOne});
-}
-
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
@@ -150,257 +104,129 @@ void check_measurements(const std::vector<Measurement>& ms, int p) {
     }
 }
 
-// Model brightness B and d ln B / d ln p_j at one geometry, from the log-parameters.
-class Model {
-  public:
-    explicit Model(const FitOptions& o) : o_(o) {
-        mo_.factor = o.factor;
-        mo_.radiometry = o.radiometry;
-        mo_.regime = o.regime;
-        mo_.wavelength_um = o.wavelength_um;
-    }
-    int size() const { return model_parameter_count(o_); }
-
-    // Returns false when B is not a positive finite number (underflow far outside the lobe).
-    bool eval(const Geometry& g, const double* log_p, double& B, double* dlnB) const {
-        if (o_.model == FitModel::VeryRough) {
-            const double s = std::exp(log_p[0]);
-            B = very_rough(g, s);
-            if (dlnB) {
-                // Eq. 4: d ln B/d ln(σ/T) = b/(2 s²); Eq. 5: 3 (b/s²)/(1 + b/s²), b = q_xy²/q_z².
-                const ScatteringDirection q = scattering_direction(g);
-                const double x = q.qxy2() / (q.qz2() * s * s);
-                dlnB[0] = o_.correlation == Correlation::Gaussian ? 0.5 * x : 3.0 * x / (1.0 + x);
-            }
-        } else {
-            B = slightly_rough(g, std::exp(log_p[0]), std::exp(log_p[1]));
-            if (dlnB) {
-                const double h = 1e-6;
-                for (int j = 0; j < 2; ++j) {
-                    double lp[2] = {log_p[0], log_p[1]};
-                    lp[j] += h;
-                    const double up = slightly_rough(g, std::exp(lp[0]), std::exp(lp[1]));
-                    lp[j] -= 2.0 * h;
-                    const double dn = slightly_rough(g, std::exp(lp[0]), std::exp(lp[1]));
-                    dlnB[j] = (std::log(up) - std::log(dn)) / (2.0 * h);
-                    if (!std::isfinite(dlnB[j])) return false;
-                }
-            }
-        }
-        return std::isfinite(B) && B > 0.0;
-    }
-
-    double very_rough(const Geometry& g, double s) const {
-        const double F2 = geometric_factor_squared(o_.factor, g);
-        const ScatteringDirection q = scattering_direction(g);
-        const double shape = o_.correlation == Correlation::Gaussian
-                                 ? very_rough_shape_gaussian(F2, q, s)
-                                 : very_rough_shape_exponential(F2, q, s);
-        return shape * radiometric_factor(o_.radiometry, g);
-    }
-    double slightly_rough(const Geometry& g, double sigma_um, double T_um) const {
-        const ScatteredPower p =
-            mean_scattered_power(g, Surface{sigma_um, T_um, o_.correlation}, mo_);
-        return p.diffuse * radiometric_factor(o_.radiometry, g);
-    }
-
-  private:
-    const FitOptions& o_;
-    ModelOptions mo_;
-};
-
-double residual_of(ResidualType rt, double sw, double KB, double E) {
-    switch (rt) {
-        case ResidualType::Relative:
-            return sw * (KB - E) / E;
-        case ResidualType::Absolute:
-            return sw * (KB - E);
-        case ResidualType::Log:
-            return sw * (std::log(KB) - std::log(E));
-    }
-    return 0.0;
+// The model brightness B(geom; θ) of the fit (gain 1), θ in natural units: the library's scalar
+// forms, never a copy of them.
+double model_brightness(const Geometry& g, const double* theta, const FitOptions& o) {
+    if (o.model == FitModel::VeryRough)
+        // Eq. 4 (Gaussian) / Eq. 5 (exponential) × radiometric factor (§3.3).
+        return very_rough_brightness(g, theta[0], o.correlation, o.factor, o.radiometry);
+    // Diffuse term of Eq. 1 in the chosen regime (Eq. 3 by default) × radiometric factor.
+    ModelOptions mo;
+    mo.factor = o.factor;
+    mo.radiometry = o.radiometry;
+    mo.regime = o.regime;
+    mo.wavelength_um = o.wavelength_um;
+    const ScatteredPower p =
+        mean_scattered_power(g, Surface{theta[0], theta[1], o.correlation}, mo);
+    return p.diffuse * radiometric_factor(o.radiometry, g);
 }
 
-// One residual per measurement; one parameter block [ln p..., ln K].
-class MeasurementCost final : public ceres::CostFunction {
-  public:
-    MeasurementCost(const Measurement& m, const Model& model, ResidualType rt)
-        : m_(m), model_(model), rt_(rt) {
-        set_num_residuals(1);
-        mutable_parameter_block_sizes()->push_back(model.size() + 1);
+// A positive parameter, log-transformed, with bounds [lower, upper].
+ParameterSpec bounded(const char* name, double lower, double upper) {
+    ParameterSpec s;
+    s.name = name;
+    s.lower = lower;
+    s.upper = upper;
+    return s;
+}
+
+// The engine's problem for the measurements: parameters with bounds and starts
+// (docs/estimation.md), the model over every measurement, the gain profiled out.
+LeastSquaresProblem make_problem(const std::vector<Measurement>& ms, const FitOptions& o) {
+    LeastSquaresProblem P;
+    P.residual = o.residual;
+    P.gain = GainMode::Profiled;
+    for (const auto& m : ms) {
+        P.data.push_back(m.brightness);
+        P.weights.push_back(m.weight);
     }
-    bool Evaluate(double const* const* parameters, double* residuals,
-                  double** jacobians) const override {
-        const double* p = parameters[0];
-        const int n = model_.size();
-        double B = 0.0, dlnB[2] = {0.0, 0.0};
-        if (!model_.eval(m_.geometry, p, B, jacobians && jacobians[0] ? dlnB : nullptr))
+    std::vector<Geometry> geoms;
+    for (const auto& m : ms) geoms.push_back(m.geometry);
+    P.model = [geoms, o](std::span<const double> theta, std::span<double> out) {
+        try {
+            for (std::size_t i = 0; i < geoms.size(); ++i) {
+                out[i] = model_brightness(geoms[i], theta.data(), o);
+                // B must be positive: it underflows to 0 far outside the lobe.
+                if (!(std::isfinite(out[i]) && out[i] > 0.0)) return false;
+            }
+        } catch (const Error&) {
             return false;
-        const double KB = std::exp(p[n]) * B;
-        if (!(std::isfinite(KB) && KB > 0.0)) return false;
-        const double sw = std::sqrt(m_.weight), E = m_.brightness;
-        residuals[0] = residual_of(rt_, sw, KB, E);
-        if (jacobians && jacobians[0]) {
-            // d(K B)/d ln p_j = K B d ln B/d ln p_j, d(K B)/d ln K = K B.
-            double scale = 0.0;
-            switch (rt_) {
-                case ResidualType::Relative:
-                    scale = sw * KB / E;
-                    break;
-                case ResidualType::Absolute:
-                    scale = sw * KB;
-                    break;
-                case ResidualType::Log:
-                    scale = sw;
-                    break;
-            }
-            for (int j = 0; j < n; ++j) jacobians[0][j] = scale * dlnB[j];
-            jacobians[0][n] = scale;
         }
-        return std::isfinite(residuals[0]);
-    }
-
-  private:
-    const Measurement& m_;
-    const Model& model_;
-    ResidualType rt_;
-};
-
-// The gain minimising the (unrobustified) sum of squares for fixed model brightness B_i.
-double optimal_log_gain(const std::vector<Measurement>& ms, const std::vector<double>& B,
-                        ResidualType rt) {
-    double num = 0.0, den = 0.0;
-    for (std::size_t i = 0; i < ms.size(); ++i) {
-        const double w = ms[i].weight, E = ms[i].brightness;
-        switch (rt) {
-            case ResidualType::Relative:
-                num += w * B[i] / E;
-                den += w * B[i] * B[i] / (E * E);
-                break;
-            case ResidualType::Absolute:
-                num += w * B[i] * E;
-                den += w * B[i] * B[i];
-                break;
-            case ResidualType::Log:
-                num += w * (std::log(E) - std::log(B[i]));
-                den += w;
-                break;
-        }
-    }
-    return rt == ResidualType::Log ? num / den : std::log(num / den);
-}
-
-// Sum of squares with the gain profiled out; inf when the model underflows somewhere.
-double profile_sse(const std::vector<Measurement>& ms, const Model& model, const double* log_p,
-                   double* log_K_out = nullptr, ResidualType rt = ResidualType::Relative) {
-    std::vector<double> B(ms.size());
-    for (std::size_t i = 0; i < ms.size(); ++i)
-        if (!model.eval(ms[i].geometry, log_p, B[i], nullptr)) return kInf;
-    const double lK = optimal_log_gain(ms, B, rt);
-    if (!std::isfinite(lK)) return kInf;
-    double sse = 0.0;
-    for (std::size_t i = 0; i < ms.size(); ++i) {
-        const double r =
-            residual_of(rt, std::sqrt(ms[i].weight), std::exp(lK) * B[i], ms[i].brightness);
-        sse += r * r;
-    }
-    if (log_K_out) *log_K_out = lK;
-    return std::isfinite(sse) ? sse : kInf;
-}
-
-// Starting point [ln p..., ln K] (see docs/estimation.md).
-std::vector<double> initial_point(const std::vector<Measurement>& ms, const Model& model,
-                                  const FitOptions& o) {
-    const int n = model.size();
-    std::vector<double> x(n + 1, 0.0);
+        return true;
+    };
     if (o.model == FitModel::VeryRough) {
-        if (o.initial_sigma_over_T) {
-            x[0] = std::log(*o.initial_sigma_over_T);
-        } else {
-            // Coarse profile scan (gain profiled out) over the bounds, capped to [1e-3, 1e3].
-            const double lo = std::log(std::max(o.sigma_over_T_min, 1e-3));
-            const double hi = std::log(std::min(o.sigma_over_T_max, 1e3));
-            double best = kInf;
-            x[0] = 0.5 * (lo + hi);
-            const int steps = 24;
-            for (int k = 0; k <= steps; ++k) {
-                const double ls = lo + (hi - lo) * k / steps;
-                const double sse = profile_sse(ms, model, &ls, nullptr, o.residual);
+        ParameterSpec s = bounded("sigma_over_T", o.sigma_over_T_min, o.sigma_over_T_max);
+        s.initial = o.initial_sigma_over_T;
+        // Grid start: 25 log-spaced σ/T over the bounds, capped to [1e-3, 1e3].
+        s.start_lower = std::max(o.sigma_over_T_min, 1e-3);
+        s.start_upper = std::min(o.sigma_over_T_max, 1e3);
+        if (!(*s.start_lower < *s.start_upper)) s.start_lower = s.start_upper = std::nullopt;
+        s.grid_points = 25;
+        P.parameters.push_back(s);
+        return P;
+    }
+    P.parameters.push_back(bounded("sigma_um", o.sigma_min_um, o.sigma_max_um));
+    P.parameters.push_back(bounded("T_um", o.T_min_um, o.T_max_um));
+    double sigma0 = 0.0, T0 = 0.0;
+    if (!(o.initial_sigma_um && o.initial_T_um)) {
+        // Eq. 3 in logs is linear: ln E − ln(v_z² F² rad) = c − σ² v_z² − (T²/4) v_xy².
+        Eigen::MatrixXd A(ms.size(), 3);
+        Eigen::VectorXd y(ms.size());
+        for (std::size_t i = 0; i < ms.size(); ++i) {
+            const Geometry& g = ms[i].geometry;
+            const ScatteringVector v = scattering_vector(g, o.wavelength_um);
+            const double sw = std::sqrt(ms[i].weight);
+            const double F2 = geometric_factor_squared(o.factor, g);
+            A(i, 0) = sw;
+            A(i, 1) = -sw * v.vz * v.vz;
+            A(i, 2) = -sw * v.vxy2() / 4.0;
+            y(i) = sw * (std::log(ms[i].brightness) -
+                         std::log(v.vz * v.vz * F2 * radiometric_factor(o.radiometry, g)));
+        }
+        const Eigen::VectorXd c = A.colPivHouseholderQr().solve(y);
+        if (c.allFinite() && c(1) > 0.0) sigma0 = std::sqrt(c(1));
+        if (c.allFinite() && c(2) > 0.0) T0 = std::sqrt(c(2));
+    }
+    if (o.initial_sigma_um) sigma0 = *o.initial_sigma_um;
+    if (o.initial_T_um) T0 = *o.initial_T_um;
+    double s0 = sigma0, t0 = T0;
+    if (!(sigma0 > 0.0 && T0 > 0.0)) {
+        // Coarse profile scan around λ-scaled values (the log-linear start failed).
+        double best = kInf;
+        const double k = wavenumber_per_um(o.wavelength_um);
+        for (int a = 0; a <= 12; ++a)
+            for (int b = 0; b <= 12; ++b) {
+                const double s = sigma0 > 0.0 ? sigma0 : std::pow(10.0, -2.5 + 0.25 * a) / k;
+                const double t = T0 > 0.0 ? T0 : std::pow(10.0, -1.0 + 0.25 * b) / k;
+                const double theta[2] = {std::clamp(s, o.sigma_min_um, o.sigma_max_um),
+                                         std::clamp(t, o.T_min_um, o.T_max_um)};
+                const double sse = profiled_sse(P, theta);
                 if (sse < best) {
                     best = sse;
-                    x[0] = ls;
+                    s0 = s;
+                    t0 = t;
                 }
             }
+        if (!std::isfinite(best)) {
+            s0 = sigma0 > 0.0 ? sigma0 : 0.05 / k;
+            t0 = T0 > 0.0 ? T0 : 1.0 / k;
         }
-    } else {
-        double sigma0 = 0.0, T0 = 0.0;
-        if (!(o.initial_sigma_um && o.initial_T_um)) {
-            // Eq. 3 in logs is linear: ln E − ln(v_z² F² rad) = c − σ² v_z² − (T²/4) v_xy².
-            Eigen::MatrixXd A(ms.size(), 3);
-            Eigen::VectorXd y(ms.size());
-            for (std::size_t i = 0; i < ms.size(); ++i) {
-                const Geometry& g = ms[i].geometry;
-                const ScatteringVector v = scattering_vector(g, o.wavelength_um);
-                const double sw = std::sqrt(ms[i].weight);
-                const double F2 = geometric_factor_squared(o.factor, g);
-                A(i, 0) = sw;
-                A(i, 1) = -sw * v.vz * v.vz;
-                A(i, 2) = -sw * v.vxy2() / 4.0;
-                y(i) = sw * (std::log(ms[i].brightness) -
-                             std::log(v.vz * v.vz * F2 * radiometric_factor(o.radiometry, g)));
-            }
-            const Eigen::VectorXd c = A.colPivHouseholderQr().solve(y);
-            if (c.allFinite() && c(1) > 0.0) sigma0 = std::sqrt(c(1));
-            if (c.allFinite() && c(2) > 0.0) T0 = std::sqrt(c(2));
-        }
-        if (o.initial_sigma_um) sigma0 = *o.initial_sigma_um;
-        if (o.initial_T_um) T0 = *o.initial_T_um;
-        if (!(sigma0 > 0.0 && T0 > 0.0)) {
-            // Coarse profile scan around λ-scaled values (the log-linear start failed).
-            double best = kInf;
-            const double k = wavenumber_per_um(o.wavelength_um);
-            for (int a = 0; a <= 12; ++a)
-                for (int b = 0; b <= 12; ++b) {
-                    const double s = sigma0 > 0.0 ? sigma0 : std::pow(10.0, -2.5 + 0.25 * a) / k;
-                    const double t = T0 > 0.0 ? T0 : std::pow(10.0, -1.0 + 0.25 * b) / k;
-                    const double lp[2] = {std::log(s), std::log(t)};
-                    const double sse = profile_sse(ms, model, lp, nullptr, o.residual);
-                    if (sse < best) {
-                        best = sse;
-                        x[0] = lp[0];
-                        x[1] = lp[1];
-                    }
-                }
-            if (!std::isfinite(best)) {
-                x[0] = std::log(sigma0 > 0.0 ? sigma0 : 0.05 / k);
-                x[1] = std::log(T0 > 0.0 ? T0 : 1.0 / k);
-            }
-        } else {
-            x[0] = std::log(sigma0);
-            x[1] = std::log(T0);
-        }
-        x[0] = std::clamp(x[0], std::log(o.sigma_min_um), std::log(o.sigma_max_um));
-        x[1] = std::clamp(x[1], std::log(o.T_min_um), std::log(o.T_max_um));
     }
-    if (o.model == FitModel::VeryRough)
-        x[0] = std::clamp(x[0], std::log(o.sigma_over_T_min), std::log(o.sigma_over_T_max));
-    double lK = 0.0;
-    if (std::isfinite(profile_sse(ms, model, x.data(), &lK, o.residual))) x[n] = lK;
-    return x;
+    P.parameters[0].initial = std::clamp(s0, o.sigma_min_um, o.sigma_max_um);
+    P.parameters[1].initial = std::clamp(t0, o.T_min_um, o.T_max_um);
+    return P;
 }
 
-ceres::LossFunction* make_loss(const FitOptions& o) {
-    switch (o.loss) {
-        case LossType::None:
-            return nullptr;
-        case LossType::Huber:
-            return new ceres::HuberLoss(o.loss_scale);
-        case LossType::Cauchy:
-            return new ceres::CauchyLoss(o.loss_scale);
-        case LossType::SoftLOne:
-            return new ceres::SoftLOneLoss(o.loss_scale);
-    }
-    return nullptr;
+LeastSquaresOptions engine_options(const FitOptions& o) {
+    LeastSquaresOptions e;
+    e.max_iterations = o.max_iterations;
+    e.function_tolerance = o.function_tolerance;
+    e.gradient_tolerance = o.gradient_tolerance;
+    e.parameter_tolerance = o.parameter_tolerance;
+    e.loss = o.loss;
+    e.loss_scale = o.loss_scale;
+    e.scale_covariance = o.scale_covariance;
+    return e;
 }
 
 std::string correlation_label(Correlation c) {
@@ -420,14 +246,13 @@ double fit_model_brightness(const Geometry& geom, const std::vector<double>& par
         throw InvalidArgument("parameters: " + std::to_string(parameters.size()) + " given, the " +
                               std::string(to_string(options.model)) + " model has " +
                               std::to_string(n));
-    Model model(options);
     if (n == 1) {
         check::positive("sigma/T", parameters[0]);
-        return model.very_rough(geom, parameters[0]);
+    } else {
+        check::positive("sigma", parameters[0], "um");
+        check::positive("T", parameters[1], "um");
     }
-    check::positive("sigma", parameters[0], "um");
-    check::positive("T", parameters[1], "um");
-    return model.slightly_rough(geom, parameters[0], parameters[1]);
+    return model_brightness(geom, parameters.data(), options);
 }
 
 const FitParameter& FitResult::parameter(std::string_view name) const {
@@ -463,152 +288,33 @@ FitResult fit_roughness(const std::vector<Measurement>& measurements, const FitO
     const int n = model_parameter_count(options);
     const int p = n + 1;
     check_measurements(measurements, p);
-    const int N = static_cast<int>(measurements.size());
+
+    const LeastSquaresResult lsq =
+        solve_least_squares(make_problem(measurements, options), engine_options(options));
 
     FitResult result;
     result.options = options;
-    result.num_measurements = N;
-    result.num_parameters = p;
-
-    Model model(options);
-    std::vector<double> x = initial_point(measurements, model, options);
-
-    ceres::Problem::Options problem_options;
-    problem_options.loss_function_ownership = ceres::TAKE_OWNERSHIP;
-    problem_options.cost_function_ownership = ceres::TAKE_OWNERSHIP;
-    ceres::Problem problem(problem_options);
-    std::vector<const MeasurementCost*> costs;
-    for (const auto& m : measurements) {
-        auto* cost = new MeasurementCost(m, model, options.residual);
-        costs.push_back(cost);
-        problem.AddResidualBlock(cost, make_loss(options), x.data());
-    }
-    std::vector<std::array<double, 2>> bounds;
-    std::vector<std::string> names;
-    if (options.model == FitModel::VeryRough) {
-        bounds.push_back({options.sigma_over_T_min, options.sigma_over_T_max});
-        names.push_back("sigma_over_T");
-    } else {
-        bounds.push_back({options.sigma_min_um, options.sigma_max_um});
-        bounds.push_back({options.T_min_um, options.T_max_um});
-        names.push_back("sigma_um");
-        names.push_back("T_um");
-    }
-    for (int j = 0; j < n; ++j) {
-        problem.SetParameterLowerBound(x.data(), j, std::log(bounds[j][0]));
-        problem.SetParameterUpperBound(x.data(), j, std::log(bounds[j][1]));
-    }
-
-    ceres::Solver::Options so;
-    so.linear_solver_type = ceres::DENSE_QR;
-    so.trust_region_strategy_type = ceres::LEVENBERG_MARQUARDT;
-    so.max_num_iterations = options.max_iterations;
-    so.function_tolerance = options.function_tolerance;
-    so.gradient_tolerance = options.gradient_tolerance;
-    so.parameter_tolerance = options.parameter_tolerance;
-    so.logging_type = ceres::SILENT;
-    so.minimizer_progress_to_stdout = false;
-    so.num_threads = 1;
-    ceres::Solver::Summary summary;
-    ceres::Solve(so, &problem, &summary);
-
-    result.iterations = static_cast<int>(summary.iterations.size()) - 1;
-    result.initial_cost = summary.initial_cost;
-    result.final_cost = summary.final_cost;
-    switch (summary.termination_type) {
-        case ceres::CONVERGENCE:
-            result.status = SolverStatus::Converged;
-            break;
-        case ceres::NO_CONVERGENCE:
-            result.status = SolverStatus::NoConvergence;
-            break;
-        default:
-            result.status = SolverStatus::Failed;
-            break;
-    }
-    result.message = summary.message;
-
-    // Residuals and predictions at the solution (unrobustified).
-    result.residuals.resize(N);
-    result.predicted.resize(N);
-    double sse = 0.0;
-    bool finite = true;
-    for (int i = 0; i < N; ++i) {
-        double B = 0.0;
-        finite = finite && model.eval(measurements[i].geometry, x.data(), B, nullptr);
-        const double KB = std::exp(x[n]) * B;
-        result.predicted[i] = KB;
-        result.residuals[i] = residual_of(options.residual, std::sqrt(measurements[i].weight), KB,
-                                          measurements[i].brightness);
-        sse += result.residuals[i] * result.residuals[i];
-    }
-    if (!finite || !std::isfinite(sse)) {
-        result.status = SolverStatus::Failed;
-        result.message += "; the model brightness is not finite at the solution";
-    }
-    result.sse = sse;
-    const double sse_floor = std::max(sse / N, std::numeric_limits<double>::min());
-    result.aic = N * std::log(sse_floor) + 2.0 * p;
-    result.aicc = N - p - 1 > 0 ? result.aic + 2.0 * p * (p + 1) / double(N - p - 1) : kInf;
-
-    // Parameters and covariance (log space → natural units by the delta method).
-    std::vector<double> natural(p);
-    for (int j = 0; j < p; ++j) natural[j] = std::exp(x[j]);
-    result.covariance = Eigen::MatrixXd::Zero(p, p);
-    if (result.status != SolverStatus::Failed) {
-        // Gauss–Newton covariance (JᵀJ)⁻¹ in log space from the Jacobian at the solution, rows
-        // scaled by √ρ'(r²) for a robust loss (the first-order correction Ceres also applies).
-        // Computed here with an SVD rather than ceres::Covariance so that a rank-deficient
-        // problem is reported in the result instead of logged.
-        const std::unique_ptr<ceres::LossFunction> loss(make_loss(options));
-        Eigen::MatrixXd J(N, p);
-        bool ok = true;
-        for (int i = 0; i < N && ok; ++i) {
-            double r = 0.0;
-            std::vector<double> row(p);
-            const double* params[] = {x.data()};
-            double* jac[] = {row.data()};
-            ok = costs[i]->Evaluate(params, &r, jac);
-            double w = 1.0;
-            if (loss) {
-                double rho[3];
-                loss->Evaluate(r * r, rho);
-                w = std::sqrt(std::max(rho[1], 0.0));
-            }
-            for (int j = 0; j < p; ++j) J(i, j) = w * row[j];
-        }
-        if (ok && J.allFinite()) {
-            Eigen::JacobiSVD<Eigen::MatrixXd> svd(J, Eigen::ComputeThinV);
-            const Eigen::VectorXd sv = svd.singularValues();
-            if (sv(sv.size() - 1) > 1e-10 * sv(0)) {
-                const Eigen::VectorXd inv2 = sv.array().square().inverse();
-                const Eigen::MatrixXd C =
-                    svd.matrixV() * inv2.asDiagonal() * svd.matrixV().transpose();
-                const double scale = options.scale_covariance ? sse / (N - p) : 1.0;
-                for (int a = 0; a < p; ++a)
-                    for (int b = 0; b < p; ++b)
-                        result.covariance(a, b) = scale * C(a, b) * natural[a] * natural[b];
-                result.covariance_available = result.covariance.allFinite();
-            }
-        }
-        if (!result.covariance_available)
-            result.message +=
-                "; covariance unavailable (the Jacobian is rank deficient: the "
-                "measurements do not constrain every parameter)";
-    }
-    for (int j = 0; j < p; ++j) {
-        FitParameter fp;
-        fp.name = j < n ? names[j] : "gain";
-        fp.value = natural[j];
-        fp.lower = j < n ? bounds[j][0] : 0.0;
-        fp.upper = j < n ? bounds[j][1] : kInf;
-        fp.std_error =
-            result.covariance_available ? std::sqrt(std::max(0.0, result.covariance(j, j))) : 0.0;
-        if (j < n)
-            fp.at_bound = std::abs(x[j] - std::log(fp.lower)) < 1e-9 ||
-                          std::abs(x[j] - std::log(fp.upper)) < 1e-9;
-        result.parameters.push_back(fp);
-    }
+    result.status = lsq.status;
+    result.message = lsq.message;
+    result.parameters = lsq.parameters;
+    result.parameters.back().lower = 0.0;  // the gain of a positive brightness model is > 0
+    result.not_identifiable = lsq.not_identifiable;
+    result.covariance_available = lsq.covariance_available;
+    result.covariance = lsq.covariance;
+    result.residuals = lsq.residuals;
+    result.predicted = lsq.predicted;
+    result.sse = lsq.sse;
+    result.aic = lsq.aic;
+    result.aicc = lsq.aicc;
+    result.num_measurements = lsq.num_data;
+    result.num_parameters = lsq.num_parameters;
+    result.iterations = lsq.iterations;
+    result.evaluations = lsq.evaluations;
+    result.initial_cost = lsq.initial_cost;
+    result.final_cost = lsq.final_cost;
+    std::vector<double> natural(static_cast<std::size_t>(p));
+    for (int j = 0; j < p; ++j)
+        natural[static_cast<std::size_t>(j)] = lsq.parameters[static_cast<std::size_t>(j)].value;
 
     // Derived quantities.
     RoughnessEstimate& est = result.estimate;
@@ -649,7 +355,10 @@ FitResult fit_roughness(const std::vector<Measurement>& measurements, const FitO
                                    fmt(fp.upper) +
                                    "]: the data do not constrain it there; its standard error "
                                    "is not meaningful");
-    if (result.status != SolverStatus::Converged)
+    if (result.status == SolverStatus::NotIdentifiable)
+        est.warnings.push_back("the measurements do not determine the parameters: " +
+                               result.message);
+    else if (result.status == SolverStatus::NoConvergence || result.status == SolverStatus::Failed)
         est.warnings.push_back("the fit did not converge: " + result.message);
     return result;
 }

@@ -15,7 +15,10 @@
 //  * *_fit             least squares over every used measurement with an unknown gain K:
 //                      min over (params, K) of Σ w_j (K M_j − d_j/max d)². σ/T for B–K and V–H,
 //                      n for Lafortune, (σ_ON, ρ_ON) for Oren–Nayar (the fair comparison the
-//                      paper did not make).
+//                      paper did not make). Solved by the library's least-squares engine
+//                      (fit/engine.hpp: K profiled out, grid start, Levenberg–Marquardt with
+//                      bounds, covariance and identifiability from the Jacobian); the fitted
+//                      gain is the parameter "gain".
 //
 // Error measures per model (ErrorMeasures):
 //  * paper_sse  the paper's Table 4 figure: Σ_j w_j (M_j/max M − d_j/max d)², a SUM over the
@@ -41,6 +44,7 @@
 
 #include "roughscope/brdf/curet.hpp"
 #include "roughscope/brdf/table.hpp"
+#include "roughscope/fit/engine.hpp"
 #include "roughscope/scattering/factors.hpp"
 #include "roughscope/scattering/reflectance_models.hpp"
 
@@ -103,17 +107,12 @@ ErrorMeasures error_measures(std::span<const double> model, std::span<const doub
 // ---------------------------------------------------------------------------------------------
 // Per-model results
 
-enum class FitStatus {
-    Converged,  // interior minimum found
-    AtBound,    // the best value lies on a bound of the search interval (reported, not an error)
-    Failed,     // the optimiser did not converge (message says why)
-};
-std::string_view to_string(FitStatus status);  // "converged", "at_bound", "failed"
-
 struct ModelParameter {
     std::string name;  // "sigma_over_T", "n", "sigma_rad", "albedo", "gain"
     double value = 0.0;
-    std::optional<double> standard_error;  // fits only: from the Jacobian at the optimum
+    // Fits only: from the covariance at the optimum; none for a parameter on a bound of its
+    // range, or when the parameters are not identifiable.
+    std::optional<double> standard_error;
 };
 
 struct ModelResult {
@@ -122,9 +121,12 @@ struct ModelResult {
     std::string reason;  // why the model is unavailable (empty when available)
     std::string method;  // how its parameters were obtained
     std::vector<ModelParameter> parameters;
-    std::optional<FitStatus> fit_status;  // fits and the exhaustive search
+    // Fits (engine.hpp's status: converged, at_bound, not_identifiable, no_convergence,
+    // failed) and the exhaustive Lafortune search (converged, or at_bound at an end of its grid).
+    std::optional<SolverStatus> fit_status;
     std::string fit_message;
-    std::vector<double> covariance;  // fits: row-major over `parameters` (incl. gain last)
+    std::vector<double> covariance;  // fits: row-major over `parameters` (incl. gain last);
+                                     // empty when unavailable
     int evaluations = 0;             // model evaluations over the whole table
     ErrorMeasures errors;
     std::vector<double> prediction;  // model brightness at each used measurement

@@ -7,12 +7,14 @@
 //  * FitModel::SlightlyRough θ = (σ, T) in µm: B = the diffuse term of mean_scattered_power in
 //                            the chosen regime (Eq. 3 by default; the exact series for moderately
 //                            rough surfaces), × radiometric factor, at wavelength λ.
-// Solved with Ceres (Levenberg–Marquardt, dense QR) on the logarithms of the parameters (which
-// keeps them positive and makes the problem better scaled), with bounds and an optional robust
-// loss. The covariance of the parameters is (JᵀJ)⁻¹ from an SVD of the Jacobian at the solution
-// (rank deficiency is reported, not printed), scaled by
-// the residual variance SSE/(N − p) unless scale_covariance = false (then the weights must be
-// 1/variance of the residuals), and is mapped to natural units by the delta method.
+// Solved by the library's least-squares engine (engine.hpp: Ceres Levenberg–Marquardt on the
+// logarithms of the parameters, which keeps them positive and makes the problem better scaled,
+// with bounds, the gain K profiled out by variable projection — or fitted jointly under a robust
+// loss — and an identifiability test). The covariance of all parameters, K included, is (JᵀJ)⁻¹
+// from an SVD of the Jacobian at the solution, scaled by the residual variance SSE/(N − p) unless
+// scale_covariance = false (then the weights must be 1/variance of the residuals), and is mapped
+// to natural units by the delta method. Status: SolverStatus (engine.hpp); a parameter on a bound
+// gives AtBound and FitParameter::at_bound, a rank-deficient Jacobian NotIdentifiable.
 //
 // Model comparison: AIC = N ln(SSE/N) + 2p (Gaussian errors of unknown variance), also the
 // small-sample AICc = AIC + 2p(p+1)/(N − p − 1). Lower is better; compare_correlations fits both
@@ -27,6 +29,7 @@
 #include <Eigen/Core>
 
 #include "roughscope/estimation/estimation.hpp"
+#include "roughscope/fit/engine.hpp"
 #include "roughscope/scattering/beckmann.hpp"
 #include "roughscope/scattering/factors.hpp"
 #include "roughscope/scattering/geometry.hpp"
@@ -41,21 +44,10 @@ struct Measurement {
 };
 
 enum class FitModel { VeryRough, SlightlyRough };
-enum class ResidualType {
-    Relative,  // √w (K B − E)/E: suited to a relative (multiplicative) noise — the default
-    Absolute,  // √w (K B − E)
-    Log,       // √w (ln(K B) − ln E)
-};
-enum class LossType { None, Huber, Cauchy, SoftLOne };
-enum class SolverStatus { Converged, NoConvergence, Failed };
+// ResidualType (relative — the default here —, absolute, log), LossType, SolverStatus: engine.hpp.
 
 std::string_view to_string(FitModel m);           // "very_rough", "slightly_rough"
-std::string_view to_string(ResidualType r);       // "relative", "absolute", "log"
-std::string_view to_string(LossType l);           // "none", "huber", "cauchy", "soft_l_one"
-std::string_view to_string(SolverStatus s);       // "converged", "no_convergence", "failed"
 FitModel parse_fit_model(std::string_view name);  // throw InvalidArgument listing the names
-ResidualType parse_residual_type(std::string_view name);
-LossType parse_loss_type(std::string_view name);
 
 struct FitOptions {
     FitModel model = FitModel::VeryRough;
@@ -90,20 +82,13 @@ struct FitOptions {
     bool scale_covariance = true;  // multiply by SSE/(N − p) (noise level unknown)
 };
 
-struct FitParameter {
-    std::string name;  // "sigma_over_T", "sigma_um", "T_um", "gain"
-    double value = 0.0;
-    double std_error = 0.0;  // valid when FitResult::covariance_available
-    double lower = 0.0;      // bounds (gain: 0, inf)
-    double upper = 0.0;
-    bool at_bound = false;  // the solution sits on a bound: its std_error is not meaningful
-};
-
 struct FitResult {
     SolverStatus status = SolverStatus::Failed;
-    std::string message;                   // Ceres' termination message and our notes
-    FitOptions options;                    // what was fitted
-    std::vector<FitParameter> parameters;  // model parameters, then the gain K
+    std::string message;                        // Ceres' termination message and our notes
+    FitOptions options;                         // what was fitted
+    std::vector<FitParameter> parameters;       // "sigma_over_T" or "sigma_um", "T_um"; then "gain"
+                                                // (gain bounds: 0, inf)
+    std::vector<std::string> not_identifiable;  // names, when status is NotIdentifiable
     bool covariance_available = false;
     Eigen::MatrixXd covariance;     // natural units, order of `parameters`
     std::vector<double> residuals;  // weighted residuals at the solution
@@ -114,6 +99,7 @@ struct FitResult {
     int num_measurements = 0;
     int num_parameters = 0;
     int iterations = 0;
+    int evaluations = 0;        // model evaluations over all measurements
     double initial_cost = 0.0;  // Ceres cost ½ Σ ρ(r²) at the start and the end
     double final_cost = 0.0;
     RoughnessEstimate estimate;  // σ/T (σ, T), m, θK, ξK, g, class, warnings

@@ -378,6 +378,114 @@ TEST(CuretPaper, FitsNeverDoWorseThanTheTwoPointEstimate) {
 }
 
 // ---------------------------------------------------------------------------------------------
+// The fits on the library's least-squares engine against the previous engine (grid + Brent with
+// the gain eliminated, finite-difference covariance), whose values for six samples are typed in
+// below: gain_sse agrees to 1e-9, the fitted parameter to 1e-5 (σ/T, n; 1e-4 for σ_ON), the
+// standard error to 1e-4 (relative). Where σ_ON = 0 (Lambert), albedo and gain trade off exactly:
+// the old engine reported no covariance, the new one says NotIdentifiable.
+
+TEST(CuretFitEngine, TableFourFitsAgreeWithThePreviousEngine) {
+    REQUIRE_CURET();
+    struct Old {
+        int sample;
+        ComparisonModel model;
+        double gain_sse;
+        const char* parameter;
+        double value;
+        double standard_error;  // -1: none
+    };
+    const Old old[] = {
+        {7, ComparisonModel::OrenNayarFit, 5.77215248485, "sigma_rad", 0.697095409992, 1.98148},
+        {7, ComparisonModel::LafortuneFit, 6.50229713458, "n", 0.01, 0.0670658},
+        {7, ComparisonModel::BkGaussianFit, 18.109661831, "sigma_over_T", 0.468795504013,
+         0.0426574},
+        {7, ComparisonModel::BkExponentialFit, 14.6166245337, "sigma_over_T", 0.543579586036,
+         0.051324},
+        {7, ComparisonModel::VhGaussianFit, 3.16368302148, "sigma_over_T", 4.6076966318, 0.702779},
+        {7, ComparisonModel::VhExponentialFit, 3.15018433293, "sigma_over_T", 10.1213922223,
+         1.62953},
+        {15, ComparisonModel::OrenNayarFit, 7.99056682754, "sigma_rad", 0, -1},
+        {15, ComparisonModel::LafortuneFit, 7.84515466749, "n", 0.133638631788, 0.0674979},
+        {15, ComparisonModel::BkGaussianFit, 24.5169789139, "sigma_over_T", 0.227195007204,
+         0.0324734},
+        {15, ComparisonModel::BkExponentialFit, 24.5656172182, "sigma_over_T", 0.31020397419,
+         0.0498608},
+        {15, ComparisonModel::VhGaussianFit, 10.3173585506, "sigma_over_T", 0.41028263481,
+         0.0321183},
+        {15, ComparisonModel::VhExponentialFit, 9.76475609561, "sigma_over_T", 0.792561156953,
+         0.0750624},
+        {25, ComparisonModel::OrenNayarFit, 7.99000026821, "sigma_rad", 0, -1},
+        {25, ComparisonModel::LafortuneFit, 8.02599638973, "n", 0.01, 0.0875827},
+        {25, ComparisonModel::BkGaussianFit, 12.445859484, "sigma_over_T", 0.23348562516,
+         0.0195269},
+        {25, ComparisonModel::BkExponentialFit, 12.2521960516, "sigma_over_T", 0.319133205731,
+         0.0291124},
+        {25, ComparisonModel::VhGaussianFit, 1.88829396852, "sigma_over_T", 0.479192306653,
+         0.0177187},
+        {25, ComparisonModel::VhExponentialFit, 1.34894045044, "sigma_over_T", 0.920447826561,
+         0.0350708},
+        {30, ComparisonModel::OrenNayarFit, 0.299470270669, "sigma_rad", 0.528583459411, 0.123011},
+        {30, ComparisonModel::LafortuneFit, 3.10373366679, "n", 0.01, 0.0200407},
+        {30, ComparisonModel::BkGaussianFit, 77.5944191074, "sigma_over_T", 0.693707307958,
+         0.0838121},
+        {30, ComparisonModel::BkExponentialFit, 75.9107254928, "sigma_over_T", 0.607915510202,
+         0.128309},
+        {30, ComparisonModel::VhGaussianFit, 37.1349975657, "sigma_over_T", 1.94300141788,
+         0.283093},
+        {30, ComparisonModel::VhExponentialFit, 36.9773840305, "sigma_over_T", 4.12719174103,
+         0.728017},
+        {34, ComparisonModel::OrenNayarFit, 6.77838043035, "sigma_rad", 0, -1},
+        {34, ComparisonModel::LafortuneFit, 6.79237746296, "n", 0.01, 0.116288},
+        {34, ComparisonModel::BkGaussianFit, 7.40837324349, "sigma_over_T", 0.198270071607,
+         0.0163995},
+        {34, ComparisonModel::BkExponentialFit, 7.29047815463, "sigma_over_T", 0.282020536084,
+         0.0250981},
+        {34, ComparisonModel::VhGaussianFit, 1.17696487542, "sigma_over_T", 0.331044488841,
+         0.0106409},
+        {34, ComparisonModel::VhExponentialFit, 0.846420164185, "sigma_over_T", 0.64174925958,
+         0.0223989},
+        {41, ComparisonModel::OrenNayarFit, 7.56649663534, "sigma_rad", 0, -1},
+        {41, ComparisonModel::LafortuneFit, 7.58371960924, "n", 0.01, 0.116329},
+        {41, ComparisonModel::BkGaussianFit, 7.9304709505, "sigma_over_T", 0.195559648907,
+         0.0154492},
+        {41, ComparisonModel::BkExponentialFit, 7.92060367033, "sigma_over_T", 0.289932546983,
+         0.0246323},
+        {41, ComparisonModel::VhGaussianFit, 1.57182790089, "sigma_over_T", 0.304165958388,
+         0.0105852},
+        {41, ComparisonModel::VhExponentialFit, 1.23541330778, "sigma_over_T", 0.606475899771,
+         0.0242178},
+    };
+    int checked = 0;
+    for (const Old& o : old) {
+        const Comparison c = compare_curet_sample(database(), o.sample);
+        const ModelResult& r = c.result(o.model);
+        const std::string where = "sample " + std::to_string(o.sample) + " " +
+                                  std::string(to_string(o.model)) + ": " + r.fit_message;
+        ASSERT_TRUE(r.available) << where;
+        ASSERT_TRUE(r.fit_status.has_value()) << where;
+        EXPECT_NEAR(r.errors.gain_sse, o.gain_sse, 1e-9 * o.gain_sse) << where;
+        const std::optional<double> v = r.parameter(o.parameter);
+        ASSERT_TRUE(v.has_value()) << where;
+        const double tol = std::string(o.parameter) == "sigma_rad" ? 1e-4 : 1e-5;
+        EXPECT_NEAR(*v, o.value, tol * std::max(o.value, 1e-3)) << where;
+        const ModelParameter& p = r.parameters.at(0);
+        if (o.standard_error > 0.0 && p.standard_error) {
+            EXPECT_NEAR(*p.standard_error, o.standard_error, 1e-4 * o.standard_error) << where;
+        }
+        if (o.model == ComparisonModel::OrenNayarFit && o.value == 0.0) {
+            EXPECT_EQ(*r.fit_status, SolverStatus::NotIdentifiable) << where;
+            EXPECT_FALSE(p.standard_error.has_value()) << where;
+        }
+        if (o.model != ComparisonModel::OrenNayarFit && o.model != ComparisonModel::LafortuneFit) {
+            EXPECT_EQ(*r.fit_status, SolverStatus::Converged) << where;
+        }
+        EXPECT_NE(*r.fit_status, SolverStatus::Failed) << where;
+        ++checked;
+    }
+    EXPECT_EQ(checked, 36);
+}
+
+// ---------------------------------------------------------------------------------------------
 // The whole database, including sample 61
 
 TEST(CuretAll, EverySampleIsProcessedAndSample61ExplainsItsMissingEstimate) {

@@ -1,0 +1,896 @@
+// The least-squares engine (engine.hpp): Ceres Levenberg–Marquardt with bounds, variable
+// projection of a linear gain, grid starts, identifiability test and covariance from an SVD.
+#include "roughscope/fit/engine.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <exception>
+#include <memory>
+#include <numeric>
+#include <string>
+
+#include <Eigen/Dense>
+#include <ceres/ceres.h>
+
+#include "roughscope/core/errors.hpp"
+
+namespace roughscope {
+
+// ---------------------------------------------------------------------------------------------
+// Names
+
+std::string_view to_string(ResidualType r) {
+    switch (r) {
+        case ResidualType::Relative:
+            return "relative";
+        case ResidualType::Absolute:
+            return "absolute";
+        case ResidualType::Log:
+            return "log";
+    }
+    return "relative";
+}
+std::string_view to_string(LossType l) {
+    switch (l) {
+        case LossType::None:
+            return "none";
+        case LossType::Huber:
+            return "huber";
+        case LossType::Cauchy:
+            return "cauchy";
+        case LossType::SoftLOne:
+            return "soft_l_one";
+    }
+    return "none";
+}
+std::string_view to_string(SolverStatus s) {
+    switch (s) {
+        case SolverStatus::Converged:
+            return "converged";
+        case SolverStatus::AtBound:
+            return "at_bound";
+        case SolverStatus::NotIdentifiable:
+            return "not_identifiable";
+        case SolverStatus::NoConvergence:
+            return "no_convergence";
+        case SolverStatus::Failed:
+            return "failed";
+    }
+    return "failed";
+}
+
+namespace {
+template <class Enum, std::size_t N>
+Enum parse_enum(std::string_view what, std::string_view name, const std::array<Enum, N>& values) {
+    std::string accepted;
+    for (Enum v : values) {
+        if (to_string(v) == name) return v;
+        if (!accepted.empty()) accepted += ", ";
+        accepted += std::string(to_string(v));
+    }
+    throw InvalidArgument(std::string(what) + " '" + std::string(name) +
+                          "' is not recognised; accepted: " + accepted);
+}
+}  // namespace
+
+ResidualType parse_residual_type(std::string_view name) {
+    return parse_enum(
+        "residual type", name,
+        std::array{ResidualType::Relative, ResidualType::Absolute, ResidualType::Log});
+}
+LossType parse_loss_type(std::string_view name) {
+    return parse_enum(
+        "loss", name,
+        std::array{LossType::None, LossType::Huber, LossType::Cauchy, LossType::SoftLOne});
+}
+
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+std::string fmt(double x, int digits = 6) {
+    if (std::isnan(x)) return "nan";
+    if (std::isinf(x)) return x > 0 ? "inf" : "-inf";
+    char buf[64];
+    std::snprintf(buf, sizeof buf, "%.*g", digits, x);
+    return buf;
+}
+
+double residual_of(ResidualType rt, double sw, double KM, double y) {
+    switch (rt) {
+        case ResidualType::Relative:
+            return sw * (KM - y) / y;
+        case ResidualType::Absolute:
+            return sw * (KM - y);
+        case ResidualType::Log:
+            return sw * (std::log(KM) - std::log(y));
+    }
+    return 0.0;
+}
+
+std::unique_ptr<ceres::LossFunction> make_loss(LossType loss, double scale) {
+    switch (loss) {
+        case LossType::None:
+            return nullptr;
+        case LossType::Huber:
+            return std::make_unique<ceres::HuberLoss>(scale);
+        case LossType::Cauchy:
+            return std::make_unique<ceres::CauchyLoss>(scale);
+        case LossType::SoftLOne:
+            return std::make_unique<ceres::SoftLOneLoss>(scale);
+    }
+    return nullptr;
+}
+
+// Bounds of the optimised variable u (ln θ for Log, θ for Linear).
+double to_u(Transform t, double theta) { return t == Transform::Log ? std::log(theta) : theta; }
+double to_theta(Transform t, double u) { return t == Transform::Log ? std::exp(u) : u; }
+
+void validate(const LeastSquaresProblem& P, const LeastSquaresOptions& O) {
+    if (P.parameters.empty())
+        throw InvalidArgument("parameters: none given; the model needs at least 1");
+    if (!P.model) throw InvalidArgument("model: no model function given");
+    if (P.data.empty()) throw InvalidArgument("data: empty; at least 1 data point is needed");
+    if (!P.weights.empty() && P.weights.size() != P.data.size())
+        throw InvalidArgument("weights: " + std::to_string(P.weights.size()) + " given for " +
+                              std::to_string(P.data.size()) +
+                              " data points; give none (all 1) or one per datum");
+    for (std::size_t i = 0; i < P.parameters.size(); ++i) {
+        const ParameterSpec& s = P.parameters[i];
+        const std::string nm = "parameter '" + s.name + "'";
+        if (s.name.empty())
+            throw InvalidArgument("parameter " + std::to_string(i + 1) + ": empty name");
+        for (std::size_t k = 0; k < i; ++k)
+            if (P.parameters[k].name == s.name)
+                throw InvalidArgument(nm + " is given twice; names must be unique");
+        if (P.gain != GainMode::None && s.name == "gain")
+            throw InvalidArgument(nm + ": the name 'gain' is reserved for the fitted gain");
+        if (std::isnan(s.lower) || std::isnan(s.upper) || !(s.lower < s.upper))
+            throw InvalidArgument(nm + " bounds [" + fmt(s.lower) + ", " + fmt(s.upper) +
+                                  "] are invalid: need lower < upper (±inf allowed)");
+        if (s.transform == Transform::Log && !(s.lower >= 0.0))
+            throw InvalidArgument(nm + " lower bound = " + fmt(s.lower) +
+                                  " is negative, but a log-transformed parameter must lie in "
+                                  "[0, inf); use Transform::Linear");
+        if (s.initial) {
+            check::finite("initial " + s.name, *s.initial);
+            if (*s.initial < s.lower || *s.initial > s.upper)
+                throw InvalidArgument("initial " + s.name + " = " + fmt(*s.initial) +
+                                      " is outside its bounds [" + fmt(s.lower) + ", " +
+                                      fmt(s.upper) + "]");
+            if (s.transform == Transform::Log && !(*s.initial > 0.0))
+                throw InvalidArgument("initial " + s.name + " = " + fmt(*s.initial) +
+                                      " must be > 0 (log-transformed parameter)");
+        } else {
+            const double lo = s.start_lower.value_or(s.lower);
+            const double hi = s.start_upper.value_or(s.upper);
+            if (!std::isfinite(lo) || !std::isfinite(hi) || !(lo < hi) || lo < s.lower ||
+                hi > s.upper || (s.transform == Transform::Log && !(lo > 0.0)))
+                throw InvalidArgument(
+                    nm + " has no initial value and its start range [" + fmt(lo) + ", " + fmt(hi) +
+                    "] cannot be gridded: give an initial value or a finite range " +
+                    "inside the bounds [" + fmt(s.lower) + ", " + fmt(s.upper) + "]" +
+                    (s.transform == Transform::Log ? " with a positive lower end" : ""));
+            if (s.grid_points == 1 || s.grid_points < 0)
+                throw InvalidArgument(nm + " grid_points = " + std::to_string(s.grid_points) +
+                                      " must be 0 (default) or >= 2");
+        }
+    }
+    double sum_w = 0.0;
+    auto at = [](const char* what, std::size_t i) {
+        std::string s = what;
+        s += '[';
+        s += std::to_string(i);
+        s += ']';
+        return s;
+    };
+    for (std::size_t i = 0; i < P.data.size(); ++i) {
+        const double y = P.data[i];
+        if (!std::isfinite(y)) check::finite(at("data", i), y);
+        if (P.residual != ResidualType::Absolute && !(y > 0.0))
+            throw InvalidArgument(at("data", i) + " = " + fmt(y) + " must be > 0 for " +
+                                  std::string(to_string(P.residual)) +
+                                  " residuals (valid range (0, inf)); use absolute residuals");
+        if (!P.weights.empty()) {
+            const double wi = P.weights[i];
+            if (!(std::isfinite(wi) && wi >= 0.0))
+                throw InvalidArgument(at("weights", i) + " = " + fmt(wi) +
+                                      " is outside the valid range [0, inf)");
+            sum_w += wi;
+        }
+    }
+    if (!P.weights.empty() && !(sum_w > 0.0))
+        throw InvalidArgument("weights: all zero; at least one must be > 0");
+    if (O.max_iterations < 1)
+        throw InvalidArgument("max_iterations = " + std::to_string(O.max_iterations) +
+                              " must be >= 1");
+    check::positive("function_tolerance", O.function_tolerance);
+    check::positive("gradient_tolerance", O.gradient_tolerance);
+    check::positive("parameter_tolerance", O.parameter_tolerance);
+    check::positive("loss_scale", O.loss_scale);
+    if (O.grid_points < 2)
+        throw InvalidArgument("grid_points = " + std::to_string(O.grid_points) + " must be >= 2");
+    if (O.num_starts < 1)
+        throw InvalidArgument("num_starts = " + std::to_string(O.num_starts) + " must be >= 1");
+    if (!(O.rank_tolerance > 0.0 && O.rank_tolerance < 1.0))
+        throw InvalidArgument("rank_tolerance = " + fmt(O.rank_tolerance) +
+                              " is outside the valid range (0, 1)");
+}
+
+// Residual evaluation shared by Ceres' cost function, the grid start and the covariance.
+class Evaluator {
+  public:
+    Evaluator(const LeastSquaresProblem& P, const LeastSquaresOptions& O, GainMode gain)
+        : P_(P),
+          gain_(gain),
+          n_(static_cast<int>(P.parameters.size())),
+          loss_(make_loss(O.loss, O.loss_scale)) {
+        const std::size_t N = P.data.size();
+        sw_.resize(N);
+        w_.resize(N);
+        for (std::size_t i = 0; i < N; ++i) {
+            w_[i] = P.weights.empty() ? 1.0 : P.weights[i];
+            sw_[i] = std::sqrt(w_[i]);
+        }
+        theta_.resize(static_cast<std::size_t>(n_));
+        M_.resize(N);
+        for (const ParameterSpec& s : P.parameters) {
+            const bool has_lower = s.transform == Transform::Linear || s.lower > 0.0;
+            lower_.push_back(has_lower ? to_u(s.transform, s.lower) : -kInf);
+            upper_.push_back(to_u(s.transform, s.upper));
+        }
+    }
+    // Bounds of the optimised variable j (the gain, j = n, is unbounded).
+    double lower(int j) const { return j < n_ ? lower_[static_cast<std::size_t>(j)] : -kInf; }
+    double upper(int j) const { return j < n_ ? upper_[static_cast<std::size_t>(j)] : kInf; }
+    int n() const { return n_; }
+    std::size_t size() const { return P_.data.size(); }
+    GainMode gain() const { return gain_; }
+    const ceres::LossFunction* loss() const { return loss_.get(); }
+    const std::vector<double>& weights() const { return w_; }
+    int evaluations() const { return evaluations_; }
+
+    // M(θ(u)) into M; false when the model fails or gives a non-finite value.
+    bool model(const double* u, std::vector<double>& M) const {
+        for (int j = 0; j < n_; ++j)
+            theta_[static_cast<std::size_t>(j)] =
+                to_theta(P_.parameters[static_cast<std::size_t>(j)].transform, u[j]);
+        M.resize(size());
+        ++evaluations_;
+        try {
+            if (!P_.model(std::span<const double>(theta_), std::span<double>(M))) return false;
+        } catch (const std::exception&) {
+            return false;  // an exception must not cross Ceres: the point is unusable
+        }
+        for (double m : M)
+            if (!std::isfinite(m)) return false;
+        return true;
+    }
+
+    // Residuals r_i = √w_i residual(K M_i, y_i) at x = [u..., (K if `mode` is Free)], the gain
+    // profiled out (mode Profiled), explicit (Free) or 1 (None); robust: r̃ = sign(r) √ρ(r²), so
+    // that Σ r̃² = Σ ρ(r²) is the robust cost. K through `gain` when given.
+    bool residuals(const double* x, GainMode mode, bool robust, double* r,
+                   double* gain = nullptr) const {
+        if (!model(x, M_)) return false;
+        double K = 1.0;
+        if (mode == GainMode::Profiled)
+            K = optimal_gain(M_, P_.data, w_, P_.residual);
+        else if (mode == GainMode::Free)
+            K = x[n_];
+        if (!std::isfinite(K)) return false;
+        for (std::size_t i = 0; i < size(); ++i) {
+            const double KM = K * M_[i];
+            if (P_.residual == ResidualType::Log && !(KM > 0.0)) {
+                if (w_[i] == 0.0) {
+                    r[i] = 0.0;
+                    continue;
+                }
+                return false;
+            }
+            double ri = residual_of(P_.residual, sw_[i], KM, P_.data[i]);
+            if (robust && loss_) {
+                double rho[3];
+                loss_->Evaluate(ri * ri, rho);
+                ri = std::copysign(std::sqrt(std::max(rho[0], 0.0)), ri);
+            }
+            if (!std::isfinite(ri)) return false;
+            r[i] = ri;
+        }
+        if (gain) *gain = K;
+        return true;
+    }
+
+  private:
+    const LeastSquaresProblem& P_;
+    GainMode gain_;
+    int n_;
+    std::unique_ptr<ceres::LossFunction> loss_;
+    std::vector<double> sw_, w_, lower_, upper_;
+    mutable std::vector<double> theta_, M_;
+    mutable int evaluations_ = 0;
+};
+
+// Central difference of the vector function f in coordinate j of x, the step (1e-6 max(1, |x_j|))
+// kept inside [lo, hi]: one-sided at a bound, or when one side cannot be evaluated. f0 = f(x).
+template <class F>
+bool bounded_difference(F&& f, std::vector<double>& x, std::size_t j, double lo, double hi,
+                        const std::vector<double>& f0, std::vector<double>& d) {
+    const double xj = x[j];
+    const double h = 1e-6 * std::max(1.0, std::abs(xj));
+    double a = std::max(lo, xj - h), b = std::min(hi, xj + h);
+    std::vector<double> fa, fb;
+    x[j] = b;
+    const bool okb = b > xj && f(x.data(), fb);
+    x[j] = a;
+    const bool oka = a < xj && f(x.data(), fa);
+    x[j] = xj;
+    if (!okb) b = xj;
+    if (!oka) a = xj;
+    if (!(b > a)) return false;
+    const std::vector<double>& up = okb ? fb : f0;
+    const std::vector<double>& dn = oka ? fa : f0;
+    d.resize(f0.size());
+    for (std::size_t i = 0; i < f0.size(); ++i) d[i] = (up[i] - dn[i]) / (b - a);
+    return true;
+}
+
+// Ceres' cost: the N (robustified, gain-projected) residuals as one block over [u..., (gain)],
+// Jacobian by bounded central differences, so that the model is never evaluated outside the
+// bounds (e.g. σ_ON < 0).
+class EngineCost final : public ceres::CostFunction {
+  public:
+    EngineCost(const Evaluator& e, int size) : e_(e) {
+        set_num_residuals(static_cast<int>(e.size()));
+        mutable_parameter_block_sizes()->push_back(size);
+    }
+    bool Evaluate(double const* const* x, double* r, double** J) const override {
+        const int size = parameter_block_sizes()[0];
+        const std::size_t N = e_.size();
+        // Ceres evaluates a candidate point without, then (once accepted) with the Jacobian: the
+        // residuals of the last point are reused.
+        if (last_x_.size() == static_cast<std::size_t>(size) &&
+            std::equal(last_x_.begin(), last_x_.end(), x[0])) {
+            std::copy(last_r_.begin(), last_r_.end(), r);
+        } else {
+            if (!e_.residuals(x[0], e_.gain(), true, r)) return false;
+            last_x_.assign(x[0], x[0] + size);
+            last_r_.assign(r, r + N);
+        }
+        if (J == nullptr || J[0] == nullptr) return true;
+        std::vector<double> xv(x[0], x[0] + size), r0(r, r + N), d;
+        auto f = [this, N](const double* xx, std::vector<double>& out) {
+            out.resize(N);
+            return e_.residuals(xx, e_.gain(), true, out.data());
+        };
+        for (int j = 0; j < size; ++j) {
+            if (!bounded_difference(f, xv, static_cast<std::size_t>(j), e_.lower(j), e_.upper(j),
+                                    r0, d))
+                return false;
+            for (std::size_t i = 0; i < N; ++i)
+                J[0][i * static_cast<std::size_t>(size) + static_cast<std::size_t>(j)] = d[i];
+        }
+        return true;
+    }
+
+  private:
+    const Evaluator& e_;
+    mutable std::vector<double> last_x_, last_r_;
+};
+
+// Ceres solve from start x (size n, or n + 1 with a free gain).
+struct Run {
+    std::vector<double> x;
+    ceres::Solver::Summary summary;  // of the last solve (initial_cost: of the first)
+    int iterations = 0;              // over every solve
+};
+
+// Whether the optimised variable j sits on one of its bounds.
+bool on_bound(const Evaluator& e, int j, double u) {
+    const double tol = 1e-9 * std::max(1.0, std::abs(u));
+    return std::abs(u - e.lower(j)) <= tol || std::abs(u - e.upper(j)) <= tol;
+}
+
+// Ceres from start x. When parameters end on a bound, the projected Levenberg–Marquardt step can
+// stall the others (the step that leaves the box is cut back); an active-set polish then solves
+// again with the parameters that the gradient holds on their bounds fixed there, then once more
+// with everything free, until that set is stable.
+Run solve_from(const Evaluator& e, const LeastSquaresOptions& O, std::vector<double> x) {
+    Run run;
+    run.x = std::move(x);
+    const int size = static_cast<int>(run.x.size());
+    ceres::Problem problem;  // takes ownership of the cost function
+    problem.AddResidualBlock(new EngineCost(e, size), nullptr, run.x.data());
+    for (int j = 0; j < e.n(); ++j) {
+        if (std::isfinite(e.lower(j))) problem.SetParameterLowerBound(run.x.data(), j, e.lower(j));
+        if (std::isfinite(e.upper(j))) problem.SetParameterUpperBound(run.x.data(), j, e.upper(j));
+    }
+    ceres::Solver::Options so;
+    so.linear_solver_type = ceres::DENSE_QR;
+    so.trust_region_strategy_type = ceres::LEVENBERG_MARQUARDT;
+    so.max_num_iterations = O.max_iterations;
+    so.function_tolerance = O.function_tolerance;
+    so.gradient_tolerance = O.gradient_tolerance;
+    so.parameter_tolerance = O.parameter_tolerance;
+    so.logging_type = ceres::SILENT;
+    so.minimizer_progress_to_stdout = false;
+    so.num_threads = 1;
+    ceres::Solve(so, &problem, &run.summary);
+    const double initial_cost = run.summary.initial_cost;
+    int iterations = std::max(0, static_cast<int>(run.summary.iterations.size()) - 1);
+    auto count = [&](const ceres::Solver::Summary& sm) {
+        iterations += std::max(0, static_cast<int>(sm.iterations.size()) - 1);
+    };
+    // Held: on a bound with the gradient of the cost pointing out of the box (a KKT multiplier
+    // of the right sign). False when the cost cannot be evaluated.
+    auto held_set = [&](std::vector<int>& held) {
+        double cost = 0.0;
+        std::vector<double> gradient;
+        if (!problem.Evaluate(ceres::Problem::EvaluateOptions(), &cost, nullptr, &gradient,
+                              nullptr))
+            return false;
+        held.clear();
+        for (int j = 0; j < e.n(); ++j) {
+            const double u = run.x[static_cast<std::size_t>(j)];
+            const double g = gradient[static_cast<std::size_t>(j)];
+            if (!on_bound(e, j, u)) continue;
+            const bool at_lower = std::abs(u - e.lower(j)) <= 1e-9 * std::max(1.0, std::abs(u));
+            if (at_lower ? g > 0.0 : g < 0.0) held.push_back(j);
+        }
+        return true;
+    };
+    std::vector<int> held, held_before;
+    for (int pass = 0; pass < 4; ++pass) {
+        const bool usable = run.summary.termination_type == ceres::CONVERGENCE ||
+                            run.summary.termination_type == ceres::NO_CONVERGENCE;
+        if (!usable || !held_set(held) || held.empty() || static_cast<int>(held.size()) == size ||
+            held == held_before)
+            break;
+        held_before = held;
+        ceres::Solver::Summary polished;
+        problem.SetManifold(run.x.data(), new ceres::SubsetManifold(size, held));
+        ceres::Solve(so, &problem, &polished);
+        count(polished);
+        problem.SetManifold(run.x.data(), nullptr);
+        // The same parameters still held (KKT holds at the polished point): done, without a
+        // free solve that would only crawl against the bounds again.
+        std::vector<int> held_after;
+        if (held_set(held_after) && held_after == held) {
+            run.summary = polished;
+            break;
+        }
+        ceres::Solve(so, &problem, &run.summary);
+        count(run.summary);
+    }
+    run.summary.initial_cost = initial_cost;
+    run.iterations = iterations;
+    return run;
+}
+
+// The grid-start points: the `count` best of the tensor grid over the parameters without an
+// initial value (others at their initial value), in u coordinates, by profiled SSE.
+std::vector<std::vector<double>> grid_starts(const Evaluator& e, const LeastSquaresProblem& P,
+                                             const LeastSquaresOptions& O, int count) {
+    const int n = e.n();
+    std::vector<double> base(static_cast<std::size_t>(n));
+    std::vector<int> free;
+    std::vector<std::vector<double>> axes;
+    for (int j = 0; j < n; ++j) {
+        const ParameterSpec& s = P.parameters[static_cast<std::size_t>(j)];
+        if (s.initial) {
+            base[static_cast<std::size_t>(j)] = to_u(s.transform, *s.initial);
+            continue;
+        }
+        const double lo = to_u(s.transform, s.start_lower.value_or(s.lower));
+        const double hi = to_u(s.transform, s.start_upper.value_or(s.upper));
+        const int g = s.grid_points > 0 ? s.grid_points : O.grid_points;
+        std::vector<double> axis(static_cast<std::size_t>(g));
+        for (int k = 0; k < g; ++k)
+            axis[static_cast<std::size_t>(k)] = lo + (hi - lo) * k / (g - 1);
+        free.push_back(j);
+        axes.push_back(std::move(axis));
+    }
+    if (free.empty()) return {base};
+    double total = 1.0;
+    for (const auto& a : axes) total *= static_cast<double>(a.size());
+    if (total > 1e6)
+        throw InvalidArgument("grid start: " + fmt(total) +
+                              " points (more than 1e6); give initial values or fewer points");
+    std::vector<std::pair<double, std::vector<double>>> scored;
+    std::vector<std::size_t> idx(free.size(), 0);
+    std::vector<double> r(e.size());
+    for (;;) {
+        std::vector<double> u = base;
+        for (std::size_t a = 0; a < free.size(); ++a)
+            u[static_cast<std::size_t>(free[a])] = axes[a][idx[a]];
+        double sse = kInf;
+        if (e.residuals(u.data(), e.gain() == GainMode::None ? GainMode::None : GainMode::Profiled,
+                        false, r.data())) {
+            sse = 0.0;
+            for (double v : r) sse += v * v;
+            if (!std::isfinite(sse)) sse = kInf;
+        }
+        scored.emplace_back(sse, std::move(u));
+        std::size_t a = 0;
+        while (a < free.size() && ++idx[a] == axes[a].size()) idx[a++] = 0;
+        if (a == free.size()) break;
+    }
+    std::stable_sort(scored.begin(), scored.end(),
+                     [](const auto& l, const auto& rr) { return l.first < rr.first; });
+    std::vector<std::vector<double>> out;
+    for (const auto& [sse, u] : scored) {
+        if (static_cast<int>(out.size()) >= count) break;
+        if (std::isfinite(sse) || out.empty()) out.push_back(u);
+    }
+    return out;
+}
+
+// Jacobian of the unprojected residuals r_i = √w_i residual(K M_i(θ(u)), y_i) over [u..., K] at
+// the solution: dM/du by bounded central differences, the chain rule through the residual, the
+// gain column analytic; rows scaled by √ρ'(r²) for a robust loss. False when it cannot be computed.
+bool jacobian(const Evaluator& e, const LeastSquaresProblem& P, std::vector<double> u, double K,
+              const std::vector<double>& M, const std::vector<double>& r, Eigen::MatrixXd& J) {
+    const int n = e.n();
+    const bool has_gain = e.gain() != GainMode::None;
+    const auto N = static_cast<Eigen::Index>(e.size());
+    J.setZero(N, n + (has_gain ? 1 : 0));
+    const std::vector<double>& w = e.weights();
+    // d r_i / d(K M_i).
+    std::vector<double> drdKM(e.size(), 0.0);
+    for (std::size_t i = 0; i < e.size(); ++i) {
+        if (w[i] == 0.0) continue;
+        const double sw = std::sqrt(w[i]);
+        drdKM[i] = P.residual == ResidualType::Absolute   ? sw
+                   : P.residual == ResidualType::Relative ? sw / P.data[i]
+                                                          : sw / (K * M[i]);
+    }
+    auto f = [&e](const double* uu, std::vector<double>& out) { return e.model(uu, out); };
+    std::vector<double> dM;
+    for (int j = 0; j < n; ++j) {
+        if (!bounded_difference(f, u, static_cast<std::size_t>(j), e.lower(j), e.upper(j), M, dM))
+            return false;
+        for (Eigen::Index i = 0; i < N; ++i)
+            J(i, j) = drdKM[static_cast<std::size_t>(i)] * K * dM[static_cast<std::size_t>(i)];
+    }
+    if (has_gain)
+        for (Eigen::Index i = 0; i < N; ++i)
+            J(i, n) = drdKM[static_cast<std::size_t>(i)] * M[static_cast<std::size_t>(i)];
+    if (const ceres::LossFunction* loss = e.loss())
+        for (Eigen::Index i = 0; i < N; ++i) {
+            double rho[3];
+            const double ri = r[static_cast<std::size_t>(i)];
+            loss->Evaluate(ri * ri, rho);
+            J.row(i) *= std::sqrt(std::max(rho[1], 0.0));
+        }
+    return J.allFinite();
+}
+
+// Identifiability of the columns `cols` of J: the names of the parameters that the data do not
+// determine (empty when J restricted to cols has full column rank).
+std::vector<int> unidentified(const Eigen::MatrixXd& J, const std::vector<int>& cols, double tol) {
+    std::vector<int> bad;
+    if (cols.empty()) return bad;
+    Eigen::VectorXd norms(static_cast<Eigen::Index>(cols.size()));
+    for (std::size_t a = 0; a < cols.size(); ++a)
+        norms(static_cast<Eigen::Index>(a)) = J.col(cols[a]).norm();
+    const double max_norm = norms.maxCoeff();
+    std::vector<int> live;
+    for (std::size_t a = 0; a < cols.size(); ++a) {
+        if (!(norms(static_cast<Eigen::Index>(a)) > tol * max_norm))
+            bad.push_back(cols[a]);  // no effect on the residuals
+        else
+            live.push_back(cols[a]);
+    }
+    if (live.size() >= 2) {
+        Eigen::MatrixXd S(J.rows(), static_cast<Eigen::Index>(live.size()));
+        for (std::size_t a = 0; a < live.size(); ++a)
+            S.col(static_cast<Eigen::Index>(a)) = J.col(live[a]) / J.col(live[a]).norm();
+        Eigen::JacobiSVD<Eigen::MatrixXd> svd(S, Eigen::ComputeThinV);
+        const Eigen::VectorXd sv = svd.singularValues();
+        const Eigen::MatrixXd& V = svd.matrixV();
+        std::vector<bool> flagged(live.size(), false);
+        for (Eigen::Index k = 0; k < sv.size(); ++k) {
+            if (sv(k) > tol * sv(0)) continue;
+            for (std::size_t a = 0; a < live.size(); ++a)
+                if (std::abs(V(static_cast<Eigen::Index>(a), k)) >= 0.1) flagged[a] = true;
+        }
+        for (std::size_t a = 0; a < live.size(); ++a)
+            if (flagged[a]) bad.push_back(live[a]);
+    }
+    std::sort(bad.begin(), bad.end());
+    return bad;
+}
+
+// (JᵀJ)⁻¹ over the columns `cols` (others zero), from an SVD; false when rank deficient.
+bool inverse_normal_matrix(const Eigen::MatrixXd& J, const std::vector<int>& cols,
+                           Eigen::MatrixXd& C) {
+    C.setZero(J.cols(), J.cols());
+    if (cols.empty()) return true;
+    Eigen::MatrixXd S(J.rows(), static_cast<Eigen::Index>(cols.size()));
+    for (std::size_t a = 0; a < cols.size(); ++a)
+        S.col(static_cast<Eigen::Index>(a)) = J.col(cols[a]);
+    Eigen::JacobiSVD<Eigen::MatrixXd> svd(S, Eigen::ComputeThinV);
+    const Eigen::VectorXd sv = svd.singularValues();
+    if (!(sv(sv.size() - 1) > 1e-12 * sv(0))) return false;
+    const Eigen::VectorXd inv2 = sv.array().square().inverse();
+    const Eigen::MatrixXd Cs = svd.matrixV() * inv2.asDiagonal() * svd.matrixV().transpose();
+    for (std::size_t a = 0; a < cols.size(); ++a)
+        for (std::size_t b = 0; b < cols.size(); ++b)
+            C(cols[a], cols[b]) = Cs(static_cast<Eigen::Index>(a), static_cast<Eigen::Index>(b));
+    return C.allFinite();
+}
+
+std::string join_names(const std::vector<FitParameter>& ps, const std::vector<int>& idx) {
+    std::string s;
+    for (int j : idx) s += (s.empty() ? "" : ", ") + ps[static_cast<std::size_t>(j)].name;
+    return s;
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------------
+
+double optimal_gain(std::span<const double> model, std::span<const double> data,
+                    std::span<const double> weights, ResidualType residual) {
+    double num = 0.0, den = 0.0;
+    for (std::size_t i = 0; i < model.size(); ++i) {
+        const double w = weights.empty() ? 1.0 : weights[i];
+        if (w == 0.0) continue;
+        const double M = model[i], y = data[i];
+        switch (residual) {
+            case ResidualType::Relative:
+                num += w * M / y;
+                den += w * M * M / (y * y);
+                break;
+            case ResidualType::Absolute:
+                num += w * M * y;
+                den += w * M * M;
+                break;
+            case ResidualType::Log:
+                if (!(M > 0.0 && y > 0.0)) return kNaN;
+                num += w * (std::log(y) - std::log(M));
+                den += w;
+                break;
+        }
+    }
+    if (!(den > 0.0) || !std::isfinite(den)) return kNaN;
+    return residual == ResidualType::Log ? std::exp(num / den) : num / den;
+}
+
+double profiled_sse(const LeastSquaresProblem& problem, std::span<const double> theta,
+                    double* gain) {
+    validate(problem, LeastSquaresOptions{});
+    if (theta.size() != problem.parameters.size())
+        throw InvalidArgument("theta: " + std::to_string(theta.size()) + " values for " +
+                              std::to_string(problem.parameters.size()) + " parameters");
+    const GainMode mode = problem.gain == GainMode::None ? GainMode::None : GainMode::Profiled;
+    const Evaluator e(problem, LeastSquaresOptions{}, mode);
+    std::vector<double> u(theta.size()), r(problem.data.size());
+    for (std::size_t j = 0; j < theta.size(); ++j)
+        u[j] = to_u(problem.parameters[j].transform, theta[j]);
+    if (!e.residuals(u.data(), mode, false, r.data(), gain)) return kInf;
+    double sse = 0.0;
+    for (double v : r) sse += v * v;
+    return std::isfinite(sse) ? sse : kInf;
+}
+
+const FitParameter& LeastSquaresResult::parameter(std::string_view name) const {
+    for (const auto& p : parameters)
+        if (p.name == name) return p;
+    std::string names;
+    for (const auto& p : parameters) names += (names.empty() ? "" : ", ") + p.name;
+    throw InvalidArgument("fit parameter '" + std::string(name) +
+                          "' does not exist; have: " + names);
+}
+
+std::string LeastSquaresResult::brief_report() const {
+    std::string s = "roughscope least squares: " + std::string(to_string(status)) + " after " +
+                    std::to_string(iterations) + " iterations (" + std::to_string(evaluations) +
+                    " model evaluations); N = " + std::to_string(num_data) +
+                    ", p = " + std::to_string(num_parameters) + ";";
+    for (const auto& p : parameters) {
+        s += " " + p.name + " = " + fmt(p.value);
+        if (covariance_available && !p.at_bound) s += " +/- " + fmt(p.std_error, 3);
+        if (p.at_bound) s += " (at bound)";
+        s += ";";
+    }
+    s += " SSE = " + fmt(sse) + ", AIC = " + fmt(aic) + ". " + message;
+    return s;
+}
+
+LeastSquaresResult solve_least_squares(const LeastSquaresProblem& P, const LeastSquaresOptions& O) {
+    validate(P, O);
+    const GainMode mode =
+        P.gain == GainMode::Profiled && O.loss != LossType::None ? GainMode::Free : P.gain;
+    const Evaluator e(P, O, mode);
+    const int n = e.n();
+    const bool has_gain = P.gain != GainMode::None;
+    const int p = n + (has_gain ? 1 : 0);
+    const std::vector<double>& w = e.weights();
+    const int N =
+        static_cast<int>(std::count_if(w.begin(), w.end(), [](double v) { return v > 0; }));
+
+    LeastSquaresResult res;
+    res.num_data = N;
+    res.num_parameters = p;
+    for (const ParameterSpec& s : P.parameters)
+        res.parameters.push_back({s.name, kNaN, 0.0, s.lower, s.upper, false});
+    if (has_gain) res.parameters.push_back({"gain", kNaN, 0.0, -kInf, kInf, false});
+
+    // Starts, then one Ceres run per start; the lowest final cost wins.
+    const std::vector<std::vector<double>> starts = grid_starts(e, P, O, O.num_starts);
+    std::vector<double> r(e.size());
+    bool have_run = false;
+    Run best;
+    for (std::vector<double> x : starts) {
+        if (mode == GainMode::Free) {
+            double K = 1.0;
+            if (!e.residuals(x.data(), GainMode::Profiled, false, r.data(), &K)) K = 1.0;
+            x.push_back(K);
+        }
+        Run run = solve_from(e, O, std::move(x));
+        res.iterations += run.iterations;
+        const bool usable = run.summary.termination_type != ceres::FAILURE &&
+                            run.summary.termination_type != ceres::USER_FAILURE;
+        const bool best_usable = have_run && best.summary.termination_type != ceres::FAILURE &&
+                                 best.summary.termination_type != ceres::USER_FAILURE;
+        if (!have_run ||
+            (usable && (!best_usable || run.summary.final_cost < best.summary.final_cost))) {
+            best = std::move(run);
+            have_run = true;
+        }
+    }
+    res.initial_cost = best.summary.initial_cost;
+    res.final_cost = best.summary.final_cost;
+    res.message = best.summary.message;
+    switch (best.summary.termination_type) {
+        case ceres::CONVERGENCE:
+            res.status = SolverStatus::Converged;
+            break;
+        case ceres::NO_CONVERGENCE:
+            res.status = SolverStatus::NoConvergence;
+            break;
+        default:
+            res.status = SolverStatus::Failed;
+            break;
+    }
+
+    // The solution: model, gain, residuals (unrobustified).
+    const std::vector<double>& x = best.x;
+    std::vector<double> M;
+    double K = 1.0;
+    bool finite = e.model(x.data(), M);
+    if (finite) {
+        if (mode == GainMode::Profiled)
+            K = optimal_gain(M, P.data, w, P.residual);
+        else if (mode == GainMode::Free)
+            K = x[static_cast<std::size_t>(n)];
+        std::vector<double> xk(x.begin(), x.begin() + n);
+        if (has_gain) xk.push_back(K);
+        finite =
+            std::isfinite(K) &&
+            e.residuals(xk.data(), has_gain ? GainMode::Free : GainMode::None, false, r.data());
+    }
+    res.evaluations = e.evaluations();
+    for (int j = 0; j < n; ++j) {
+        const ParameterSpec& s = P.parameters[static_cast<std::size_t>(j)];
+        FitParameter& fp = res.parameters[static_cast<std::size_t>(j)];
+        const double u = x[static_cast<std::size_t>(j)];
+        fp.value = to_theta(s.transform, u);
+        fp.at_bound = on_bound(e, j, u);
+    }
+    if (has_gain) res.parameters.back().value = K;
+    res.gain = K;
+    if (!finite) {
+        res.status = SolverStatus::Failed;
+        res.message += "; the model cannot be evaluated at the solution";
+        res.evaluations = e.evaluations();
+        return res;
+    }
+    res.model = M;
+    res.predicted.resize(M.size());
+    for (std::size_t i = 0; i < M.size(); ++i) res.predicted[i] = K * M[i];
+    res.residuals = r;
+    double sse = 0.0;
+    for (double v : r) sse += v * v;
+    res.sse = sse;
+    const double sse_floor = std::max(sse / N, std::numeric_limits<double>::min());
+    res.aic = N * std::log(sse_floor) + 2.0 * p;
+    res.aicc = N - p - 1 > 0 ? res.aic + 2.0 * p * (p + 1) / double(N - p - 1) : kInf;
+
+    // Identifiability and covariance. A parameter on a bound is "held" there when the gradient of
+    // the cost pushes it out of the box (|cos(J_j, r)| > 1e-4 with the outward sign): it is then
+    // fixed by the bound and left out of the rank test. One on a bound with no such pull (a flat
+    // direction that drifted to the bound) is tested like a free one.
+    std::vector<int> all(static_cast<std::size_t>(p)), free_cols;
+    std::iota(all.begin(), all.end(), 0);
+    std::vector<int> bad;
+    Eigen::MatrixXd J;
+    bool have_J = false;
+    if (N < p) {
+        bad = all;
+        res.message += "; " + std::to_string(N) + " data points (with weight > 0) for " +
+                       std::to_string(p) + " parameters: at least " + std::to_string(p) +
+                       " are needed";
+    } else {
+        std::vector<double> u(x.begin(), x.begin() + n);
+        have_J = jacobian(e, P, u, K, M, r, J);
+        if (have_J) {
+            const Eigen::Map<const Eigen::VectorXd> rv(r.data(),
+                                                       static_cast<Eigen::Index>(r.size()));
+            for (int j = 0; j < p; ++j) {
+                bool held = false;
+                if (res.parameters[static_cast<std::size_t>(j)].at_bound) {
+                    const double g = J.col(j).dot(rv);
+                    const double scale = J.col(j).norm() * rv.norm();
+                    const double uj = x[static_cast<std::size_t>(j)];
+                    const bool at_lower =
+                        std::abs(uj - e.lower(j)) <= 1e-9 * std::max(1.0, std::abs(uj));
+                    held = scale > 0.0 && (at_lower ? g : -g) > 1e-4 * scale;
+                }
+                if (!held) free_cols.push_back(j);
+            }
+            bad = unidentified(J, free_cols, O.rank_tolerance);
+        }
+        if (!bad.empty())
+            res.message += "; the Jacobian is rank deficient: the data do not determine " +
+                           join_names(res.parameters, bad) +
+                           " (a parameter without effect, repeated geometries or constant "
+                           "data, or parameters that trade off exactly)";
+    }
+    for (int j : bad)
+        res.not_identifiable.push_back(res.parameters[static_cast<std::size_t>(j)].name);
+    if (!bad.empty() && res.status != SolverStatus::Failed)
+        res.status = SolverStatus::NotIdentifiable;
+    res.evaluations = e.evaluations();
+
+    res.covariance = Eigen::MatrixXd::Zero(p, p);
+    if (have_J && bad.empty()) {
+        Eigen::MatrixXd C;
+        const bool full =
+            unidentified(J, all, O.rank_tolerance).empty() && inverse_normal_matrix(J, all, C);
+        const bool ok = full || inverse_normal_matrix(J, free_cols, C);
+        if (ok && (N > p || !O.scale_covariance)) {
+            const double scale = O.scale_covariance ? sse / (N - p) : 1.0;
+            std::vector<double> d(static_cast<std::size_t>(p), 1.0);  // dθ/du
+            for (int j = 0; j < n; ++j)
+                if (P.parameters[static_cast<std::size_t>(j)].transform == Transform::Log)
+                    d[static_cast<std::size_t>(j)] =
+                        res.parameters[static_cast<std::size_t>(j)].value;
+            for (int a = 0; a < p; ++a)
+                for (int b = 0; b < p; ++b)
+                    res.covariance(a, b) = scale * C(a, b) * d[static_cast<std::size_t>(a)] *
+                                           d[static_cast<std::size_t>(b)];
+            res.covariance_available = res.covariance.allFinite();
+        }
+        if (!res.covariance_available)
+            res.message += N > p ? "; covariance unavailable (singular Jacobian)"
+                                 : "; covariance unavailable (N = p: no degrees of freedom)";
+    } else if (!have_J && N >= p) {
+        res.message += "; covariance unavailable (the Jacobian cannot be evaluated)";
+    }
+    if (res.covariance_available)
+        for (int j = 0; j < p; ++j)
+            res.parameters[static_cast<std::size_t>(j)].std_error =
+                std::sqrt(std::max(0.0, res.covariance(j, j)));
+
+    std::vector<int> at;
+    for (int j = 0; j < n; ++j)
+        if (res.parameters[static_cast<std::size_t>(j)].at_bound) at.push_back(j);
+    if (!at.empty()) {
+        std::string list;
+        for (int j : at) {
+            const FitParameter& fp = res.parameters[static_cast<std::size_t>(j)];
+            list += (list.empty() ? "" : ", ") + fp.name + " = " + fmt(fp.value) + " in [" +
+                    fmt(fp.lower) + ", " + fmt(fp.upper) + "]";
+        }
+        res.message += "; on a bound: " + list;
+        if (res.status == SolverStatus::Converged) res.status = SolverStatus::AtBound;
+    }
+    return res;
+}
+
+}  // namespace roughscope
