@@ -18,6 +18,7 @@
 #include <nlohmann/json.hpp>
 
 #include "roughscope/core/errors.hpp"
+#include "roughscope/core/names.hpp"
 #include "roughscope/estimation/estimation.hpp"
 #include "roughscope/scattering/beckmann.hpp"
 
@@ -452,10 +453,10 @@ std::string_view display_name(ComparisonModel model) { return info(model).label;
 ComparisonModel parse_comparison_model(std::string_view name) {
     std::string list;
     for (const ModelInfo& i : kModelInfo) {
-        if (name == i.key) return i.model;
+        if (name_matches(i.key, name)) return i.model;
         list += (list.empty() ? "" : ", ") + std::string(i.key);
     }
-    throw InvalidArgument("model '" + std::string(name) + "' is not one of: " + list);
+    throw_unknown_name("comparison model", name, list);
 }
 
 bool is_fit(ComparisonModel model) {
@@ -473,15 +474,12 @@ bool is_fit(ComparisonModel model) {
 }
 
 std::string_view to_string(FitStatus status) {
-    switch (status) {
-        case FitStatus::Converged:
-            return "converged";
-        case FitStatus::AtBound:
-            return "at_bound";
-        case FitStatus::Failed:
-            return "failed";
-    }
-    return "failed";
+    static constexpr std::array<NameEntry<FitStatus>, 3> kFitStatusNames{{
+        {"converged", FitStatus::Converged},
+        {"at_bound", FitStatus::AtBound},
+        {"failed", FitStatus::Failed},
+    }};
+    return name_of(kFitStatusNames, status);
 }
 
 std::optional<double> ModelResult::parameter(std::string_view name) const {

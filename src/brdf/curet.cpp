@@ -13,6 +13,7 @@
 #include <system_error>
 
 #include "roughscope/core/errors.hpp"
+#include "roughscope/core/names.hpp"
 
 namespace roughscope {
 namespace {
@@ -179,27 +180,22 @@ bool has_curet_files(const fs::path& dir) {
 
 }  // namespace
 
-std::string_view to_string(CuretChannel channel) {
-    switch (channel) {
-        case CuretChannel::Mean:
-            return "mean";
-        case CuretChannel::Red:
-            return "red";
-        case CuretChannel::Green:
-            return "green";
-        case CuretChannel::Blue:
-            return "blue";
-    }
-    return "mean";
-}
+// The file letters a, r, g, b are accepted as aliases.
+constexpr std::array<NameEntry<CuretChannel>, 8> kChannelNames{{
+    {"mean", CuretChannel::Mean},
+    {"red", CuretChannel::Red},
+    {"green", CuretChannel::Green},
+    {"blue", CuretChannel::Blue},
+    {"a", CuretChannel::Mean},
+    {"r", CuretChannel::Red},
+    {"g", CuretChannel::Green},
+    {"b", CuretChannel::Blue},
+}};
+
+std::string_view to_string(CuretChannel channel) { return name_of(kChannelNames, channel); }
 
 CuretChannel parse_curet_channel(std::string_view name) {
-    if (name == "mean" || name == "a") return CuretChannel::Mean;
-    if (name == "red" || name == "r") return CuretChannel::Red;
-    if (name == "green" || name == "g") return CuretChannel::Green;
-    if (name == "blue" || name == "b") return CuretChannel::Blue;
-    throw InvalidArgument("channel '" + std::string(name) +
-                          "' is not one of: mean (a), red (r), green (g), blue (b)");
+    return parse_name(kChannelNames, "channel", name);
 }
 
 std::string curet_brdf_file_name(CuretChannel channel) {
