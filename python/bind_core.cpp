@@ -18,6 +18,7 @@
 #include <cmath>
 #include <cstdint>
 #include <exception>
+#include <filesystem>
 #include <limits>
 #include <optional>
 #include <string>
@@ -29,8 +30,10 @@
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
+#include <pybind11/stl/filesystem.h>
 
 #include "bindings.hpp"
+#include "roughscope/io/data_locator.hpp"
 #include "roughscope/roughscope.hpp"
 
 #if defined(__x86_64__) && defined(__GLIBC__) && (defined(__GNUC__) || defined(__clang__))
@@ -784,6 +787,39 @@ void bind_core(py::module_& m) {
     m.attr("ROUGHNESS_CLASSES") = py::tuple(py::cast(enum_names(kRoughnessClasses)));
     m.attr("SLIGHTLY_ROUGH_MAX_G") = kSlightlyRoughMaxG;
     m.attr("VERY_ROUGH_MIN_G") = kVeryRoughMinG;
+
+    // ---- Reference data beside the project (io/data_locator.hpp) ----------------------------
+    using Starts = std::vector<std::filesystem::path>;
+    m.def(
+        "shared_dir_candidates",
+        [](const Starts& extra_starts) { return io::shared_dir_candidates(extra_starts); },
+        arg("extra_starts") = Starts{},
+        "The shared folders searched, in order: $ROUGHSCOPE_SHARED_DIR alone when set, else "
+        "../shared from the current directory upward, then from each of extra_starts.");
+    m.def(
+        "find_shared",
+        [](const std::string& relative, const Starts& extra_starts) {
+            return io::find_shared(relative, extra_starts);
+        },
+        arg("relative"), arg("extra_starts") = Starts{},
+        "Path of `relative` in the first shared folder holding it, or None.");
+    m.def(
+        "paper_tables_path",
+        [](const Starts& extra_starts) { return io::paper_tables_path(extra_starts); },
+        arg("extra_starts") = Starts{},
+        "Path of reference/paper-tables.json in the shared folder, or None.");
+    m.def(
+        "curet_data_dir",
+        [](const Starts& extra_starts) { return io::curet_data_dir(extra_starts); },
+        arg("extra_starts") = Starts{},
+        "The shared folder's data/curet (holding table.txt and abrdf.dat), or None.");
+    m.def(
+        "shared_search_description",
+        [](const std::string& relative) { return io::shared_search_description(relative); },
+        arg("relative"), "One line saying where `relative` is looked for.");
+    m.def("shared_data_required", &io::shared_data_required,
+          "True when ROUGHSCOPE_REQUIRE_SHARED_DATA=1: tests must fail, not skip, when the "
+          "shared data are missing.");
 
     // ---- Private knobs for tests and benchmarks ---------------------------------------------
     m.def(
