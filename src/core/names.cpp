@@ -3,13 +3,12 @@
 
 #include <cctype>
 
+#include "roughscope/core/numbers.hpp"
+
 namespace roughscope {
 
 std::string normalize_name(std::string_view name) {
-    constexpr std::string_view kSpace = " \t\r\n\v\f";
-    const auto first = name.find_first_not_of(kSpace);
-    if (first == std::string_view::npos) return {};
-    name = name.substr(first, name.find_last_not_of(kSpace) - first + 1);
+    name = trim_space(name);
     std::string out;
     out.reserve(name.size());
     for (const char c : name)

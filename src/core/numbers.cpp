@@ -12,15 +12,6 @@
 namespace roughscope {
 namespace {
 
-constexpr std::string_view kSpace = " \t\r\n\v\f";
-
-std::string_view trim(std::string_view s) {
-    const auto first = s.find_first_not_of(kSpace);
-    if (first == std::string_view::npos) return {};
-    const auto last = s.find_last_not_of(kSpace);
-    return s.substr(first, last - first + 1);
-}
-
 [[noreturn]] void refuse_non_finite(std::string_view name) {
     throw Error("internal error: " + std::string(name) +
                 " is not a finite number; refusing to print it");
@@ -34,8 +25,16 @@ std::string printf_g(double value, int digits) {
 
 }  // namespace
 
+std::string_view trim_space(std::string_view s) {
+    constexpr std::string_view kSpace = " \t\r\n\v\f";
+    const auto first = s.find_first_not_of(kSpace);
+    if (first == std::string_view::npos) return {};
+    const auto last = s.find_last_not_of(kSpace);
+    return s.substr(first, last - first + 1);
+}
+
 std::optional<double> try_parse_number(std::string_view text, std::string& reason) {
-    std::string_view s = trim(text);
+    std::string_view s = trim_space(text);
     if (s.empty()) {
         reason = "empty (a number is required)";
         return std::nullopt;
@@ -66,7 +65,7 @@ double parse_number(std::string_view text, std::string_view what) {
     std::string reason;
     const auto value = try_parse_number(text, reason);
     if (!value)
-        throw InvalidArgument(std::string(what) + ": '" + std::string(trim(text)) + "' is " +
+        throw InvalidArgument(std::string(what) + ": '" + std::string(trim_space(text)) + "' is " +
                               reason);
     return *value;
 }
@@ -83,7 +82,8 @@ std::vector<double> parse_number_list(std::string_view text, std::size_t count,
     }
     if (parts.size() != count)
         throw InvalidArgument(std::string(what) + ": expected " + std::to_string(count) +
-                              " comma-separated numbers, got '" + std::string(trim(text)) + "'");
+                              " comma-separated numbers, got '" + std::string(trim_space(text)) +
+                              "'");
     std::vector<double> out;
     out.reserve(count);
     for (std::size_t i = 0; i < parts.size(); ++i)

@@ -30,12 +30,6 @@ bool is_space(char c) {
 
 }  // namespace
 
-std::string_view trim(std::string_view s) {
-    while (!s.empty() && is_space(s.front())) s.remove_prefix(1);
-    while (!s.empty() && is_space(s.back())) s.remove_suffix(1);
-    return s;
-}
-
 std::vector<std::string_view> split_fields(std::string_view line, char separator) {
     std::vector<std::string_view> out;
     std::size_t start = 0;

@@ -23,6 +23,10 @@
 
 namespace roughscope {
 
+// `text` without leading and trailing spaces, tabs, CR, LF, VT, FF (what the parser ignores; the
+// one trim of the library's text readers).
+std::string_view trim_space(std::string_view text);
+
 // Parses the whole of `text` as a finite double. Returns std::nullopt and sets `reason` ("empty
 // (a number is required)", "not a number", "not a finite number (NaN is not accepted)", "out of
 // the range of double-precision numbers", ...) otherwise.

@@ -26,13 +26,15 @@
 #include <string_view>
 #include <vector>
 
+#include "roughscope/core/numbers.hpp"
+
 namespace roughscope::io {
 
 // ---------------------------------------------------------------------------------------------
 // Lower level: lines and fields
 
-// `s` without leading and trailing spaces, tabs, CR and LF.
-std::string_view trim(std::string_view s);
+// `s` without leading and trailing spaces, tabs, CR and LF (core/numbers.hpp's trim_space).
+inline std::string_view trim(std::string_view s) { return trim_space(s); }
 
 // The fields of `line` between `separator`s, untrimmed ("a,,b" -> "a", "", "b"; "" -> one field).
 std::vector<std::string_view> split_fields(std::string_view line, char separator);

@@ -40,6 +40,12 @@ TEST(Numbers, ParsesWholeTextWithSurroundingSpaces) {
     EXPECT_EQ(parse_number(" 42 ", "x"), 42.0);
 }
 
+TEST(Numbers, TrimSpace) {
+    EXPECT_EQ(trim_space(" \t 1.5 \r\n"), "1.5");
+    EXPECT_EQ(trim_space("   "), "");
+    EXPECT_EQ(trim_space("a b"), "a b");
+}
+
 TEST(Numbers, RejectsAnythingButOneFiniteNumber) {
     EXPECT_EQ(reason_for(""), "empty (a number is required)");
     EXPECT_EQ(reason_for("   "), "empty (a number is required)");
