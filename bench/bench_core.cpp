@@ -11,7 +11,12 @@
 //                                       labelled "naive overflows" there)
 //        lambert_baseline/1M            cos θi over 1M random geometries (the baseline)
 //        very_rough/<eq>/<how>/1M       Eq. 4 / Eq. 5 over the same 1M geometries
+//        very_rough/<eq>/batch/1M       the batch kernel (scattering/brightness_batch.hpp) over
+//                                       the same geometries; its counters give the ratios
+//                                       speedup_vs_scalar (very_rough_brightness in a loop, timed
+//                                       in the same run) and time_vs_lambert (the baseline loop)
 // items_per_second counts evaluations; divide times by the baseline's for ratios.
+#include <chrono>
 #include <cmath>
 #include <random>
 #include <string>
@@ -20,6 +25,7 @@
 #include <benchmark/benchmark.h>
 
 #include "roughscope/scattering/beckmann.hpp"
+#include "roughscope/scattering/brightness_batch.hpp"
 #include "roughscope/scattering/factors.hpp"
 #include "roughscope/scattering/geometry.hpp"
 #include "roughscope/scattering/reflectance_models.hpp"
@@ -168,6 +174,56 @@ BENCHMARK(BM_very_rough_brightness<true>)
     ->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_very_rough_brightness<false>)
     ->Name("very_rough/eq5/very_rough_brightness/1M")
+    ->Unit(benchmark::kMillisecond);
+
+// The batch kernel over the same geometries (structure of arrays), with the ratios to the scalar
+// API and to the Lambert baseline measured in the same process.
+template <bool kGaussian>
+void BM_very_rough_batch(benchmark::State& state) {
+    const std::vector<Geometry>& geoms = random_geometries();
+    const Correlation c = kGaussian ? Correlation::Gaussian : Correlation::Exponential;
+    std::vector<double> ti, ts, ps, out(geoms.size());
+    for (const Geometry& g : geoms) {
+        ti.push_back(g.theta_i_rad);
+        ts.push_back(g.theta_s_rad);
+        ps.push_back(g.phi_s_rad);
+    }
+    const std::vector<double> m = {kSigmaOverT};
+    using Clock = std::chrono::steady_clock;
+    auto seconds = [](Clock::duration d) { return std::chrono::duration<double>(d).count(); };
+    // Baselines, timed once each with the same clock.
+    auto t0 = Clock::now();
+    double sum = 0.0;
+    for (const Geometry& g : geoms) sum += very_rough_brightness(g, kSigmaOverT, c);
+    const double scalar_s = seconds(Clock::now() - t0);
+    t0 = Clock::now();
+    for (const Geometry& g : geoms) sum += std::cos(g.theta_i_rad);
+    const double lambert_s = seconds(Clock::now() - t0);
+    benchmark::DoNotOptimize(sum);
+
+    double batch_s = 0.0;
+    std::size_t runs = 0;
+    for (auto _ : state) {
+        const auto t = Clock::now();
+        very_rough_brightness_batch({ti, ts, ps, m}, out, {c});
+        batch_s += seconds(Clock::now() - t);
+        ++runs;
+        benchmark::DoNotOptimize(out.data());
+        benchmark::ClobberMemory();
+    }
+    state.SetItemsProcessed(state.iterations() * geoms.size());
+    if (runs > 0 && batch_s > 0.0) {
+        const double per_run = batch_s / static_cast<double>(runs);
+        state.counters["speedup_vs_scalar"] = scalar_s / per_run;
+        state.counters["time_vs_lambert"] = per_run / lambert_s;
+    }
+    state.SetLabel(std::string(to_string(active_vector_isa())));
+}
+BENCHMARK(BM_very_rough_batch<true>)
+    ->Name("very_rough/eq4/batch/1M")
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_very_rough_batch<false>)
+    ->Name("very_rough/eq5/batch/1M")
     ->Unit(benchmark::kMillisecond);
 
 }  // namespace

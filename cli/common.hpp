@@ -24,6 +24,11 @@
 #include <nlohmann/json.hpp>
 
 #include "roughscope/core/errors.hpp"
+#include "roughscope/core/names.hpp"
+#include "roughscope/core/numbers.hpp"
+#include "roughscope/io/csv.hpp"
+#include "roughscope/io/data_locator.hpp"
+#include "roughscope/io/output_file.hpp"
 #include "roughscope/scattering/factors.hpp"
 
 namespace roughscope::cli {
@@ -61,25 +66,32 @@ void print_error(std::string_view message);
 // ---------------------------------------------------------------------------------------------
 // Numbers: strict parsing and safe printing
 
-// Parses the whole of `text` (surrounding spaces allowed, leading '+' allowed) as a finite
-// double with std::from_chars. Returns std::nullopt and sets `reason` otherwise ("not a number",
-// "not a finite number (nan)", ...).
-std::optional<double> parse_double(std::string_view text, std::string& reason);
+// The library's strict parser (roughscope/core/numbers.hpp): the whole of `text` (surrounding
+// spaces allowed, leading '+' allowed) as a finite double. Returns std::nullopt and sets `reason`
+// otherwise ("not a number", "not a finite number (NaN is not accepted)", ...).
+inline std::optional<double> parse_double(std::string_view text, std::string& reason) {
+    return roughscope::try_parse_number(text, reason);
+}
 
 // As parse_double but throws InvalidArgument "<what>: '<text>' is <reason>".
-double parse_double_or_throw(std::string_view text, std::string_view what);
+inline double parse_double_or_throw(std::string_view text, std::string_view what) {
+    return roughscope::parse_number(text, what);
+}
 
 // Parses "a,b,c" into exactly `count` finite numbers; throws InvalidArgument naming `what`.
-std::vector<double> parse_number_list(std::string_view text, std::size_t count,
-                                      std::string_view what);
+using roughscope::parse_number_list;
 
 // Rounds to `digits` significant digits (the precision of every printed result).
 inline constexpr int kPrintDigits = 10;
-double round_significant(double value, int digits = kPrintDigits);
+inline double round_significant(double value, int digits = kPrintDigits) {
+    return roughscope::round_significant(value, digits);
+}
 
 // Human-readable result with kPrintDigits significant digits ("%.10g"). Throws roughscope::Error
 // naming `name` if value is NaN or infinite: results are never printed as NaN.
-std::string format_result(double value, std::string_view name = "result");
+inline std::string format_result(double value, std::string_view name = "result") {
+    return roughscope::format_significant(value, kPrintDigits, name);
+}
 
 // JSON number rounded to kPrintDigits significant digits; throws roughscope::Error naming `name`
 // if the value is not finite.
@@ -96,39 +108,23 @@ std::string dump_json(const json& value);
 // ---------------------------------------------------------------------------------------------
 // Files
 
-// Writes `content` to `path` atomically: a temporary file in the same directory is written,
-// flushed and renamed over `path`. On any failure the temporary file is removed, `path` is left
-// untouched, and DataError("cannot write <path>: <reason>") is thrown.
-void write_file_atomic(const std::filesystem::path& path, const std::string& content);
-
-// Writes `content` to `path` atomically when given, else to stdout.
-void write_output(const std::optional<std::filesystem::path>& path, const std::string& content);
-
-// One data row of a CSV file read by read_csv_with_header.
-struct CsvRow {
-    std::size_t line = 0;                        // 1-based line number in the file
-    std::map<std::string, double> values;        // parsed required + present optional columns
-    std::map<std::string, std::string> text;     // every column, trimmed, as written
-    double at(const std::string& column) const;  // required column (asserted present)
-    std::optional<double> find(const std::string& column) const;  // optional column
-};
-
-// Reads a comma-separated file with a header line.
-//  * Blank lines and lines whose first non-space character is '#' are skipped (before or after
-//    the header); fields are trimmed of spaces/tabs; CRLF line ends are accepted.
-//  * The header must contain every column of `required`; columns of `optional` are parsed when
-//    present; other columns are kept as text only. Column names are case-sensitive.
-//  * Numeric fields are parsed strictly (parse_double): "nan", "inf", "1.5x" are rejected.
-//    An empty cell of an optional column means "not given"; an empty required cell is an error.
-// Errors throw DataError "<file>:<line>: <reason>" naming the column (missing file, missing
-// header, missing required column — listing columns found and required —, duplicate column,
-// wrong number of fields, bad number, no data rows).
-std::vector<CsvRow> read_csv_with_header(const std::filesystem::path& path,
-                                         const std::vector<std::string>& required,
-                                         const std::vector<std::string>& optional = {});
-
-// Quotes a CSV field only if it contains a comma, quote or newline.
-std::string csv_field(std::string_view text);
+// The library's writers and CSV reader (roughscope/io/output_file.hpp, roughscope/io/csv.hpp):
+//  * write_file_atomic(path, content): temporary file in the same directory, renamed over `path`;
+//    DataError("cannot write <path>: <reason>") and nothing left behind on failure;
+//  * write_output(path or nullopt, content): atomically to the file, else to stdout;
+//  * read_csv_with_header(path, required, optional): every row of a CSV file with a header
+//    (comments, blank lines, CRLF, UTF-8 BOM accepted; strict numbers; DataError
+//    "<file>:<line>: <reason>" naming the column);
+//  * csv_field(text): quotes a field only if it contains a comma, quote or line break.
+using roughscope::io::csv_field;
+using roughscope::io::CsvRow;
+using roughscope::io::write_file_atomic;
+using roughscope::io::write_output;
+inline std::vector<CsvRow> read_csv_with_header(const std::filesystem::path& path,
+                                                const std::vector<std::string>& required,
+                                                const std::vector<std::string>& optional = {}) {
+    return roughscope::io::read_csv(path, required, optional);
+}
 
 // ---------------------------------------------------------------------------------------------
 // Options with validation at parse time (errors name the flag and the valid range)
@@ -163,8 +159,9 @@ CLI::Validator positive_validator(const std::string& unit = "");
 CLI::Validator non_negative_validator(const std::string& unit = "");
 CLI::Validator range_validator(double lo, double hi);
 
-// Lower-cases `name` and replaces '-' by '_' (so "very-rough" == "very_rough").
-std::string normalize_name(std::string_view name);
+// Lower-cases `name` and replaces '-' by '_' (so "very-rough" == "very_rough"): the library's
+// enum-name scheme (roughscope/core/names.hpp).
+using roughscope::normalize_name;
 
 // An enum option parsed by one of the library's parse_* functions (parse_correlation,
 // parse_geometric_factor, parse_regime, parse_radiometry, ...). The value is normalised with

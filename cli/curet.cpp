@@ -315,8 +315,9 @@ void register_curet(CLI::App& app) {
 
     const std::string data = "CUReT data";
     cmd->add_option("--data", a.data_dir,
-                    "Directory with table.txt and abrdf.dat (default: ../shared/data/curet when "
-                    "it exists, else $ROUGHSCOPE_CURET)")
+                    "Directory with table.txt and abrdf.dat (default: $ROUGHSCOPE_SHARED_DIR/"
+                    "data/curet, else ../shared/data/curet searched upward from the current "
+                    "directory, else $ROUGHSCOPE_CURET)")
         ->group(data);
     add_enum_option(*cmd, "--channel", a.channel, parse_curet_channel,
                     "mean (abrdf.dat, default), red, green or blue")

@@ -1,10 +1,10 @@
 // `roughscope paper tables`: the paper's Tables 1, 2 and 3 recomputed from their printed inputs
 // with the §4 estimators, next to the printed values.
 //
-// The printed values are read from ../shared/reference/paper-tables.json (relative to the
-// current directory) or --reference FILE; they are not part of the repository. The library
-// recomputes them (serialize/paper_tables.hpp, where the agreement marks are defined); this file
-// only prints the document as text or JSON.
+// The printed values are read from ../shared/reference/paper-tables.json (io/data_locator.hpp:
+// $ROUGHSCOPE_SHARED_DIR, else searched upward from the current directory) or --reference FILE;
+// they are not part of the repository. The library recomputes them (serialize/paper_tables.hpp,
+// where the agreement marks are defined); this file only prints the document as text or JSON.
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -33,7 +33,7 @@ namespace fs = std::filesystem;
 constexpr const char* kDefaultReference = "../shared/reference/paper-tables.json";
 
 struct Args {
-    std::string reference = kDefaultReference;
+    std::string reference;  // empty: found by io::paper_tables_path (io/data_locator.hpp)
     bool json_output = false;
     std::string output_path;
     CLI::Option* o_output{};
@@ -76,7 +76,9 @@ json load_reference(const fs::path& path) {
 }
 
 void run_tables(const Args& a) {
-    const fs::path path(a.reference);
+    const fs::path path = a.reference.empty()
+                              ? roughscope::io::paper_tables_path().value_or(kDefaultReference)
+                              : fs::path(a.reference);
     const json ref = load_reference(path);
     json out;
     out["reference"] = path.string();

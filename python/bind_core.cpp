@@ -14,12 +14,13 @@
 #include <algorithm>
 #include <array>
 #include <atomic>
-#include <bit>
 #include <cmath>
 #include <cstdint>
 #include <exception>
+#include <filesystem>
 #include <limits>
 #include <optional>
+#include <span>
 #include <string>
 #include <thread>
 #include <tuple>
@@ -29,16 +30,12 @@
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
+#include <pybind11/stl/filesystem.h>
 
 #include "bindings.hpp"
+#include "roughscope/io/data_locator.hpp"
 #include "roughscope/roughscope.hpp"
-
-#if defined(__x86_64__) && defined(__GLIBC__) && (defined(__GNUC__) || defined(__clang__))
-#define ROUGHSCOPE_HAVE_LIBMVEC 1
-#include <immintrin.h>
-#else
-#define ROUGHSCOPE_HAVE_LIBMVEC 0
-#endif
+#include "roughscope/scattering/brightness_batch.hpp"
 
 namespace py = pybind11;
 
@@ -290,429 +287,41 @@ constexpr std::array<RoughnessClass, 3> kRoughnessClasses = {
     RoughnessClass::SlightlyRough, RoughnessClass::ModeratelyRough, RoughnessClass::VeryRough};
 
 // =============================================================================================
-// very_rough_brightness: the array fast path
+// very_rough_brightness over arrays: the library's batch kernel (scattering/brightness_batch.hpp)
 // =============================================================================================
-//
-// Same physics as roughscope::very_rough_brightness (Eq. 4 / Eq. 5 shapes of beckmann.hpp times
-// the radiometric factor), evaluated in blocks of kBlock elements: each block is validated
-// (branch-free) in the same pass that computes it; sines and cosines come from short polynomials
-// on the validated ranges (below), the exponential from glibc's vector math library (AVX-512 8
-// lanes or AVX2 4 lanes) when the CPU has it, std:: otherwise, and the rest is arithmetic that
-// GCC auto-vectorises for the same instruction set, with
-//   q_xy² = (sin θi − sin θs)² + 4 sin θi sin θs sin²(φs/2)   (= sin²θi + sin²θs − 2 sinθi sinθs
-//   cos φs, written without cancellation), q_z² = (cos θi + cos θs)².
-
-// Instruction sets the kernel is compiled for; the best one the CPU has is picked at run time.
-enum class Isa { Generic, Avx2, Avx512 };
-enum class MathFn { Exp, InvPow32 };  // e^x; x^(−3/2) for x > 0
-
-template <class Fn>
-inline void apply_scalar(Fn fn, const double* x, double* y, ssize_t n) {
-    for (ssize_t j = 0; j < n; ++j) y[j] = fn(x[j]);
-}
-
-void apply_generic(MathFn fn, const double* x, double* y, ssize_t n) {
-    switch (fn) {
-        case MathFn::Exp:
-            return apply_scalar([](double v) { return std::exp(v); }, x, y, n);
-        case MathFn::InvPow32:
-            return apply_scalar([](double v) { return 1.0 / (v * std::sqrt(v)); }, x, y, n);
-    }
-}
-
-#if ROUGHSCOPE_HAVE_LIBMVEC
-// glibc's libmvec (linked through libm): AVX2 4-lane and AVX-512 8-lane exp, ≤ 4 ulp.
-#pragma GCC push_options
-#pragma GCC target("avx2,fma")
-extern "C" __m256d _ZGVdN4v_exp(__m256d);
-// x^(−3/2) = 1/(x √x), IEEE sqrt and division.
-__m256d inv_pow32_avx2(__m256d x) {
-    return _mm256_div_pd(_mm256_set1_pd(1.0), _mm256_mul_pd(x, _mm256_sqrt_pd(x)));
-}
-
-template <__m256d (*Fn)(__m256d)>
-void apply_avx2_fn(const double* x, double* y, ssize_t n) {
-    ssize_t j = 0;
-    for (; j + 4 <= n; j += 4) _mm256_storeu_pd(y + j, Fn(_mm256_loadu_pd(x + j)));
-    if (j < n) {  // the tail goes through the same vector function (position-independent)
-        alignas(32) double in[4] = {0.0, 0.0, 0.0, 0.0}, res[4];
-        for (ssize_t t = 0; j + t < n; ++t) in[t] = x[j + t];
-        _mm256_store_pd(res, Fn(_mm256_load_pd(in)));
-        for (ssize_t t = 0; j + t < n; ++t) y[j + t] = res[t];
-    }
-}
-
-void apply_avx2(MathFn fn, const double* x, double* y, ssize_t n) {
-    switch (fn) {
-        case MathFn::Exp:
-            return apply_avx2_fn<_ZGVdN4v_exp>(x, y, n);
-        case MathFn::InvPow32:
-            return apply_avx2_fn<inv_pow32_avx2>(x, y, n);
-    }
-}
-#pragma GCC pop_options
-
-#pragma GCC push_options
-#pragma GCC target("avx512f")
-extern "C" __m512d _ZGVeN8v_exp(__m512d);
-// x^(−3/2) without the divider (its sqrt + div cost ~10% of the Eq. 5 kernel): y ≈ 1/√x from
-// vrsqrt14pd (relative error < 2^−14), two Newton steps y += y (1 − x y²)/2 (error ~1.5 e² each,
-// then rounding: a few ulp), then y³. x = +inf gives 0 (as 1/(x √x) does), NaN stays NaN.
-__m512d inv_pow32_avx512(__m512d x) {
-    const __m512d one = _mm512_set1_pd(1.0), half = _mm512_set1_pd(0.5);
-    __m512d y = _mm512_maskz_rsqrt14_pd(0xFF, x);  // (maskz: no uninitialised-operand warning)
-    for (int step = 0; step < 2; ++step) {
-        const __m512d r = _mm512_fnmadd_pd(_mm512_mul_pd(x, y), y, one);  // 1 − x y²
-        y = _mm512_fmadd_pd(_mm512_mul_pd(half, y), r, y);
-    }
-    y = _mm512_maskz_mov_pd(_mm512_cmp_pd_mask(x, _mm512_set1_pd(HUGE_VAL), _CMP_NEQ_UQ), y);
-    return _mm512_mul_pd(_mm512_mul_pd(y, y), y);
-}
-
-template <__m512d (*Fn)(__m512d)>
-void apply_avx512_fn(const double* x, double* y, ssize_t n) {
-    ssize_t j = 0;
-    for (; j + 8 <= n; j += 8) _mm512_storeu_pd(y + j, Fn(_mm512_loadu_pd(x + j)));
-    if (j < n) {
-        const __mmask8 mask = static_cast<__mmask8>((1u << (n - j)) - 1u);
-        _mm512_mask_storeu_pd(y + j, mask, Fn(_mm512_maskz_loadu_pd(mask, x + j)));
-    }
-}
-
-void apply_avx512(MathFn fn, const double* x, double* y, ssize_t n) {
-    switch (fn) {
-        case MathFn::Exp:
-            return apply_avx512_fn<_ZGVeN8v_exp>(x, y, n);
-        case MathFn::InvPow32:
-            return apply_avx512_fn<inv_pow32_avx512>(x, y, n);
-    }
-}
-#pragma GCC pop_options
-
-Isa cpu_isa() {
-    static const Isa isa = [] {
-        __builtin_cpu_init();
-        if (__builtin_cpu_supports("avx512f")) return Isa::Avx512;
-        if (__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma")) return Isa::Avx2;
-        return Isa::Generic;
-    }();
-    return isa;
-}
-#else
-Isa cpu_isa() { return Isa::Generic; }
-#endif
-
-// The instruction set in use: the CPU's best unless lowered by _set_vector_isa (for tests).
-std::atomic<Isa> g_isa_cap{Isa::Avx512};
-Isa best_isa() { return std::min(cpu_isa(), g_isa_cap.load()); }
-
-const char* isa_name(Isa isa) {
-    switch (isa) {
-        case Isa::Generic:
-            return "generic";
-        case Isa::Avx2:
-            return "avx2";
-        case Isa::Avx512:
-            return "avx512";
-    }
-    return "generic";
-}
-
-template <Isa I>
-inline void apply_math(MathFn fn, const double* x, double* y, ssize_t n) {
-#if ROUGHSCOPE_HAVE_LIBMVEC
-    if constexpr (I == Isa::Avx512) return apply_avx512(fn, x, y, n);
-    if constexpr (I == Isa::Avx2) return apply_avx2(fn, x, y, n);
-#endif
-    apply_generic(fn, x, y, n);
-}
-
-struct VeryRoughInputs {
-    const double* theta_i_deg;
-    ssize_t step_i;
-    const double* theta_s_deg;
-    ssize_t step_s;
-    const double* phi_s_deg;
-    ssize_t step_p;
-    const double* sigma_over_T;
-    ssize_t step_m;
-};
-
-constexpr ssize_t kBlock = 512;
-
-// Finds the first bad element of [begin, end) and throws the library's error for it (called only
-// when the kernel's branch-free test found one); `at` is left at that element.
-void validate_very_rough(const VeryRoughInputs& in, ssize_t begin, ssize_t end, ssize_t& at) {
-    constexpr double kHalfPi = kPi / 2.0;
-    for (at = begin; at < end; ++at) {
-        const double ti = deg_to_rad(in.theta_i_deg[at * in.step_i]);
-        const double ts = deg_to_rad(in.theta_s_deg[at * in.step_s]);
-        const double p = in.phi_s_deg[at * in.step_p];
-        const double m = in.sigma_over_T[at * in.step_m];
-        if (!(ti >= 0.0 && ti < kHalfPi)) check::polar_angle("theta_i_deg", ti);
-        if (!(ts >= 0.0 && ts < kHalfPi)) check::polar_angle("theta_s_deg", ts);
-        if (!std::isfinite(p)) check::azimuth("phi_s_deg", deg_to_rad(p));
-        if (!(m > 0.0 && m <= std::numeric_limits<double>::max()))
-            check::positive("sigma_over_T", m);
-        // The library accepted what the quick test rejected (never expected): say so anyway.
-        if (!(ti >= 0.0 && ti < kHalfPi && ts >= 0.0 && ts < kHalfPi && std::isfinite(p) &&
-              m > 0.0 && m <= std::numeric_limits<double>::max()))
-            throw InvalidArgument(
-                "very_rough_brightness: angles must be in [0, 90) degrees, "
-                "phi_s_deg finite and sigma_over_T finite and > 0");
-    }
-}
-
-// sin x and cos x for |x| <= π/4 (fdlibm's __kernel_sin / __kernel_cos minimax polynomials, ~1
-// ulp).
-[[gnu::always_inline]] inline double kernel_sin(double x) {
-    constexpr double S1 = -1.66666666666666324348e-01, S2 = 8.33333333332248946124e-03,
-                     S3 = -1.98412698298579493134e-04, S4 = 2.75573137070700676789e-06,
-                     S5 = -2.50507602534068634195e-08, S6 = 1.58969099521155010221e-10;
-    const double z = x * x;
-    const double r = S2 + z * (S3 + z * (S4 + z * (S5 + z * S6)));
-    return x + (z * x) * (S1 + z * r);
-}
-[[gnu::always_inline]] inline double kernel_cos(double x) {
-    constexpr double C1 = 4.16666666666666019037e-02, C2 = -1.38888888888741095749e-03,
-                     C3 = 2.48015872894767294178e-05, C4 = -2.75573143513906633035e-07,
-                     C5 = 2.08757232129817482790e-09, C6 = -1.13596475577881948265e-11;
-    const double z = x * x;
-    // 1 + z q with q = −1/2 + z (C1 + ...): the last step (an FMA where the ISA has one) adds
-    // |z q| <= 0.31 to 1, so the result (>= 0.7) is within ~1 ulp.
-    const double q = -0.5 + z * (C1 + z * (C2 + z * (C3 + z * (C4 + z * (C5 + z * C6)))));
-    return 1.0 + z * q;
-}
-// c ? a : b for doubles as a bitwise select: both sides are evaluated, so GCC cannot sink them
-// into a branch (which, under -ftrapping-math, it would then not if-convert and the loop would
-// stay scalar on AVX2 and SSE2).
-[[gnu::always_inline]] inline double select(bool c, double a, double b) {
-    const std::uint64_t mask = -static_cast<std::uint64_t>(c);
-    return std::bit_cast<double>((std::bit_cast<std::uint64_t>(a) & mask) |
-                                 (std::bit_cast<std::uint64_t>(b) & ~mask));
-}
-// π/2 = kPio2Hi + kPio2Lo; kPio2Hi − x is exact for x in [π/4, π/2] (Sterbenz).
-constexpr double kPio2Hi = 1.57079632679489655800e+00, kPio2Lo = 6.12323399573676603587e-17;
-
-// sin θ and cos θ for a polar angle θ in [0, π/2] (what validation admits): one reduction to
-// |y| <= π/4 and both kernels, branch-free (vectorises), no general range reduction.
-[[gnu::always_inline]] inline void polar_sincos(double theta, double& s, double& c) {
-    const bool upper = theta > 0.25 * kPi;
-    const double y = select(upper, (kPio2Hi - theta) + kPio2Lo, theta);
-    const double sy = kernel_sin(y), cy = kernel_cos(y);
-    s = select(upper, cy, sy);
-    c = select(upper, sy, cy);
-}
-
-// sin²(φ/2) for φ in degrees already reduced to |φ| <= 180 (+ rounding): x = |φ|/2 in radians is
-// in [0, π/2]; sin² x = s² (x <= π/4) or cos² y = 1 − sin² y with y = π/2 − x (>= 1/2, no
-// cancellation). One polynomial.
-[[gnu::always_inline]] inline double sin2_half_azimuth(double phi_reduced_deg) {
-    constexpr double kHalfRadPerDeg = kPi / 360.0;
-    const double x = __builtin_fabs(phi_reduced_deg) * kHalfRadPerDeg;
-    const bool upper = x > 0.25 * kPi;
-    const double y = select(upper, (kPio2Hi - x) + kPio2Lo, x);  // may be ~−1e-16: sin² is even
-    const double s = kernel_sin(y), s2 = s * s;
-    return select(upper, 1.0 - s2, s2);
-}
-
-// Brightness for elements [begin, end), one block of kBlock elements at a time. Inlined into one
-// wrapper per instruction set so that the loops are auto-vectorised for it. One pass per block
-// reads the inputs where they are (a broadcast scalar is read from a block filled once),
-// validates them (branch-free; nothing is returned unless all are valid) and computes everything
-// but the exponential (Gaussian, libmvec) or w^(−3/2) (exponential); a last pass writes
-// the result. Per element: one reduction and two short polynomials per polar angle (sin and cos
-// together), one polynomial for sin²(φs/2) after an exact reduction of φs modulo 360°, one
-// division at most (Gaussian: 1/q_z²; exponential: none); no general-purpose sin/cos, no pow.
-template <Correlation C, GeometricFactor F, Radiometry R, Isa I>
-[[gnu::always_inline]] inline void very_rough_body(const VeryRoughInputs& in, ssize_t begin,
-                                                   ssize_t end, double* __restrict out,
-                                                   ssize_t& at) {
-    constexpr double kRadPerDeg = kPi / 180.0;
-    constexpr double kHalfPi = kPi / 2.0;
-    constexpr double kMax = std::numeric_limits<double>::max();
-    constexpr double kRound = 0x1.8p52;  // (x + kRound) − kRound = nearest integer, |x| < 2^51
-    constexpr double kWide = 0x1p44;     // |φs| below this: φs − 360 k is exact
-    // km = 1/(4 m²) (Gaussian) or 1/m² (exponential), m = σ/T.
-    constexpr double kM = C == Correlation::Gaussian ? 0.25 : 1.0;
-    alignas(64) double km[kBlock], pref[kBlock], arg[kBlock], aux[kBlock];
-    alignas(64) double scalar_ti[kBlock], scalar_ts[kBlock], scalar_p[kBlock], wide_p[kBlock];
-    // Operands repeated over the result (step 0) are read from a block filled once.
-    auto source = [](const double* data, ssize_t step, double* fill) {
-        if (step == 0) std::fill_n(fill, kBlock, data[0]);
-        return step == 0;
-    };
-    const bool ti_rep = source(in.theta_i_deg, in.step_i, scalar_ti);
-    const bool ts_rep = source(in.theta_s_deg, in.step_s, scalar_ts);
-    const bool p_rep = source(in.phi_s_deg, in.step_p, scalar_p);
-    const bool m_rep = in.step_m == 0;
-    const double m0 = in.sigma_over_T[0];
-    const bool m0_bad = !(m0 > 0.0 && m0 <= kMax);
-    if (m_rep) std::fill_n(km, kBlock, kM / (m0 * m0));
-    for (ssize_t start = begin; start < end; start += kBlock) {
-        const ssize_t n = std::min(kBlock, end - start);
-        const double* __restrict ti_deg = ti_rep ? scalar_ti : in.theta_i_deg + start;
-        const double* __restrict ts_deg = ts_rep ? scalar_ts : in.theta_s_deg + start;
-        const double* __restrict p_deg = p_rep ? scalar_p : in.phi_s_deg + start;
-        int bad = m_rep && m0_bad;
-        if (!m_rep) {
-            const double* __restrict m = in.sigma_over_T + start;
-            for (ssize_t j = 0; j < n; ++j) {
-                bad += static_cast<int>(!(m[j] > 0.0) | !(m[j] <= kMax));
-                km[j] = kM / (m[j] * m[j]);
-            }
-        }
-        // The pass (inlined: it must be compiled for the wrapper's instruction set); `phi_deg`
-        // holds φs, reduced exactly below when |φs| < 2^44.
-        auto pass = [&](const double* __restrict phi_deg) __attribute__((always_inline)) {
-            int bad_here = 0, wide = 0;
-            for (ssize_t j = 0; j < n; ++j) {
-                const double t_i = ti_deg[j] * kRadPerDeg, t_s = ts_deg[j] * kRadPerDeg;
-                const double p = phi_deg[j];
-                const double dp = p - p;  // 0 if finite, NaN otherwise
-                bad_here += static_cast<int>(!(t_i >= 0.0) | !(t_i < kHalfPi) | !(t_s >= 0.0) |
-                                             !(t_s < kHalfPi) | !(dp == 0.0));
-                wide += static_cast<int>(!(__builtin_fabs(p) < kWide));
-                const double k = (p * (1.0 / 360.0) + kRound) - kRound;
-                const double sh2 = sin2_half_azimuth(p - 360.0 * k);  // φs − 360k in [−180, 180]
-                double si, ci, ss, cs;
-                polar_sincos(t_i, si, ci);
-                polar_sincos(t_s, ss, cs);
-                // q_xy² = sin²θi + sin²θs − 2 sinθi sinθs cos φs, without cancellation:
-                const double d = si - ss;
-                const double qxy2 = d * d + 4.0 * si * ss * sh2;
-                const double sum_c = ci + cs;
-                const double qz2 = sum_c * sum_c;
-                double F2;
-                if constexpr (F == GeometricFactor::VernoldHarvey) {
-                    F2 = ci;  // F_VH² = cos θi (§3.2)
-                } else {
-                    // Eq. 6 with cos φs = 1 − 2 sin²(φs/2).
-                    const double cos_phi = 1.0 - 2.0 * sh2;
-                    double f = (1.0 + ci * cs - si * ss * cos_phi) / (ci * sum_c);
-                    if constexpr (F == GeometricFactor::Ogilvy) f *= ci;
-                    if constexpr (F == GeometricFactor::Kirchhoff) f *= ci / cs;
-                    F2 = f * f;
-                }
-                // The radiometric factor 1/cos θs of intensity (§3.3) joins the denominator.
-                if constexpr (C == Correlation::Gaussian) {
-                    // Eq. 4 shape: F²/q_z² exp(−q_xy²/(4 m² q_z²))
-                    if constexpr (R == Radiometry::Intensity) {
-                        const double r = 1.0 / (qz2 * cs);
-                        pref[j] = F2 * r;
-                        arg[j] = -(qxy2 * km[j]) * (cs * r);
-                    } else {
-                        const double r = 1.0 / qz2;
-                        pref[j] = F2 * r;
-                        arg[j] = -(qxy2 * km[j]) * r;
-                    }
-                } else {
-                    // Eq. 5 shape: F²/(q_z² t^{3/2}), t = 1 + q_xy²/(m² q_z²). With w = q_z² t =
-                    // q_z² + q_xy²/m² (> 0, no cancellation) and √q_z² = cos θi + cos θs:
-                    // F²/(q_z² t^{3/2}) = F² (cos θi + cos θs)/(w √w); the root is taken below.
-                    pref[j] = F2 * sum_c;
-                    arg[j] = qz2 + qxy2 * km[j];
-                    if constexpr (R == Radiometry::Intensity) pref[j] /= cs;
-                }
-            }
-            bad += bad_here;
-            return wide;
-        };
-        if (pass(p_deg)) {  // rare: some |φs| >= 2^44 degrees; reduce those with the exact fmod
-            for (ssize_t j = 0; j < n; ++j)
-                wide_p[j] =
-                    __builtin_fabs(p_deg[j]) < kWide ? p_deg[j] : std::fmod(p_deg[j], 360.0);
-            pass(wide_p);
-        }
-        // The library's checks find and report the first bad element of the block.
-        if (bad) validate_very_rough(in, start, start + n, at);
-        double* __restrict o = out + start;
-        if constexpr (C == Correlation::Gaussian) {
-            apply_math<I>(MathFn::Exp, arg, arg, n);
-            for (ssize_t j = 0; j < n; ++j) o[j] = pref[j] * arg[j];
-        } else {
-            apply_math<I>(MathFn::InvPow32, arg, aux, n);  // w^(−3/2)
-            for (ssize_t j = 0; j < n; ++j) o[j] = pref[j] * aux[j];
-        }
-    }
-}
-
-template <Correlation C, GeometricFactor F, Radiometry R>
-void very_rough_generic(const VeryRoughInputs& in, ssize_t begin, ssize_t end, double* out,
-                        ssize_t& at) {
-    very_rough_body<C, F, R, Isa::Generic>(in, begin, end, out, at);
-}
-#if ROUGHSCOPE_HAVE_LIBMVEC
-template <Correlation C, GeometricFactor F, Radiometry R>
-__attribute__((target("avx2,fma"))) void very_rough_avx2(const VeryRoughInputs& in, ssize_t begin,
-                                                         ssize_t end, double* out, ssize_t& at) {
-    very_rough_body<C, F, R, Isa::Avx2>(in, begin, end, out, at);
-}
-template <Correlation C, GeometricFactor F, Radiometry R>
-__attribute__((target("avx512f"))) void very_rough_avx512(const VeryRoughInputs& in, ssize_t begin,
-                                                          ssize_t end, double* out, ssize_t& at) {
-    very_rough_body<C, F, R, Isa::Avx512>(in, begin, end, out, at);
-}
-#endif
-
-using VeryRoughKernel = void (*)(const VeryRoughInputs&, ssize_t, ssize_t, double*, ssize_t&);
-
-template <Correlation C, GeometricFactor F, Radiometry R>
-VeryRoughKernel pick_isa(Isa isa) {
-#if ROUGHSCOPE_HAVE_LIBMVEC
-    if (isa == Isa::Avx512) return very_rough_avx512<C, F, R>;
-    if (isa == Isa::Avx2) return very_rough_avx2<C, F, R>;
-#endif
-    (void)isa;
-    return very_rough_generic<C, F, R>;
-}
-
-template <Correlation C, Radiometry R>
-VeryRoughKernel pick_kernel(GeometricFactor f, Isa isa) {
-    switch (f) {
-        case GeometricFactor::Beckmann:
-            return pick_isa<C, GeometricFactor::Beckmann, R>(isa);
-        case GeometricFactor::VernoldHarvey:
-            return pick_isa<C, GeometricFactor::VernoldHarvey, R>(isa);
-        case GeometricFactor::Ogilvy:
-            return pick_isa<C, GeometricFactor::Ogilvy, R>(isa);
-        case GeometricFactor::Kirchhoff:
-            return pick_isa<C, GeometricFactor::Kirchhoff, R>(isa);
-    }
-    return nullptr;
-}
-
-VeryRoughKernel pick_kernel(Correlation c, GeometricFactor f, Radiometry r, Isa isa) {
-    using enum Correlation;
-    using enum Radiometry;
-    if (c == Gaussian)
-        return r == Radiance ? pick_kernel<Gaussian, Radiance>(f, isa)
-                             : pick_kernel<Gaussian, Intensity>(f, isa);
-    return r == Radiance ? pick_kernel<Exponential, Radiance>(f, isa)
-                         : pick_kernel<Exponential, Intensity>(f, isa);
-}
 
 py::object very_rough_brightness_py(py::handle theta_i_deg, py::handle theta_s_deg,
                                     py::handle phi_s_deg, py::handle sigma_over_T,
                                     const std::string& correlation, const std::string& factor,
                                     const std::string& radiometry) {
-    const Correlation c = parse_correlation(correlation);
-    const GeometricFactor f = parse_geometric_factor(factor);
-    const Radiometry r = parse_radiometry(radiometry);
+    const BrightnessBatchModel model{parse_correlation(correlation), parse_geometric_factor(factor),
+                                     parse_radiometry(radiometry)};
     auto [ops, b] = broadcast<4>({"theta_i_deg", "theta_s_deg", "phi_s_deg", "sigma_over_T"},
                                  {theta_i_deg, theta_s_deg, phi_s_deg, sigma_over_T});
     if (b.scalar) {  // one value: the library's own function
         const double x = very_rough_brightness(
-            geometry_deg(ops[0].data[0], ops[1].data[0], ops[2].data[0]), ops[3].data[0], c, f, r);
+            geometry_deg(ops[0].data[0], ops[1].data[0], ops[2].data[0]), ops[3].data[0],
+            model.correlation, model.factor, model.radiometry);
         return py::float_(x);
     }
-    const VeryRoughInputs in{ops[0].data, ops[0].step, ops[1].data, ops[1].step,
-                             ops[2].data, ops[2].step, ops[3].data, ops[3].step};
-    const VeryRoughKernel kernel = pick_kernel(c, f, r, best_isa());
+    const auto n = static_cast<std::size_t>(b.size);
+    auto span_of = [n](const Operand& op) {
+        return std::span<const double>(op.data, op.step == 0 ? 1 : n);
+    };
+    const BrightnessBatchInput in{span_of(ops[0]), span_of(ops[1]), span_of(ops[2]),
+                                  span_of(ops[3]), AngleUnit::Degrees};
     py::array_t<double> out = make_output(b);
-    double* o = out.mutable_data();
-    run_chunks(b, worker_count(b.size, 16384),
-               [&](ssize_t begin, ssize_t end, ssize_t& at) { kernel(in, begin, end, o, at); });
+    const std::span<double> o(out.mutable_data(), n);
+    run_chunks(b, worker_count(b.size, 16384), [&](ssize_t begin, ssize_t end, ssize_t& at) {
+        std::size_t bad = static_cast<std::size_t>(begin);
+        try {
+            very_rough_brightness_batch(in, o, model, static_cast<std::size_t>(begin),
+                                        static_cast<std::size_t>(end), bad);
+        } catch (...) {
+            at = static_cast<ssize_t>(bad);
+            throw;
+        }
+    });
     return finish(b, out);
 }
 
@@ -785,22 +394,44 @@ void bind_core(py::module_& m) {
     m.attr("SLIGHTLY_ROUGH_MAX_G") = kSlightlyRoughMaxG;
     m.attr("VERY_ROUGH_MIN_G") = kVeryRoughMinG;
 
+    // ---- Reference data beside the project (io/data_locator.hpp) ----------------------------
+    using Starts = std::vector<std::filesystem::path>;
+    m.def(
+        "shared_dir_candidates",
+        [](const Starts& extra_starts) { return io::shared_dir_candidates(extra_starts); },
+        arg("extra_starts") = Starts{},
+        "The shared folders searched, in order: $ROUGHSCOPE_SHARED_DIR alone when set, else "
+        "../shared from the current directory upward, then from each of extra_starts.");
+    m.def(
+        "find_shared",
+        [](const std::string& relative, const Starts& extra_starts) {
+            return io::find_shared(relative, extra_starts);
+        },
+        arg("relative"), arg("extra_starts") = Starts{},
+        "Path of `relative` in the first shared folder holding it, or None.");
+    m.def(
+        "paper_tables_path",
+        [](const Starts& extra_starts) { return io::paper_tables_path(extra_starts); },
+        arg("extra_starts") = Starts{},
+        "Path of reference/paper-tables.json in the shared folder, or None.");
+    m.def(
+        "curet_data_dir",
+        [](const Starts& extra_starts) { return io::curet_data_dir(extra_starts); },
+        arg("extra_starts") = Starts{},
+        "The shared folder's data/curet (holding table.txt and abrdf.dat), or None.");
+    m.def(
+        "shared_search_description",
+        [](const std::string& relative) { return io::shared_search_description(relative); },
+        arg("relative"), "One line saying where `relative` is looked for.");
+    m.def("shared_data_required", &io::shared_data_required,
+          "True when ROUGHSCOPE_REQUIRE_SHARED_DATA=1: tests must fail, not skip, when the "
+          "shared data are missing.");
+
     // ---- Private knobs for tests and benchmarks ---------------------------------------------
     m.def(
         "_set_vector_isa",
         [](const std::string& name) {
-            Isa isa;
-            if (name == "generic")
-                isa = Isa::Generic;
-            else if (name == "avx2")
-                isa = Isa::Avx2;
-            else if (name == "avx512" || name == "best")
-                isa = Isa::Avx512;
-            else
-                throw InvalidArgument("isa = '" + name +
-                                      "' is not one of 'generic', 'avx2', 'avx512', 'best'");
-            g_isa_cap.store(isa);
-            return std::string(isa_name(best_isa()));
+            return std::string(to_string(set_vector_isa_cap(parse_vector_isa(name))));
         },
         arg("isa"),
         "Testing aid: cap the instruction set of the array kernels ('generic', 'avx2', "

@@ -22,17 +22,12 @@ def _e(text):
 
 def _paper_tables(data_dir):
     """The printed tables, or None."""
-    candidates = []
-    try:
-        candidates.append(Path(data_dir).resolve().parents[1] / "reference" / "paper-tables.json")
-    except (IndexError, OSError):
-        pass
-    candidates.append(Path("..") / "shared" / "reference" / "paper-tables.json")
-    for c in candidates:
-        if c.is_file():
-            with open(c, encoding="utf-8") as f:
-                return json.load(f)
-    return None
+    # The library's locator (io/data_locator.hpp), also searching upward from the data folder.
+    path = _core.paper_tables_path([Path(data_dir)] if data_dir else [])
+    if path is None:
+        return None
+    with open(path, encoding="utf-8") as f:
+        return json.load(f)
 
 
 def _num(v, spec):

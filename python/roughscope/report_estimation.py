@@ -11,7 +11,6 @@ and Eq. 19 and the Table 2 surfaces.
 
 import html
 import json
-import os
 from pathlib import Path
 
 from . import _core
@@ -22,22 +21,10 @@ def _e(text):
 
 
 def find_paper_tables():
-    """Path of paper-tables.json, or None: $ROUGHSCOPE_PAPER_TABLES, ../shared/reference/ from
-    the working directory, or beside the repository this package was built from."""
-    candidates = []
-    if os.environ.get("ROUGHSCOPE_PAPER_TABLES"):
-        candidates.append(Path(os.environ["ROUGHSCOPE_PAPER_TABLES"]))
-    candidates.append(Path("..") / "shared" / "reference" / "paper-tables.json")
-    here = Path(__file__).resolve()
-    for up in (2, 3):  # <repo>/python/roughscope or <repo>/<build>/python/roughscope
-        try:
-            candidates.append(here.parents[up].parent / "shared" / "reference" / "paper-tables.json")
-        except IndexError:
-            pass
-    for c in candidates:
-        if c.is_file():
-            return c
-    return None
+    """Path of paper-tables.json, or None (the library's locator, io/data_locator.hpp:
+    $ROUGHSCOPE_SHARED_DIR, else ../shared upward from the working directory and from where this
+    package lives)."""
+    return _core.paper_tables_path([Path(__file__).resolve().parent])
 
 
 _MARKS = {"exact": "=", "within_rounding": "≈", "differs": "≠"}
@@ -113,7 +100,7 @@ def section(outdir):
     if path is None:
         return (head + "<p><em>Skipped: the paper's printed tables were not found "
                 "(../shared/reference/paper-tables.json beside the project, or set "
-                "ROUGHSCOPE_PAPER_TABLES).</em></p>\n")
+                "ROUGHSCOPE_SHARED_DIR).</em></p>\n")
     with open(path, encoding="utf-8") as f:
         tables = json.load(f)
     rec = recompute_tables(tables)

@@ -19,6 +19,7 @@
 #include <Eigen/Dense>
 
 #include "roughscope/core/errors.hpp"
+#include "roughscope/core/names.hpp"
 #include "roughscope/estimation/estimation.hpp"
 #include "roughscope/fit/engine.hpp"
 #include "roughscope/scattering/beckmann.hpp"
@@ -382,10 +383,10 @@ std::string_view display_name(ComparisonModel model) { return info(model).label;
 ComparisonModel parse_comparison_model(std::string_view name) {
     std::string list;
     for (const ModelInfo& i : kModelInfo) {
-        if (name == i.key) return i.model;
+        if (name_matches(i.key, name)) return i.model;
         list += (list.empty() ? "" : ", ") + std::string(i.key);
     }
-    throw InvalidArgument("model '" + std::string(name) + "' is not one of: " + list);
+    throw_unknown_name("comparison model", name, list);
 }
 
 bool is_fit(ComparisonModel model) {

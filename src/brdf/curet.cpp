@@ -2,17 +2,17 @@
 #include "roughscope/brdf/curet.hpp"
 
 #include <algorithm>
-#include <cctype>
-#include <charconv>
 #include <cmath>
 #include <cstdlib>
-#include <fstream>
 #include <set>
-#include <sstream>
 #include <string>
 #include <system_error>
 
 #include "roughscope/core/errors.hpp"
+#include "roughscope/core/names.hpp"
+#include "roughscope/core/numbers.hpp"
+#include "roughscope/io/csv.hpp"
+#include "roughscope/io/data_locator.hpp"
 
 namespace roughscope {
 namespace {
@@ -27,48 +27,29 @@ const char* const kWhereFrom =
     "real-world surfaces', ACM TOG 18(1), 1999), published by Columbia University's CAVE lab "
     "(www.cs.columbia.edu/CAVE/software/curet)";
 
-std::string read_text(const fs::path& path) {
-    std::ifstream in(path, std::ios::binary);
-    if (!in) throw DataError("cannot read " + path.string() + ": no such file or not readable");
-    std::ostringstream buffer;
-    buffer << in.rdbuf();
-    return buffer.str();
-}
-
-bool parse_number(std::string_view text, double& value) {
-    if (!text.empty() && text.front() == '+') text.remove_prefix(1);
-    if (text.empty()) return false;
-    const auto [ptr, ec] = std::from_chars(text.data(), text.data() + text.size(), value);
-    return ec == std::errc() && ptr == text.data() + text.size() && std::isfinite(value);
-}
-
-// Splits text into lines of whitespace-separated fields; blank lines are skipped but counted.
+// One non-blank line of whitespace-separated fields (views into the reader's buffer).
 struct Line {
     std::size_t number = 0;
     std::vector<std::string_view> fields;
 };
 
-std::vector<Line> split_lines(std::string_view text) {
-    std::vector<Line> lines;
-    std::size_t pos = 0, number = 0;
-    while (pos < text.size()) {
-        std::size_t eol = text.find('\n', pos);
-        if (eol == std::string_view::npos) eol = text.size();
-        const std::string_view line = text.substr(pos, eol - pos);
-        pos = eol + 1;
-        ++number;
-        Line l;
-        l.number = number;
-        std::size_t k = 0;
-        while (k < line.size()) {
-            while (k < line.size() && std::isspace(static_cast<unsigned char>(line[k]))) ++k;
-            const std::size_t start = k;
-            while (k < line.size() && !std::isspace(static_cast<unsigned char>(line[k]))) ++k;
-            if (k > start) l.fields.push_back(line.substr(start, k - start));
-        }
-        if (!l.fields.empty()) lines.push_back(std::move(l));
+// Opens `path` for line-by-line reading (io/csv.hpp: UTF-8 BOM and CRLF accepted).
+io::LineReader open_lines(const fs::path& path) {
+    std::error_code ec;
+    if (!fs::is_regular_file(path, ec))
+        throw DataError("cannot read " + path.string() + ": no such file or not readable");
+    return io::LineReader(path);
+}
+
+// The next non-blank line of `reader`; false at the end of the file.
+bool next_line(io::LineReader& reader, Line& line) {
+    std::string_view text;
+    while (reader.next(text)) {
+        line.fields = io::split_whitespace(text);
+        line.number = reader.line_number();
+        if (!line.fields.empty()) return true;
     }
-    return lines;
+    return false;
 }
 
 [[noreturn]] void fail(const fs::path& file, std::size_t line, const std::string& what) {
@@ -76,12 +57,13 @@ std::vector<Line> split_lines(std::string_view text) {
 }
 
 double field_number(const fs::path& file, const Line& line, std::size_t k, const char* what) {
-    double v = 0.0;
-    if (!parse_number(line.fields[k], v))
+    std::string reason;
+    const auto v = try_parse_number(line.fields[k], reason);
+    if (!v)
         fail(file, line.number,
              std::string("field ") + std::to_string(k + 1) + " (" + what + "): '" +
-                 std::string(line.fields[k]) + "' is not a finite number");
-    return v;
+                 std::string(line.fields[k]) + "' is " + reason);
+    return *v;
 }
 
 int field_integer(const fs::path& file, const Line& line, std::size_t k, const char* what) {
@@ -94,10 +76,10 @@ int field_integer(const fs::path& file, const Line& line, std::size_t k, const c
 }
 
 std::vector<CuretAngles> read_angle_table(const fs::path& file) {
-    const std::string text = read_text(file);  // `lines` views into it
-    const std::vector<Line> lines = split_lines(text);
+    io::LineReader reader = open_lines(file);
     std::vector<CuretAngles> angles;
-    for (const Line& line : lines) {
+    Line line;
+    while (next_line(reader, line)) {
         if (line.fields.size() != 5)
             fail(file, line.number,
                  "expected 5 fields (measurement theta_v phi_v theta_i phi_i), found " +
@@ -130,10 +112,10 @@ std::vector<CuretAngles> read_angle_table(const fs::path& file) {
 // Reads a per-sample file (BRDF or overflow): sample number + 205 values per line.
 void read_sample_file(const fs::path& file, bool fractions, std::vector<int>& samples,
                       std::vector<std::vector<double>>& values) {
-    const std::string text = read_text(file);  // `lines` views into it
-    const std::vector<Line> lines = split_lines(text);
+    io::LineReader reader = open_lines(file);
     std::set<int> seen;
-    for (const Line& line : lines) {
+    Line line;
+    while (next_line(reader, line)) {
         const std::size_t expected = kCuretMeasurementCount + 1;
         if (line.fields.size() != expected)
             fail(file, line.number,
@@ -179,27 +161,22 @@ bool has_curet_files(const fs::path& dir) {
 
 }  // namespace
 
-std::string_view to_string(CuretChannel channel) {
-    switch (channel) {
-        case CuretChannel::Mean:
-            return "mean";
-        case CuretChannel::Red:
-            return "red";
-        case CuretChannel::Green:
-            return "green";
-        case CuretChannel::Blue:
-            return "blue";
-    }
-    return "mean";
-}
+// The file letters a, r, g, b are accepted as aliases.
+constexpr std::array<NameEntry<CuretChannel>, 8> kChannelNames{{
+    {"mean", CuretChannel::Mean},
+    {"red", CuretChannel::Red},
+    {"green", CuretChannel::Green},
+    {"blue", CuretChannel::Blue},
+    {"a", CuretChannel::Mean},
+    {"r", CuretChannel::Red},
+    {"g", CuretChannel::Green},
+    {"b", CuretChannel::Blue},
+}};
+
+std::string_view to_string(CuretChannel channel) { return name_of(kChannelNames, channel); }
 
 CuretChannel parse_curet_channel(std::string_view name) {
-    if (name == "mean" || name == "a") return CuretChannel::Mean;
-    if (name == "red" || name == "r") return CuretChannel::Red;
-    if (name == "green" || name == "g") return CuretChannel::Green;
-    if (name == "blue" || name == "b") return CuretChannel::Blue;
-    throw InvalidArgument("channel '" + std::string(name) +
-                          "' is not one of: mean (a), red (r), green (g), blue (b)");
+    return parse_name(kChannelNames, "channel", name);
 }
 
 std::string curet_brdf_file_name(CuretChannel channel) {
@@ -246,8 +223,9 @@ fs::path find_curet_directory(const std::optional<fs::path>& explicit_dir) {
                             "; it must hold " + kNeededFiles + ", from " + kWhereFrom);
         return *explicit_dir;
     }
-    const fs::path beside = fs::path("..") / "shared" / "data" / "curet";
-    if (has_curet_files(beside)) return beside;
+    // The reference-data locator (io/data_locator.hpp): $ROUGHSCOPE_SHARED_DIR/data/curet, else
+    // ../shared/data/curet from the current directory upward.
+    if (auto located = io::curet_data_dir()) return *located;
     if (const char* env = std::getenv("ROUGHSCOPE_CURET"); env && *env) {
         const fs::path dir(env);
         if (!has_curet_files(dir))
@@ -255,9 +233,10 @@ fs::path find_curet_directory(const std::optional<fs::path>& explicit_dir) {
                             kNeededFiles + "; get them from " + kWhereFrom);
         return dir;
     }
-    throw DataError(std::string("CUReT data not found: looked in ../shared/data/curet (relative "
-                                "to the current directory) and $ROUGHSCOPE_CURET (unset); give "
-                                "--data DIR or set ROUGHSCOPE_CURET to a directory holding ") +
+    throw DataError("CUReT data not found: looked in " +
+                    io::shared_search_description(io::kCuretRelative) +
+                    " and $ROUGHSCOPE_CURET (unset); give --data DIR or set ROUGHSCOPE_CURET to "
+                    "a directory holding " +
                     kNeededFiles + ", from " + kWhereFrom);
 }
 

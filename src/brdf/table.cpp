@@ -2,48 +2,17 @@
 #include "roughscope/brdf/table.hpp"
 
 #include <algorithm>
-#include <charconv>
 #include <fstream>
-#include <map>
 #include <set>
 #include <sstream>
 #include <string>
+#include <system_error>
 
 #include "roughscope/core/errors.hpp"
+#include "roughscope/io/csv.hpp"
 
 namespace roughscope {
 namespace {
-
-std::string_view trim(std::string_view s) {
-    while (!s.empty() && (s.front() == ' ' || s.front() == '\t' || s.front() == '\r'))
-        s.remove_prefix(1);
-    while (!s.empty() && (s.back() == ' ' || s.back() == '\t' || s.back() == '\r'))
-        s.remove_suffix(1);
-    return s;
-}
-
-std::vector<std::string_view> split_commas(std::string_view line) {
-    std::vector<std::string_view> out;
-    std::size_t start = 0;
-    while (true) {
-        const std::size_t comma = line.find(',', start);
-        if (comma == std::string_view::npos) {
-            out.push_back(trim(line.substr(start)));
-            break;
-        }
-        out.push_back(trim(line.substr(start, comma - start)));
-        start = comma + 1;
-    }
-    return out;
-}
-
-// Strict: the whole field must be a finite number.
-bool parse_number(std::string_view text, double& value) {
-    if (!text.empty() && text.front() == '+') text.remove_prefix(1);
-    if (text.empty()) return false;
-    const auto [ptr, ec] = std::from_chars(text.data(), text.data() + text.size(), value);
-    return ec == std::errc() && ptr == text.data() + text.size() && std::isfinite(value);
-}
 
 [[noreturn]] void fail(std::string_view source, std::size_t line, const std::string& what) {
     throw DataError(std::string(source) + ":" + std::to_string(line) + ": " + what);
@@ -80,102 +49,48 @@ BrdfMeasurement make_brdf_measurement(int index, double theta_i_rad, double phi_
     return m;
 }
 
-BrdfTable parse_brdf_csv(std::string_view text, std::string_view source_name,
+BrdfTable parse_brdf_csv(std::istream& in, std::string_view source_name,
                          const BrdfCsvOptions& options) {
-    static const std::vector<std::string> required = {"theta_i", "phi_i", "theta_s", "phi_s",
-                                                      "value"};
+    // The one CSV reader (io/csv.hpp): header, comments, CRLF, BOM, strict numbers, and errors
+    // "<source>:<line>: ..." naming the column.
+    io::CsvReader reader(in, std::string(source_name),
+                         {"theta_i", "phi_i", "theta_s", "phi_s", "value"},
+                         {"weight", "measurement"});
     BrdfTable table;
     table.name = std::string(source_name);
-
-    std::map<std::string, std::size_t> column;  // name → position
-    std::size_t n_columns = 0;
-    bool have_header = false;
+    const bool has_channel = reader.has_column("channel");
     std::set<int> seen_index;
     std::set<std::string> channels_seen;
-    std::size_t line_no = 0, data_rows = 0;
-    std::size_t pos = 0;
-    while (pos < text.size()) {
-        std::size_t eol = text.find('\n', pos);
-        if (eol == std::string_view::npos) eol = text.size();
-        const std::string_view line = trim(text.substr(pos, eol - pos));
-        pos = eol + 1;
-        ++line_no;
-        if (line.empty() || line.front() == '#') {
-            continue;
-        }
-        const std::vector<std::string_view> fields = split_commas(line);
-        if (!have_header) {
-            for (std::size_t k = 0; k < fields.size(); ++k) {
-                const std::string name(fields[k]);
-                if (name.empty()) fail(source_name, line_no, "empty column name in the header");
-                if (!column.emplace(name, k).second)
-                    fail(source_name, line_no, "duplicate column '" + name + "' in the header");
-            }
-            std::string missing;
-            for (const auto& r : required)
-                if (!column.count(r)) missing += (missing.empty() ? "" : ", ") + r;
-            if (!missing.empty()) {
-                std::string found;
-                for (std::size_t k = 0; k < fields.size(); ++k)
-                    found += (k ? ", " : "") + std::string(fields[k]);
-                fail(source_name, line_no,
-                     "missing column(s) " + missing + " (found: " + found +
-                         "; required: theta_i, phi_i, theta_s, phi_s, value in degrees and 1/sr; "
-                         "optional: weight, channel, measurement)");
-            }
-            n_columns = fields.size();
-            have_header = true;
-            continue;
-        }
-        if (fields.size() != n_columns)
-            fail(source_name, line_no,
-                 "expected " + std::to_string(n_columns) + " fields, found " +
-                     std::to_string(fields.size()));
-        auto number = [&](const std::string& name) {
-            double v = 0.0;
-            const std::string_view f = fields[column.at(name)];
-            if (!parse_number(f, v))
-                fail(source_name, line_no,
-                     "column " + name + ": '" + std::string(f) + "' is not a finite number");
-            return v;
-        };
+    std::size_t data_rows = 0;
+    io::CsvRow row;
+    while (reader.next(row)) {
         ++data_rows;
-        if (column.count("channel")) {
-            const std::string ch(fields[column.at("channel")]);
+        if (has_channel) {
+            const std::string& ch = row.text.at("channel");
             channels_seen.insert(ch);
-            if (options.channel && ch != *options.channel) {
-                continue;
-            }
+            if (options.channel && ch != *options.channel) continue;
         }
-        const double ti = number("theta_i"), pi = number("phi_i"), ts = number("theta_s"),
-                     ps = number("phi_s"), value = number("value");
-        double weight = 1.0;
-        if (column.count("weight") && !fields[column.at("weight")].empty())
-            weight = number("weight");
+        const double weight = row.find("weight").value_or(1.0);
         int index = static_cast<int>(data_rows);
-        if (column.count("measurement")) {
-            const double idx = number("measurement");
-            if (idx != std::floor(idx) || idx < 1 || idx > 1e9)
-                fail(source_name, line_no,
-                     "column measurement: '" + std::string(fields[column.at("measurement")]) +
+        if (const auto idx = row.find("measurement")) {
+            if (*idx != std::floor(*idx) || *idx < 1 || *idx > 1e9)
+                fail(source_name, row.line,
+                     "column measurement: '" + row.text.at("measurement") +
                          "' is not a positive integer");
-            index = static_cast<int>(idx);
+            index = static_cast<int>(*idx);
         }
         if (!seen_index.insert(index).second)
-            fail(source_name, line_no, "duplicate measurement " + std::to_string(index));
+            fail(source_name, row.line, "duplicate measurement " + std::to_string(index));
         try {
-            BrdfMeasurement m =
-                make_brdf_measurement(index, deg_to_rad(ti), deg_to_rad(pi), deg_to_rad(ts),
-                                      deg_to_rad(ps), value, weight);
-            table.measurements.push_back(m);
+            table.measurements.push_back(
+                make_brdf_measurement(index, deg_to_rad(row.at("theta_i")),
+                                      deg_to_rad(row.at("phi_i")), deg_to_rad(row.at("theta_s")),
+                                      deg_to_rad(row.at("phi_s")), row.at("value"), weight));
         } catch (const InvalidArgument& e) {
-            fail(source_name, line_no, e.what());
+            fail(source_name, row.line, e.what());
         }
     }
-    if (!have_header)
-        throw DataError(std::string(source_name) +
-                        ": no header line (expected theta_i, phi_i, theta_s, phi_s, value)");
-    if (column.count("channel")) {
+    if (has_channel) {
         if (options.channel) {
             if (!channels_seen.count(*options.channel)) {
                 std::string list;
@@ -200,14 +115,21 @@ BrdfTable parse_brdf_csv(std::string_view text, std::string_view source_name,
     return table;
 }
 
+BrdfTable parse_brdf_csv(std::string_view text, std::string_view source_name,
+                         const BrdfCsvOptions& options) {
+    std::istringstream in{std::string(text)};
+    return parse_brdf_csv(in, source_name, options);
+}
+
 BrdfTable read_brdf_csv(const std::filesystem::path& path, const BrdfCsvOptions& options) {
+    std::error_code ec;
+    if (std::filesystem::is_directory(path, ec))
+        throw DataError("cannot read BRDF table " + path.string() + ": is a directory");
     std::ifstream in(path, std::ios::binary);
     if (!in)
         throw DataError("cannot read BRDF table " + path.string() +
                         ": no such file or not readable");
-    std::ostringstream buffer;
-    buffer << in.rdbuf();
-    return parse_brdf_csv(buffer.str(), path.string(), options);
+    return parse_brdf_csv(in, path.string(), options);
 }
 
 }  // namespace roughscope

@@ -1,18 +1,13 @@
 #include "roughscope/core/errors.hpp"
 
-#include <charconv>
 #include <cmath>
 #include <numbers>
 
+#include "roughscope/core/numbers.hpp"
+
 namespace roughscope::check {
 
-std::string format_number(double value) {
-    if (std::isnan(value)) return "nan";
-    if (std::isinf(value)) return value > 0 ? "inf" : "-inf";
-    char buf[64];
-    auto res = std::to_chars(buf, buf + sizeof(buf), value);
-    return std::string(buf, res.ptr);
-}
+std::string format_number(double value) { return format_message(value); }
 
 namespace {
 std::string with_unit(double value, std::string_view unit) {

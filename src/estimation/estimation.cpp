@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
-#include <cstdio>
 #include <functional>
 #include <limits>
 #include <string>
@@ -13,20 +12,15 @@
 #include <boost/math/tools/toms748_solve.hpp>
 
 #include "roughscope/core/errors.hpp"
+#include "roughscope/core/numbers.hpp"
 
 namespace roughscope {
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
-std::string fmt(double x, int digits = 7) {
-    // Short human form for numbers in messages (7 significant digits).
-    if (std::isnan(x)) return "nan";
-    if (std::isinf(x)) return x > 0 ? "inf" : "-inf";
-    char buf[64];
-    std::snprintf(buf, sizeof buf, "%.*g", digits, x);
-    return buf;
-}
+// Short human form for numbers in messages (7 significant digits).
+std::string fmt(double x) { return format_message(x, 7); }
 
 std::string deg(double rad) { return fmt(rad_to_deg(rad)) + " deg"; }
 
@@ -304,13 +298,6 @@ double d_sigma_d_specular_reflectance(double R_spec, double theta_rad, double wa
 
 namespace {
 
-void check_geometry(std::string_view which, const Geometry& geom) {
-    const std::string w(which);
-    check::polar_angle(w + " theta_i", geom.theta_i_rad);
-    check::polar_angle(w + " theta_s", geom.theta_s_rad);
-    check::azimuth(w + " phi_s", geom.phi_s_rad);
-}
-
 void check_options(const TwoGeometryOptions& o) {
     check::positive("bracket lower bound", o.lower);
     check::positive("bracket upper bound", o.upper);
@@ -473,8 +460,8 @@ std::string ratio_text(double r) { return "E1/E2 = " + check::format_number(r); 
 
 double model_ratio_very_rough(const Geometry& geom1, const Geometry& geom2, double sigma_over_T,
                               Correlation correlation, const TwoGeometryOptions& options) {
-    check_geometry("geom1", geom1);
-    check_geometry("geom2", geom2);
+    check::geometry(geom1, "geom1");
+    check::geometry(geom2, "geom2");
     check::positive("sigma/T", sigma_over_T);
     return very_rough_brightness_shape(geom1, sigma_over_T, correlation, options) /
            very_rough_brightness_shape(geom2, sigma_over_T, correlation, options);
@@ -483,8 +470,8 @@ double model_ratio_very_rough(const Geometry& geom1, const Geometry& geom2, doub
 double model_ratio_diffuse(const Geometry& geom1, const Geometry& geom2, double sigma_um,
                            double T_um, Correlation correlation,
                            const TwoGeometryOptions& options) {
-    check_geometry("geom1", geom1);
-    check_geometry("geom2", geom2);
+    check::geometry(geom1, "geom1");
+    check::geometry(geom2, "geom2");
     return diffuse_brightness(geom1, sigma_um, T_um, correlation, options) /
            diffuse_brightness(geom2, sigma_um, T_um, correlation, options);
 }
@@ -532,8 +519,8 @@ void check_distinct_diffuse(const Geometry& g1, const Geometry& g2, double wavel
 double sigma_over_T_two_geometries(double E1_over_E2, const Geometry& geom1, const Geometry& geom2,
                                    Correlation correlation, const TwoGeometryOptions& options) {
     check_ratio("E1/E2", E1_over_E2);
-    check_geometry("geom1", geom1);
-    check_geometry("geom2", geom2);
+    check::geometry(geom1, "geom1");
+    check::geometry(geom2, "geom2");
     check_options(options);
     check_distinct_very_rough(geom1, geom2);
     auto f = very_rough_log_ratio(geom1, geom2, correlation, options);
@@ -559,8 +546,8 @@ double correlation_length_two_geometries(double E1_over_E2, const Geometry& geom
     check_ratio("E1/E2", E1_over_E2);
     check::positive("sigma", sigma_um, "um");
     check::positive("wavelength", options.wavelength_um, "um");
-    check_geometry("geom1", geom1);
-    check_geometry("geom2", geom2);
+    check::geometry(geom1, "geom1");
+    check::geometry(geom2, "geom2");
     check_options(options);
     check_distinct_diffuse(geom1, geom2, options.wavelength_um);
     auto f = diffuse_log_ratio_T(geom1, geom2, sigma_um, correlation, options);
@@ -661,7 +648,7 @@ void fill_roughness_class(RoughnessEstimate& est, const std::vector<Geometry>& g
         if (assumed && c != *assumed) {
             ++count;
             if (items.size() < kListedMeasurements)
-                items.push_back(std::to_string(i + 1) + " (g = " + fmt(g, 4) + ", " +
+                items.push_back(std::to_string(i + 1) + " (g = " + format_message(g, 4) + ", " +
                                 class_text(c) + ")");
         }
     }

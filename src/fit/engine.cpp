@@ -15,76 +15,42 @@
 #include <ceres/ceres.h>
 
 #include "roughscope/core/errors.hpp"
+#include "roughscope/core/names.hpp"
 
 namespace roughscope {
 
 // ---------------------------------------------------------------------------------------------
 // Names
 
-std::string_view to_string(ResidualType r) {
-    switch (r) {
-        case ResidualType::Relative:
-            return "relative";
-        case ResidualType::Absolute:
-            return "absolute";
-        case ResidualType::Log:
-            return "log";
-    }
-    return "relative";
-}
-std::string_view to_string(LossType l) {
-    switch (l) {
-        case LossType::None:
-            return "none";
-        case LossType::Huber:
-            return "huber";
-        case LossType::Cauchy:
-            return "cauchy";
-        case LossType::SoftLOne:
-            return "soft_l_one";
-    }
-    return "none";
-}
-std::string_view to_string(SolverStatus s) {
-    switch (s) {
-        case SolverStatus::Converged:
-            return "converged";
-        case SolverStatus::AtBound:
-            return "at_bound";
-        case SolverStatus::NotIdentifiable:
-            return "not_identifiable";
-        case SolverStatus::NoConvergence:
-            return "no_convergence";
-        case SolverStatus::Failed:
-            return "failed";
-    }
-    return "failed";
-}
-
 namespace {
-template <class Enum, std::size_t N>
-Enum parse_enum(std::string_view what, std::string_view name, const std::array<Enum, N>& values) {
-    std::string accepted;
-    for (Enum v : values) {
-        if (to_string(v) == name) return v;
-        if (!accepted.empty()) accepted += ", ";
-        accepted += std::string(to_string(v));
-    }
-    throw InvalidArgument(std::string(what) + " '" + std::string(name) +
-                          "' is not recognised; accepted: " + accepted);
-}
+constexpr std::array<NameEntry<ResidualType>, 3> kResidualNames{{
+    {"relative", ResidualType::Relative},
+    {"absolute", ResidualType::Absolute},
+    {"log", ResidualType::Log},
+}};
+constexpr std::array<NameEntry<LossType>, 4> kLossNames{{
+    {"none", LossType::None},
+    {"huber", LossType::Huber},
+    {"cauchy", LossType::Cauchy},
+    {"soft_l_one", LossType::SoftLOne},
+}};
+constexpr std::array<NameEntry<SolverStatus>, 5> kSolverStatusNames{{
+    {"converged", SolverStatus::Converged},
+    {"at_bound", SolverStatus::AtBound},
+    {"not_identifiable", SolverStatus::NotIdentifiable},
+    {"no_convergence", SolverStatus::NoConvergence},
+    {"failed", SolverStatus::Failed},
+}};
 }  // namespace
 
+std::string_view to_string(ResidualType r) { return name_of(kResidualNames, r); }
+std::string_view to_string(LossType l) { return name_of(kLossNames, l); }
+std::string_view to_string(SolverStatus s) { return name_of(kSolverStatusNames, s); }
+
 ResidualType parse_residual_type(std::string_view name) {
-    return parse_enum(
-        "residual type", name,
-        std::array{ResidualType::Relative, ResidualType::Absolute, ResidualType::Log});
+    return parse_name(kResidualNames, "residual type", name);
 }
-LossType parse_loss_type(std::string_view name) {
-    return parse_enum(
-        "loss", name,
-        std::array{LossType::None, LossType::Huber, LossType::Cauchy, LossType::SoftLOne});
-}
+LossType parse_loss_type(std::string_view name) { return parse_name(kLossNames, "loss", name); }
 
 namespace {
 

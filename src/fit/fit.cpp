@@ -14,6 +14,7 @@
 #include <Eigen/Dense>
 
 #include "roughscope/core/errors.hpp"
+#include "roughscope/core/names.hpp"
 #include "roughscope/scattering/validity.hpp"
 
 namespace roughscope {
@@ -21,26 +22,19 @@ namespace roughscope {
 // ---------------------------------------------------------------------------------------------
 // Names
 
-std::string_view to_string(FitModel m) {
-    return m == FitModel::VeryRough ? "very_rough" : "slightly_rough";
-}
 namespace {
-template <class Enum, std::size_t N>
-Enum parse_enum(std::string_view what, std::string_view name, const std::array<Enum, N>& values) {
-    std::string accepted;
-    for (Enum v : values) {
-        if (to_string(v) == name) return v;
-        if (!accepted.empty()) accepted += ", ";
-        accepted += std::string(to_string(v));
-    }
-    throw InvalidArgument(std::string(what) + " '" + std::string(name) +
-                          "' is not recognised; accepted: " + accepted);
-}
+constexpr std::array<NameEntry<FitModel>, 2> kFitModelNames{{
+    {"very_rough", FitModel::VeryRough},
+    {"slightly_rough", FitModel::SlightlyRough},
+}};
 }  // namespace
 
+std::string_view to_string(FitModel m) { return name_of(kFitModelNames, m); }
+
 FitModel parse_fit_model(std::string_view name) {
-    return parse_enum("fit model", name, std::array{FitModel::VeryRough, FitModel::SlightlyRough});
+    return parse_name(kFitModelNames, "fit model", name);
 }
+
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();

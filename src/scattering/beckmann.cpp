@@ -27,12 +27,6 @@ constexpr std::array<NameEntry<Regime>, 5> kRegimeNames{{
     {"very_rough_series_limit", Regime::VeryRoughSeriesLimit},
 }};
 
-void check_geometry(const Geometry& geom) {
-    check::polar_angle("theta_i", geom.theta_i_rad);
-    check::polar_angle("theta_s", geom.theta_s_rad);
-    check::azimuth("phi_s", geom.phi_s_rad);
-}
-
 // Relative size of the second series term against the first (bounds all omitted terms).
 double second_term_ratio(Correlation c, double g, double T2_vxy2) {
     if (c == Correlation::Gaussian) return g / 4.0 * std::exp(T2_vxy2 / 8.0);  // (g/4) e^{a/2}
@@ -50,7 +44,7 @@ Regime parse_regime(std::string_view name) { return parse_name(kRegimeNames, "re
 
 ScatteredPower mean_scattered_power(const Geometry& geom, const Surface& surface,
                                     const ModelOptions& options) {
-    check_geometry(geom);
+    check::geometry(geom);
     check::positive("sigma", surface.sigma_um, "um");
     check::positive("T", surface.T_um, "um");
     check::positive("wavelength", options.wavelength_um, "um");
@@ -111,7 +105,7 @@ ScatteredPower mean_scattered_power(const Geometry& geom, const Surface& surface
 
 double very_rough_brightness(const Geometry& geom, double sigma_over_T, Correlation correlation,
                              GeometricFactor factor, Radiometry radiometry) {
-    check_geometry(geom);
+    check::geometry(geom);
     check::positive("sigma_over_T", sigma_over_T);
     const ScatteringDirection q = scattering_direction(geom);
     const double F2 = geometric_factor_squared(factor, geom);

@@ -28,10 +28,15 @@ void check_unit(std::string_view name, const Eigen::Vector3d& v, double tol) {
 
 }  // namespace
 
+void check::geometry(const Geometry& geom, std::string_view which) {
+    const std::string prefix = which.empty() ? std::string() : std::string(which) + " ";
+    check::polar_angle(prefix + "theta_i", geom.theta_i_rad);
+    check::polar_angle(prefix + "theta_s", geom.theta_s_rad);
+    check::azimuth(prefix + "phi_s", geom.phi_s_rad);
+}
+
 Geometry make_geometry(double theta_i_rad, double theta_s_rad, double phi_s_rad) {
-    check::polar_angle("theta_i", theta_i_rad);
-    check::polar_angle("theta_s", theta_s_rad);
-    check::azimuth("phi_s", phi_s_rad);
+    check::geometry({theta_i_rad, theta_s_rad, phi_s_rad});
     return {theta_i_rad, theta_s_rad, wrap_two_pi(phi_s_rad)};
 }
 

@@ -9,12 +9,6 @@
 namespace roughscope {
 namespace {
 
-void check_geometry(const Geometry& geom) {
-    check::polar_angle("theta_i", geom.theta_i_rad);
-    check::polar_angle("theta_s", geom.theta_s_rad);
-    check::azimuth("phi_s", geom.phi_s_rad);
-}
-
 void check_oren_nayar(const OrenNayarParams& p) {
     check::non_negative("oren_nayar sigma", p.sigma_rad, "rad");
     if (!(std::isfinite(p.albedo) && p.albedo >= 0.0 && p.albedo <= 1.0))
@@ -30,7 +24,7 @@ double lambert_brightness(double theta_i_rad) {
 }
 
 double oren_nayar_radiance(const Geometry& geom, const OrenNayarParams& p) {
-    check_geometry(geom);
+    check::geometry(geom);
     check_oren_nayar(p);
     const double s2 = p.sigma_rad * p.sigma_rad;
     const double ti = geom.theta_i_rad, ts = geom.theta_s_rad;
@@ -54,7 +48,7 @@ double oren_nayar_radiance(const Geometry& geom, const OrenNayarParams& p) {
 }
 
 double oren_nayar_qualitative_radiance(const Geometry& geom, const OrenNayarParams& p) {
-    check_geometry(geom);
+    check::geometry(geom);
     check_oren_nayar(p);
     const double s2 = p.sigma_rad * p.sigma_rad;
     const double alpha = std::max(geom.theta_i_rad, geom.theta_s_rad);
@@ -67,7 +61,7 @@ double oren_nayar_qualitative_radiance(const Geometry& geom, const OrenNayarPara
 }
 
 double lafortune_brdf(const Geometry& geom, const std::vector<LafortuneLobe>& lobes, double rho_d) {
-    check_geometry(geom);
+    check::geometry(geom);
     check::non_negative("rho_d", rho_d);
     const Eigen::Vector3d L = light_direction(geom), V = view_direction(geom);
     double f = rho_d / kPi;
@@ -87,7 +81,7 @@ double lafortune_brdf(const Geometry& geom, const std::vector<LafortuneLobe>& lo
 }
 
 double lafortune_diffuse_brightness(const Geometry& geom, double n) {
-    check_geometry(geom);
+    check::geometry(geom);
     check::positive("n", n);
     const double ci = std::cos(geom.theta_i_rad), cs = std::cos(geom.theta_s_rad);
     return std::pow(ci * cs, n) * ci;

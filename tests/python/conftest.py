@@ -14,6 +14,7 @@ import pytest
 
 try:
     import roughscope  # noqa: F401
+    import roughscope._core
 except ImportError as exc:  # pragma: no cover - a set-up error, reported verbatim
     raise ImportError(
         f"cannot import roughscope ({exc}); run the tests with PYTHONPATH=<build>/python "
@@ -21,15 +22,25 @@ except ImportError as exc:  # pragma: no cover - a set-up error, reported verbat
     ) from exc
 
 REPO_ROOT = pathlib.Path(__file__).resolve().parents[2]
-PAPER_TABLES = REPO_ROOT.parent / "shared" / "reference" / "paper-tables.json"
+# The library's locator (io/data_locator.hpp): $ROUGHSCOPE_SHARED_DIR, else ../shared upward from
+# the working directory and from the repository. None when absent.
+PAPER_TABLES = roughscope._core.paper_tables_path([REPO_ROOT])
+
+
+def need_shared(path, relative):
+    """Skips when shared data are absent, or fails under ROUGHSCOPE_REQUIRE_SHARED_DATA=1."""
+    if path is None:
+        where = roughscope._core.shared_search_description(relative)
+        if roughscope._core.shared_data_required():
+            pytest.fail(f"ROUGHSCOPE_REQUIRE_SHARED_DATA=1 but {where} was not found")
+        pytest.skip(f"shared data not found: {where} (not part of the repository)")
+    return path
 
 
 @pytest.fixture(scope="session")
 def paper_tables():
     """The paper's Tables 1–4 (kept beside the repository, never inside it); skip if absent."""
-    if not PAPER_TABLES.is_file():
-        pytest.skip(f"paper tables not found at ../shared/reference/paper-tables.json "
-                    f"(looked for {PAPER_TABLES})")
+    need_shared(PAPER_TABLES, "reference/paper-tables.json")
     with open(PAPER_TABLES, encoding="utf-8") as f:
         return json.load(f)
 

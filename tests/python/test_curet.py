@@ -1,7 +1,7 @@
 """Tests of the CUReT comparison through the Python module and the `roughscope curet` command.
 
-Real data: <repo>/../shared/data/curet (tests needing it skip, saying so, when it is absent).
-Printed values: <repo>/../shared/reference/paper-tables.json. Independent checks: the paper's
+Real data: ../shared/data/curet (tests needing it skip, saying so, when it is absent).
+Printed values: ../shared/reference/paper-tables.json. Both found by io/data_locator.hpp. Independent checks: the paper's
 Tables 3 and 4, facts of the data README (43 non-positive values, measurements 81 and 112), and
 synthetic tables generated here with numpy from Eq. 5 written out by hand.
 """
@@ -16,30 +16,39 @@ import numpy as np
 import pytest
 
 import roughscope
+import roughscope._core
 from roughscope import curet
 
 REPO = Path(__file__).resolve().parents[2]
-CURET_DIR = REPO.parent / "shared" / "data" / "curet"
-TABLES = REPO.parent / "shared" / "reference" / "paper-tables.json"
+# io/data_locator.hpp: $ROUGHSCOPE_SHARED_DIR, else ../shared upward (None when absent); missing
+# data skip, or fail at collection under ROUGHSCOPE_REQUIRE_SHARED_DATA=1.
+CURET_DIR = roughscope._core.curet_data_dir([REPO])
+TABLES = roughscope._core.paper_tables_path([REPO])
+if roughscope._core.shared_data_required() and (CURET_DIR is None or TABLES is None):
+    raise RuntimeError("ROUGHSCOPE_REQUIRE_SHARED_DATA=1 but the shared data were not found: " +
+                       roughscope._core.shared_search_description("data/curet"))
 
 needs_curet = pytest.mark.skipif(
-    not (CURET_DIR / "abrdf.dat").is_file(),
-    reason=f"CUReT data not found at {CURET_DIR} (abrdf.dat, table.txt); not part of the repo",
+    CURET_DIR is None,
+    reason="CUReT data not found: " + roughscope._core.shared_search_description("data/curet"),
 )
-needs_tables = pytest.mark.skipif(not TABLES.is_file(), reason=f"{TABLES} not found")
+needs_tables = pytest.mark.skipif(
+    TABLES is None,
+    reason="paper tables not found: " +
+    roughscope._core.shared_search_description("reference/paper-tables.json"))
 
 
 @pytest.fixture(scope="module")
 def db():
-    if not (CURET_DIR / "abrdf.dat").is_file():
-        pytest.skip(f"CUReT data not found at {CURET_DIR}")
+    if CURET_DIR is None:
+        pytest.skip("CUReT data not found")
     return curet.load(CURET_DIR)
 
 
 @pytest.fixture(scope="module")
 def paper():
-    if not TABLES.is_file():
-        pytest.skip(f"{TABLES} not found")
+    if TABLES is None:
+        pytest.skip("paper tables not found")
     return json.loads(TABLES.read_text(encoding="utf-8"))
 
 
@@ -282,7 +291,8 @@ def test_cli_errors_are_one_line_with_exit_codes(tmp_path):
     p = run_cli("--sample", "25", "--on-albedo", "1.5", "--on-sigma", "0.3")
     assert p.returncode == 2
     # no database anywhere: a clear error, nothing on stdout
-    env = {k: v for k, v in os.environ.items() if k != "ROUGHSCOPE_CURET"}
+    env = {k: v for k, v in os.environ.items()
+           if k not in ("ROUGHSCOPE_CURET", "ROUGHSCOPE_SHARED_DIR")}
     q = subprocess.run([_cli(), "curet", "--sample", "25"], capture_output=True, text=True,
                        cwd=tmp_path, env=env, timeout=60)
     assert q.returncode == 4 and q.stdout == ""
@@ -341,5 +351,6 @@ def test_report_section_without_data(tmp_path, monkeypatch):
 
     monkeypatch.chdir(tmp_path)
     monkeypatch.delenv("ROUGHSCOPE_CURET", raising=False)
+    monkeypatch.delenv("ROUGHSCOPE_SHARED_DIR", raising=False)
     html = report_curet.section(tmp_path / "out")
     assert "not found" in html and "<img" not in html

@@ -1,6 +1,7 @@
 // The CUReT BRDF database (Dana, van Ginneken, Nayar, Koenderink, ACM TOG 18(1), 1999), as the
 // paper uses it in §5.3. The files are never part of the project: they are read from a directory
-// (../shared/data/curet beside the project, a path the user gives, or $ROUGHSCOPE_CURET).
+// (../shared/data/curet beside the project as io/data_locator.hpp finds it, a path the user
+// gives, or $ROUGHSCOPE_CURET).
 //
 // Files (whitespace-separated text):
 //  * table.txt   205 lines `measurement theta_v phi_v theta_i phi_i`, radians, sample frame
@@ -68,7 +69,8 @@ struct CuretDatabase {
 };
 
 // Where the CUReT files are: `explicit_dir` when given (must exist and hold table.txt and
-// abrdf.dat); else ../shared/data/curet relative to the current directory when it exists; else
+// abrdf.dat); else the reference-data locator's data/curet (io/data_locator.hpp:
+// $ROUGHSCOPE_SHARED_DIR, else ../shared searched upward from the current directory); else
 // $ROUGHSCOPE_CURET. Otherwise throws DataError saying where the database comes from and which
 // files are needed.
 std::filesystem::path find_curet_directory(

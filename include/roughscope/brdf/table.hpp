@@ -18,6 +18,7 @@
 #include <cmath>
 #include <cstddef>
 #include <filesystem>
+#include <iosfwd>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -77,10 +78,15 @@ struct BrdfCsvOptions {
 //  the sample frame of the file comment) and value (BRDF, 1/sr, any sign).
 //  Optional columns: weight (≥ 0, default 1), channel (text), measurement (integer index;
 //  default: the data row number, 1-based). Other columns are ignored.
-//  Blank lines and lines starting with '#' are skipped; fields are trimmed; CRLF accepted.
+//  Read with the library's CSV reader (io/csv.hpp): blank lines and lines starting with '#' are
+//  skipped; fields are trimmed; CRLF and a UTF-8 byte-order mark accepted; numbers strict (in
+//  every row, also rows of channels not selected).
 // Throws DataError "<source>:<line>: <reason>" naming the column for anything malformed
 // (missing column, bad number, angle out of range, duplicate measurement index, no data rows).
 BrdfTable parse_brdf_csv(std::string_view text, std::string_view source_name,
+                         const BrdfCsvOptions& options = {});
+// The same from a stream, read row by row.
+BrdfTable parse_brdf_csv(std::istream& in, std::string_view source_name,
                          const BrdfCsvOptions& options = {});
 
 // The same from a file; DataError when the file cannot be read.

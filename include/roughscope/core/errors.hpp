@@ -55,7 +55,8 @@ void polar_angle(std::string_view name, double theta_rad);
 // wrapped by the functions that use them).
 void azimuth(std::string_view name, double phi_rad);
 
-// Formats a double for messages: shortest round-trip form, "nan"/"inf" spelled out.
+// Formats a double for messages: format_message of numbers.hpp (shortest round-trip form,
+// "nan"/"inf" spelled out).
 std::string format_number(double value);
 
 }  // namespace check

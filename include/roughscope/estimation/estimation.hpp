@@ -92,7 +92,8 @@ double correlation_length_from_ratio(double E1_over_E2, double sigma_um, double 
                                      GeometricFactor factor = GeometricFactor::VernoldHarvey);
 
 // =============================================================================================
-// General two-geometry solver (item 4 of the issue): E1/E2 measured at two arbitrary geometries.
+// General two-geometry solver (extends §4.2 beyond normal view): E1/E2 measured at two arbitrary
+// geometries.
 //
 // The model ratio M(x) = B(geom1; x)/B(geom2; x) of the brightness B (diffuse term × radiometric
 // factor, gain K cancels) is inverted for the unknown x (σ/T, or T with σ known) by TOMS 748
@@ -137,7 +138,8 @@ double model_ratio_diffuse(const Geometry& geom1, const Geometry& geom2, double 
                            const TwoGeometryOptions& options = {});
 
 // =============================================================================================
-// Uncertainty propagation (item 6) and derived quantities (item 7).
+// Uncertainty propagation of the §4 estimators and derived quantities (slope, Caron's θK and ξK,
+// §3.5).
 
 // A value with its standard error (first-order propagation; 0 when no noise was given).
 struct Estimate {

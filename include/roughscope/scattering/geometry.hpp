@@ -12,6 +12,7 @@
 
 #include <numbers>
 #include <optional>
+#include <string_view>
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
@@ -33,6 +34,13 @@ struct Geometry {
 // Validated constructor: θi, θs in [0, π/2), φs finite (wrapped to [0, 2π)).
 // Throws InvalidArgument naming the bad angle otherwise.
 Geometry make_geometry(double theta_i_rad, double theta_s_rad, double phi_s_rad);
+
+namespace check {
+// The one validation of a Geometry at an API boundary (§2): θi, θs in [0, π/2), φs finite.
+// Throws InvalidArgument naming the angle ("theta_i", or "<which> theta_i" when `which` is given,
+// e.g. "geom1 theta_i") and the valid range otherwise.
+void geometry(const Geometry& geom, std::string_view which = {});
+}  // namespace check
 
 // §2: θi = acos(N·L), θs = acos(N·V), φs = π − acos(L̂p·V̂p) with the tangent-plane projections
 // Lp = (N×L)×N and Vp = (N×V)×N. φs is returned in [0, π] (isotropic surfaces cannot tell ±φs).

@@ -26,6 +26,7 @@ inline RoughnessClass roughness_class(double g) {
 }
 
 std::string_view to_string(RoughnessClass c);  // "slightly_rough", "moderately_rough", "very_rough"
+RoughnessClass parse_roughness_class(std::string_view name);  // throws InvalidArgument
 
 // RMS slope m = σ√2/T (§4; also called the RMS gradient σ_g). Gaussian correlation.
 inline double rms_slope(double sigma_over_T) { return std::sqrt(2.0) * sigma_over_T; }

@@ -1,6 +1,7 @@
 // The CUReT database and the paper's §5.3 comparison (Tables 3 and 4).
-// Real data: ROUGHSCOPE_SOURCE_DIR/../shared/data/curet (tests skip, saying so, when it is absent);
-// printed values: ROUGHSCOPE_SOURCE_DIR/../shared/reference/paper-tables.json.
+// Real data: ../shared/data/curet and printed values: ../shared/reference/paper-tables.json, found
+// by io/data_locator.hpp (tests skip, saying so, when absent; fail under
+// ROUGHSCOPE_REQUIRE_SHARED_DATA=1).
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
@@ -12,6 +13,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "../io/shared_data.hpp"
 #include "roughscope/brdf/comparison.hpp"
 #include "roughscope/brdf/curet.hpp"
 #include "roughscope/core/errors.hpp"
@@ -23,25 +25,13 @@ namespace fs = std::filesystem;
 
 namespace {
 
-fs::path curet_dir() {
-    return fs::path(ROUGHSCOPE_SOURCE_DIR) / ".." / "shared" / "data" / "curet";
-}
-fs::path tables_path() {
-    return fs::path(ROUGHSCOPE_SOURCE_DIR) / ".." / "shared" / "reference" / "paper-tables.json";
-}
+// Located by io/data_locator.hpp (empty paths when absent).
+fs::path curet_dir() { return roughscope::testing::curet_dir().value_or(fs::path()); }
+fs::path tables_path() { return roughscope::testing::paper_tables().value_or(fs::path()); }
 
-bool have_curet() {
-    return fs::exists(curet_dir() / "abrdf.dat") && fs::exists(curet_dir() / "table.txt");
-}
-
-#define REQUIRE_CURET()                                                \
-    if (!have_curet())                                                 \
-    GTEST_SKIP() << "CUReT data not found at " << curet_dir().string() \
-                 << " (abrdf.dat, table.txt); the database is not part of the repository"
-
-#define REQUIRE_TABLES()            \
-    if (!fs::exists(tables_path())) \
-    GTEST_SKIP() << "paper tables not found at " << tables_path().string()
+#define REQUIRE_CURET() ROUGHSCOPE_NEED_SHARED(roughscope::testing::curet_dir(), io::kCuretRelative)
+#define REQUIRE_TABLES() \
+    ROUGHSCOPE_NEED_SHARED(roughscope::testing::paper_tables(), io::kPaperTablesRelative)
 
 const CuretDatabase& database() {
     static const CuretDatabase db = load_curet(curet_dir());

@@ -12,6 +12,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "../io/shared_data.hpp"
 #include "roughscope/core/errors.hpp"
 #include "roughscope/estimation/estimation.hpp"
 #include "roughscope/scattering/beckmann.hpp"
@@ -26,23 +27,19 @@ namespace {
 
 constexpr double kLambda = 0.555;  // µm, the paper's mean wavelength (§5)
 
-std::filesystem::path paper_tables_path() {
-    return std::filesystem::path(ROUGHSCOPE_SOURCE_DIR) / ".." / "shared" / "reference" /
-           "paper-tables.json";
-}
-
-// Loads the paper's tables, or returns null (the test then skips with the reason).
+// Loads the paper's tables (io/data_locator.hpp), or returns null (the test then skips, or fails
+// under ROUGHSCOPE_REQUIRE_SHARED_DATA=1).
 nlohmann::json load_tables() {
-    std::ifstream in(paper_tables_path());
+    const auto path = roughscope::testing::paper_tables();
+    if (!path) return nullptr;
+    std::ifstream in(*path);
     if (!in) return nullptr;
     return nlohmann::json::parse(in);
 }
 
-#define LOAD_TABLES_OR_SKIP(var)                                            \
-    const nlohmann::json var = load_tables();                               \
-    if (var.is_null())                                                      \
-        GTEST_SKIP() << "paper tables not found at " << paper_tables_path() \
-                     << " (../shared/reference/paper-tables.json beside the source tree)";
+#define LOAD_TABLES_OR_SKIP(var)              \
+    const nlohmann::json var = load_tables(); \
+    ROUGHSCOPE_NEED_SHARED(!var.is_null(), rs::io::kPaperTablesRelative)
 
 double round_to(double x, int decimals) {
     const double f = std::pow(10.0, decimals);

@@ -1,0 +1,59 @@
+// Numbers at the text boundary: the library's one strict parser and one formatter family.
+//
+// Parsing (files, command-line values, CSV cells): std::from_chars on the WHOLE text; surrounding
+// spaces/tabs (and CR/LF) are allowed, a leading '+' is allowed; anything else after the number
+// ("1.5x"), hexadecimal, "nan", "inf" and values outside the double range are rejected, with a
+// reason that can be shown to the user.
+//
+// Formatting (three members, one per use):
+//  * format_roundtrip   — shortest text that reads back to the same double (files, JSON-like
+//                         output); refuses NaN/infinity (results are never printed as NaN);
+//  * format_significant — fixed number of significant digits ("%.*g") for human-readable text;
+//                         refuses NaN/infinity too;
+//  * format_message     — error messages: shortest round-trip form (or fixed significant
+//                         digits), "nan", "inf" and "-inf" spelled out (the value being reported
+//                         may be the bad one).
+#pragma once
+
+#include <cstddef>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace roughscope {
+
+// `text` without leading and trailing spaces, tabs, CR, LF, VT, FF (what the parser ignores; the
+// one trim of the library's text readers).
+std::string_view trim_space(std::string_view text);
+
+// Parses the whole of `text` as a finite double. Returns std::nullopt and sets `reason` ("empty
+// (a number is required)", "not a number", "not a finite number (NaN is not accepted)", "out of
+// the range of double-precision numbers", ...) otherwise.
+std::optional<double> try_parse_number(std::string_view text, std::string& reason);
+
+// As try_parse_number but throws InvalidArgument "<what>: '<text>' is <reason>" (text trimmed).
+double parse_number(std::string_view text, std::string_view what);
+
+// Parses "a,b,c" into exactly `count` finite numbers; throws InvalidArgument naming `what` (and
+// the item, 1-based, for a bad number).
+std::vector<double> parse_number_list(std::string_view text, std::size_t count,
+                                      std::string_view what);
+
+// Shortest round-trip text of a finite value ("0.1", "1e-07", "-0" kept as "-0"). Throws
+// roughscope::Error naming `name` for NaN or infinity.
+std::string format_roundtrip(double value, std::string_view name = "value");
+
+// `digits` significant digits ("%.*g", 1 <= digits <= 17), "-0" printed as "0". Throws
+// roughscope::Error naming `name` for NaN or infinity.
+std::string format_significant(double value, int digits, std::string_view name = "value");
+
+// For error messages only: shortest round-trip form (or `digits` significant digits when
+// digits > 0), "nan", "inf", "-inf" spelled out.
+std::string format_message(double value, int digits = 0);
+
+// `value` rounded to `digits` significant digits (the value format_significant prints). NaN,
+// infinity and zero are returned unchanged.
+double round_significant(double value, int digits);
+
+}  // namespace roughscope

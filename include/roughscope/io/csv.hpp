@@ -1,0 +1,128 @@
+// Reading delimited text files: the library's one CSV reader and the line/field splitter under it.
+//
+// Conventions shared by every text format the library reads (CSV tables, CUReT's table.txt and
+// *.dat files):
+//  * a UTF-8 byte-order mark at the start of the file is skipped; CRLF and LF line ends are both
+//    accepted (one trailing CR is removed from every line);
+//  * numbers are parsed strictly (roughscope/core/numbers.hpp): "nan", "inf", "1.5x" are errors;
+//  * every error is a DataError "<file>:<line>: <reason>" naming the column or field.
+//
+// CSV (CsvReader): comma-separated, one header line naming the columns, then data rows.
+//  * Blank lines and lines whose first non-space character is '#' are skipped (before or after
+//    the header); fields are trimmed of spaces/tabs. No quoting.
+//  * The header must contain every `required` column; `optional` columns are parsed as numbers
+//    when present; other columns are kept as text only. Column names are case-sensitive.
+//  * An empty cell of an optional column means "not given"; an empty required cell is an error.
+// Rows are read one at a time (memory bounded by the longest line), or all at once with read_csv.
+#pragma once
+
+#include <cstddef>
+#include <filesystem>
+#include <iosfwd>
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "roughscope/core/numbers.hpp"
+
+namespace roughscope::io {
+
+// ---------------------------------------------------------------------------------------------
+// Lower level: lines and fields
+
+// `s` without leading and trailing spaces, tabs, CR and LF (core/numbers.hpp's trim_space).
+inline std::string_view trim(std::string_view s) { return trim_space(s); }
+
+// The fields of `line` between `separator`s, untrimmed ("a,,b" -> "a", "", "b"; "" -> one field).
+std::vector<std::string_view> split_fields(std::string_view line, char separator);
+
+// The whitespace-separated words of `line` (empty for a blank line).
+std::vector<std::string_view> split_whitespace(std::string_view line);
+
+// Reads a text stream line by line: skips a UTF-8 byte-order mark at the start and removes one
+// trailing CR from each line. Counts lines from 1 for error messages.
+class LineReader {
+  public:
+    // Reads `in` (which must outlive the reader); `source` names it in messages.
+    LineReader(std::istream& in, std::string source);
+    // Opens `path`; throws DataError "<path>: cannot open: <reason>" (or "is a directory").
+    explicit LineReader(const std::filesystem::path& path);
+    ~LineReader();
+    LineReader(LineReader&&) noexcept;
+    LineReader& operator=(LineReader&&) noexcept;
+
+    // The next line (without its end), valid until the next call; false at the end of input.
+    // Throws DataError "<source>: read error" on an I/O failure.
+    bool next(std::string_view& line);
+
+    std::size_t line_number() const { return line_; }  // of the last line returned
+    const std::string& source() const { return source_; }
+    // "<source>:<line>: " for the last line returned.
+    std::string where() const;
+
+  private:
+    std::unique_ptr<std::istream> owned_;
+    std::istream* in_ = nullptr;
+    std::string source_;
+    std::string buffer_;
+    std::size_t line_ = 0;
+};
+
+// ---------------------------------------------------------------------------------------------
+// CSV with a header
+
+// One data row.
+struct CsvRow {
+    std::size_t line = 0;                        // 1-based line number in the file
+    std::map<std::string, double> values;        // parsed required + present optional columns
+    std::map<std::string, std::string> text;     // every column, trimmed, as written
+    double at(const std::string& column) const;  // a value; DataError "line N: ..." if absent
+    std::optional<double> find(const std::string& column) const;  // optional column
+};
+
+// Streams the rows of a CSV file (see the conventions above). The header is read by the
+// constructor.
+class CsvReader {
+  public:
+    // Opens `path`. Throws DataError for a missing/unreadable file, a missing header ("no header
+    // line"), a header with an empty or duplicate column name, or missing required columns
+    // ("missing column(s) a, b (found: ...; required: ...; optional: ...)").
+    CsvReader(const std::filesystem::path& path, std::vector<std::string> required,
+              std::vector<std::string> optional = {});
+    // The same from a stream (which must outlive the reader); `source` names it in messages.
+    CsvReader(std::istream& in, std::string source, std::vector<std::string> required,
+              std::vector<std::string> optional = {});
+
+    const std::vector<std::string>& header() const { return header_; }
+    bool has_column(std::string_view name) const;
+    const std::string& source() const { return lines_.source(); }
+
+    // Reads the next data row into `row`; false at the end of the file. Throws DataError
+    // "<file>:<line>: ..." for a wrong number of fields ("expected N fields (...), found M") or
+    // a bad number ("column <name>: '<cell>' is not a number").
+    bool next(CsvRow& row);
+
+    std::size_t rows_read() const { return rows_; }
+
+  private:
+    void read_header();
+
+    LineReader lines_;
+    std::vector<std::string> required_, optional_, header_;
+    std::vector<int> kind_;  // per column: 0 = text only, 1 = required, 2 = optional
+    std::size_t rows_ = 0;
+};
+
+// Every row of a CSV file (CsvReader); throws DataError "<file>: no data rows after the header"
+// when there are none.
+std::vector<CsvRow> read_csv(const std::filesystem::path& path,
+                             const std::vector<std::string>& required,
+                             const std::vector<std::string>& optional = {});
+
+// Quotes a CSV field for writing only if it contains a comma, quote or line break.
+std::string csv_field(std::string_view text);
+
+}  // namespace roughscope::io

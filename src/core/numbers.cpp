@@ -1,0 +1,124 @@
+// The strict number parser and the formatter family (numbers.hpp).
+#include "roughscope/core/numbers.hpp"
+
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <system_error>
+
+#include "roughscope/core/errors.hpp"
+
+namespace roughscope {
+namespace {
+
+[[noreturn]] void refuse_non_finite(std::string_view name) {
+    throw Error("internal error: " + std::string(name) +
+                " is not a finite number; refusing to print it");
+}
+
+std::string printf_g(double value, int digits) {
+    char buf[64];
+    std::snprintf(buf, sizeof buf, "%.*g", digits, value);
+    return buf;
+}
+
+}  // namespace
+
+std::string_view trim_space(std::string_view s) {
+    constexpr std::string_view kSpace = " \t\r\n\v\f";
+    const auto first = s.find_first_not_of(kSpace);
+    if (first == std::string_view::npos) return {};
+    const auto last = s.find_last_not_of(kSpace);
+    return s.substr(first, last - first + 1);
+}
+
+std::optional<double> try_parse_number(std::string_view text, std::string& reason) {
+    std::string_view s = trim_space(text);
+    if (s.empty()) {
+        reason = "empty (a number is required)";
+        return std::nullopt;
+    }
+    if (s.front() == '+') s.remove_prefix(1);
+    double value = 0.0;
+    const auto [ptr, ec] = std::from_chars(s.data(), s.data() + s.size(), value);
+    if (ec == std::errc::result_out_of_range) {
+        reason = "out of the range of double-precision numbers";
+        return std::nullopt;
+    }
+    if (s.empty() || ec != std::errc() || ptr != s.data() + s.size()) {
+        reason = "not a number";
+        return std::nullopt;
+    }
+    if (std::isnan(value)) {
+        reason = "not a finite number (NaN is not accepted)";
+        return std::nullopt;
+    }
+    if (std::isinf(value)) {
+        reason = "not a finite number (infinity is not accepted)";
+        return std::nullopt;
+    }
+    return value;
+}
+
+double parse_number(std::string_view text, std::string_view what) {
+    std::string reason;
+    const auto value = try_parse_number(text, reason);
+    if (!value)
+        throw InvalidArgument(std::string(what) + ": '" + std::string(trim_space(text)) + "' is " +
+                              reason);
+    return *value;
+}
+
+std::vector<double> parse_number_list(std::string_view text, std::size_t count,
+                                      std::string_view what) {
+    std::vector<std::string_view> parts;
+    for (std::size_t start = 0;;) {
+        const auto comma = text.find(',', start);
+        parts.push_back(
+            text.substr(start, comma == std::string_view::npos ? comma : comma - start));
+        if (comma == std::string_view::npos) break;
+        start = comma + 1;
+    }
+    if (parts.size() != count)
+        throw InvalidArgument(std::string(what) + ": expected " + std::to_string(count) +
+                              " comma-separated numbers, got '" + std::string(trim_space(text)) +
+                              "'");
+    std::vector<double> out;
+    out.reserve(count);
+    for (std::size_t i = 0; i < parts.size(); ++i)
+        out.push_back(
+            parse_number(parts[i], std::string(what) + " (item " + std::to_string(i + 1) + ")"));
+    return out;
+}
+
+std::string format_roundtrip(double value, std::string_view name) {
+    if (!std::isfinite(value)) refuse_non_finite(name);
+    char buf[64];
+    const auto res = std::to_chars(buf, buf + sizeof buf, value);
+    return std::string(buf, res.ptr);
+}
+
+std::string format_significant(double value, int digits, std::string_view name) {
+    if (!std::isfinite(value)) refuse_non_finite(name);
+    if (digits < 1 || digits > 17)
+        throw InvalidArgument("digits = " + std::to_string(digits) +
+                              " is outside the valid range [1, 17]");
+    return printf_g(value == 0.0 ? 0.0 : value, digits);  // no "-0"
+}
+
+std::string format_message(double value, int digits) {
+    if (std::isnan(value)) return "nan";
+    if (std::isinf(value)) return value > 0 ? "inf" : "-inf";
+    if (digits > 0) return printf_g(value, digits < 17 ? digits : 17);
+    char buf[64];
+    const auto res = std::to_chars(buf, buf + sizeof buf, value);
+    return std::string(buf, res.ptr);
+}
+
+double round_significant(double value, int digits) {
+    if (!std::isfinite(value) || value == 0.0) return value;
+    return std::strtod(printf_g(value, digits).c_str(), nullptr);
+}
+
+}  // namespace roughscope

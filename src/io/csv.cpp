@@ -1,0 +1,218 @@
+// The CSV reader and the line/field splitter (csv.hpp).
+#include "roughscope/io/csv.hpp"
+
+#include <algorithm>
+#include <cerrno>
+#include <cstring>
+#include <fstream>
+#include <istream>
+#include <set>
+#include <system_error>
+
+#include "roughscope/core/errors.hpp"
+#include "roughscope/core/numbers.hpp"
+
+namespace roughscope::io {
+namespace {
+
+std::string join(const std::vector<std::string>& items, std::string_view sep) {
+    std::string out;
+    for (std::size_t i = 0; i < items.size(); ++i) {
+        if (i) out += sep;
+        out += items[i];
+    }
+    return out;
+}
+
+bool is_space(char c) {
+    return c == ' ' || c == '\t' || c == '\r' || c == '\n' || c == '\v' || c == '\f';
+}
+
+}  // namespace
+
+std::vector<std::string_view> split_fields(std::string_view line, char separator) {
+    std::vector<std::string_view> out;
+    std::size_t start = 0;
+    while (true) {
+        const auto pos = line.find(separator, start);
+        if (pos == std::string_view::npos) {
+            out.push_back(line.substr(start));
+            return out;
+        }
+        out.push_back(line.substr(start, pos - start));
+        start = pos + 1;
+    }
+}
+
+std::vector<std::string_view> split_whitespace(std::string_view line) {
+    std::vector<std::string_view> out;
+    std::size_t k = 0;
+    while (k < line.size()) {
+        while (k < line.size() && is_space(line[k])) ++k;
+        const std::size_t start = k;
+        while (k < line.size() && !is_space(line[k])) ++k;
+        if (k > start) out.push_back(line.substr(start, k - start));
+    }
+    return out;
+}
+
+// ---------------------------------------------------------------------------------------------
+// LineReader
+
+LineReader::LineReader(std::istream& in, std::string source)
+    : in_(&in), source_(std::move(source)) {}
+
+LineReader::LineReader(const std::filesystem::path& path) : source_(path.string()) {
+    std::error_code ec;
+    if (std::filesystem::is_directory(path, ec))
+        throw DataError(source_ + ": is a directory, not a file");
+    auto file = std::make_unique<std::ifstream>(path, std::ios::binary);
+    if (!*file) throw DataError(source_ + ": cannot open: " + std::strerror(errno));
+    owned_ = std::move(file);
+    in_ = owned_.get();
+}
+
+LineReader::~LineReader() = default;
+LineReader::LineReader(LineReader&&) noexcept = default;
+LineReader& LineReader::operator=(LineReader&&) noexcept = default;
+
+bool LineReader::next(std::string_view& line) {
+    if (!std::getline(*in_, buffer_)) {
+        if (in_->bad()) throw DataError(source_ + ": read error");
+        return false;
+    }
+    ++line_;
+    std::string_view view = buffer_;
+    if (line_ == 1 && view.starts_with("\xEF\xBB\xBF")) view.remove_prefix(3);  // UTF-8 BOM
+    if (!view.empty() && view.back() == '\r') view.remove_suffix(1);
+    line = view;
+    return true;
+}
+
+std::string LineReader::where() const { return source_ + ":" + std::to_string(line_) + ": "; }
+
+// ---------------------------------------------------------------------------------------------
+// CsvRow, CsvReader
+
+double CsvRow::at(const std::string& column) const {
+    const auto it = values.find(column);
+    if (it == values.end())
+        throw DataError("line " + std::to_string(line) + ": column " + column + " has no value");
+    return it->second;
+}
+
+std::optional<double> CsvRow::find(const std::string& column) const {
+    const auto it = values.find(column);
+    if (it == values.end()) return std::nullopt;
+    return it->second;
+}
+
+CsvReader::CsvReader(const std::filesystem::path& path, std::vector<std::string> required,
+                     std::vector<std::string> optional)
+    : lines_(path), required_(std::move(required)), optional_(std::move(optional)) {
+    read_header();
+}
+
+CsvReader::CsvReader(std::istream& in, std::string source, std::vector<std::string> required,
+                     std::vector<std::string> optional)
+    : lines_(in, std::move(source)),
+      required_(std::move(required)),
+      optional_(std::move(optional)) {
+    read_header();
+}
+
+bool CsvReader::has_column(std::string_view name) const {
+    return std::find(header_.begin(), header_.end(), name) != header_.end();
+}
+
+void CsvReader::read_header() {
+    std::string_view raw;
+    while (lines_.next(raw)) {
+        const std::string_view line = trim(raw);
+        if (line.empty() || line.front() == '#') continue;
+        std::set<std::string, std::less<>> seen;
+        for (const auto f : split_fields(line, ',')) {
+            std::string name(trim(f));
+            if (name.empty())
+                throw DataError(lines_.where() + "empty column name in the header '" +
+                                std::string(line) + "'");
+            if (!seen.insert(name).second)
+                throw DataError(lines_.where() + "duplicate column '" + name + "' in the header");
+            header_.push_back(std::move(name));
+        }
+        std::vector<std::string> missing;
+        for (const auto& r : required_)
+            if (!seen.count(r)) missing.push_back(r);
+        if (!missing.empty())
+            throw DataError(
+                lines_.where() + "missing column(s) " + join(missing, ", ") +
+                " (found: " + join(header_, ", ") + "; required: " + join(required_, ", ") +
+                (optional_.empty() ? "" : "; optional: " + join(optional_, ", ")) + ")");
+        for (const auto& name : header_) {
+            if (std::find(required_.begin(), required_.end(), name) != required_.end())
+                kind_.push_back(1);
+            else if (std::find(optional_.begin(), optional_.end(), name) != optional_.end())
+                kind_.push_back(2);
+            else
+                kind_.push_back(0);
+        }
+        return;
+    }
+    throw DataError(lines_.source() + ": no header line (expected columns " +
+                    join(required_, ", ") + ")");
+}
+
+bool CsvReader::next(CsvRow& row) {
+    std::string_view raw;
+    while (lines_.next(raw)) {
+        const std::string_view line = trim(raw);
+        if (line.empty() || line.front() == '#') continue;
+        const auto fields = split_fields(line, ',');
+        if (fields.size() != header_.size())
+            throw DataError(lines_.where() + "expected " + std::to_string(header_.size()) +
+                            " fields (" + join(header_, ",") + "), found " +
+                            std::to_string(fields.size()));
+        row.line = lines_.line_number();
+        row.values.clear();
+        row.text.clear();
+        for (std::size_t c = 0; c < fields.size(); ++c) {
+            const std::string_view cell = trim(fields[c]);
+            row.text.emplace(header_[c], std::string(cell));
+            if (kind_[c] == 0) continue;
+            if (cell.empty() && kind_[c] == 2) continue;  // optional, not given on this row
+            std::string reason;
+            const auto value = try_parse_number(cell, reason);
+            if (!value)
+                throw DataError(lines_.where() + "column " + header_[c] + ": '" +
+                                std::string(cell) + "' is " + reason);
+            row.values.emplace(header_[c], *value);
+        }
+        ++rows_;
+        return true;
+    }
+    return false;
+}
+
+std::vector<CsvRow> read_csv(const std::filesystem::path& path,
+                             const std::vector<std::string>& required,
+                             const std::vector<std::string>& optional) {
+    CsvReader reader(path, required, optional);
+    std::vector<CsvRow> rows;
+    CsvRow row;
+    while (reader.next(row)) rows.push_back(row);
+    if (rows.empty()) throw DataError(reader.source() + ": no data rows after the header");
+    return rows;
+}
+
+std::string csv_field(std::string_view text) {
+    if (text.find_first_of(",\"\n\r") == std::string_view::npos) return std::string(text);
+    std::string out = "\"";
+    for (char c : text) {
+        if (c == '"') out += '"';
+        out += c;
+    }
+    out += '"';
+    return out;
+}
+
+}  // namespace roughscope::io

@@ -1,0 +1,109 @@
+// The strict number parser and the formatter family (roughscope/core/numbers.hpp).
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "roughscope/core/errors.hpp"
+#include "roughscope/core/numbers.hpp"
+
+using namespace roughscope;
+
+namespace {
+
+std::string reason_for(std::string_view text) {
+    std::string reason;
+    EXPECT_FALSE(try_parse_number(text, reason).has_value()) << text;
+    return reason;
+}
+
+std::string message_of(auto&& f) {
+    try {
+        f();
+    } catch (const Error& e) {
+        return e.what();
+    }
+    ADD_FAILURE() << "no exception";
+    return {};
+}
+
+}  // namespace
+
+TEST(Numbers, ParsesWholeTextWithSurroundingSpaces) {
+    std::string reason;
+    EXPECT_EQ(try_parse_number("1.5", reason), 1.5);
+    EXPECT_EQ(try_parse_number("  -2e-3\t", reason), -2e-3);
+    EXPECT_EQ(try_parse_number("+7", reason), 7.0);
+    EXPECT_EQ(try_parse_number("0.1\r\n", reason), 0.1);
+    EXPECT_EQ(try_parse_number("1e308", reason), 1e308);
+    EXPECT_EQ(parse_number(" 42 ", "x"), 42.0);
+}
+
+TEST(Numbers, TrimSpace) {
+    EXPECT_EQ(trim_space(" \t 1.5 \r\n"), "1.5");
+    EXPECT_EQ(trim_space("   "), "");
+    EXPECT_EQ(trim_space("a b"), "a b");
+}
+
+TEST(Numbers, RejectsAnythingButOneFiniteNumber) {
+    EXPECT_EQ(reason_for(""), "empty (a number is required)");
+    EXPECT_EQ(reason_for("   "), "empty (a number is required)");
+    EXPECT_EQ(reason_for("1.5x"), "not a number");
+    EXPECT_EQ(reason_for("1 2"), "not a number");
+    EXPECT_EQ(reason_for("+"), "not a number");
+    EXPECT_EQ(reason_for("++1"), "not a number");
+    EXPECT_EQ(reason_for("0x10"), "not a number");
+    EXPECT_EQ(reason_for("1,5"), "not a number");
+    EXPECT_EQ(reason_for("nan"), "not a finite number (NaN is not accepted)");
+    EXPECT_EQ(reason_for("-inf"), "not a finite number (infinity is not accepted)");
+    EXPECT_EQ(reason_for("1e999"), "out of the range of double-precision numbers");
+}
+
+TEST(Numbers, ParseNumberThrowsNamingTheInput) {
+    const std::string m = message_of([] { parse_number(" 1.5x ", "--sigma"); });
+    EXPECT_EQ(m, "--sigma: '1.5x' is not a number");
+    EXPECT_THROW(parse_number("inf", "x"), InvalidArgument);
+}
+
+TEST(Numbers, ParseNumberList) {
+    EXPECT_EQ(parse_number_list("1, 2,3", 3, "--n"), (std::vector<double>{1, 2, 3}));
+    EXPECT_EQ(message_of([] { parse_number_list("1,2", 3, "--n"); }),
+              "--n: expected 3 comma-separated numbers, got '1,2'");
+    EXPECT_EQ(message_of([] { parse_number_list("1,x,3", 3, "--n"); }),
+              "--n (item 2): 'x' is not a number");
+}
+
+TEST(Numbers, RoundTripIsShortestAndExact) {
+    for (double v : {0.1, 1.0 / 3.0, 1e-300, -2.5e17, 123456.789, 0.0}) {
+        const std::string s = format_roundtrip(v);
+        std::string reason;
+        EXPECT_EQ(try_parse_number(s, reason), v) << s;
+    }
+    EXPECT_EQ(format_roundtrip(0.1), "0.1");
+    EXPECT_EQ(format_roundtrip(90.0), "90");
+}
+
+TEST(Numbers, RoundTripAndSignificantRefuseNonFinite) {
+    EXPECT_THROW(format_roundtrip(std::nan("")), Error);
+    EXPECT_THROW(format_significant(std::numeric_limits<double>::infinity(), 6), Error);
+    EXPECT_NE(message_of([] { format_significant(std::nan(""), 6, "sigma"); }).find("sigma"),
+              std::string::npos);
+    EXPECT_THROW(format_significant(1.0, 0), InvalidArgument);
+}
+
+TEST(Numbers, SignificantDigits) {
+    EXPECT_EQ(format_significant(1.0 / 3.0, 4), "0.3333");
+    EXPECT_EQ(format_significant(123456.0, 3), "1.23e+05");
+    EXPECT_EQ(format_significant(-0.0, 10), "0");
+    EXPECT_DOUBLE_EQ(round_significant(1.23456789, 3), 1.23);
+    EXPECT_TRUE(std::isnan(round_significant(std::nan(""), 3)));
+}
+
+TEST(Numbers, MessagesSpellOutNonFinite) {
+    EXPECT_EQ(format_message(std::nan("")), "nan");
+    EXPECT_EQ(format_message(-std::numeric_limits<double>::infinity()), "-inf");
+    EXPECT_EQ(format_message(0.5), "0.5");
+    EXPECT_EQ(format_message(1.0 / 3.0, 3), "0.333");
+    EXPECT_EQ(check::format_number(0.25), "0.25");  // the message helper of errors.hpp
+}
