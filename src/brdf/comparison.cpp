@@ -6,7 +6,6 @@
 #include <array>
 #include <atomic>
 #include <cmath>
-#include <cstdio>
 #include <exception>
 #include <functional>
 #include <limits>
@@ -20,9 +19,11 @@
 
 #include "roughscope/core/errors.hpp"
 #include "roughscope/core/names.hpp"
+#include "roughscope/core/numbers.hpp"
 #include "roughscope/estimation/estimation.hpp"
 #include "roughscope/fit/engine.hpp"
 #include "roughscope/scattering/beckmann.hpp"
+#include "roughscope/scattering/precomputed_terms.hpp"
 
 namespace roughscope {
 namespace {
@@ -56,12 +57,6 @@ const ModelInfo& info(ComparisonModel m) {
     return kModelInfo[0];  // unreachable
 }
 
-std::string fmt(double x, const char* spec = "%.6g") {
-    char buf[64];
-    std::snprintf(buf, sizeof buf, spec, x);
-    return buf;
-}
-
 // ---------------------------------------------------------------------------------------------
 // The used measurements with everything the model evaluations need, computed once per table.
 
@@ -73,10 +68,17 @@ struct Prepared {
     double sum_wdd = 0.0;
     Radiometry radiometry = Radiometry::Radiance;  // §3.3 interpretation of the B–K models
     std::vector<double> cos_i, log_cos_i_cos_s;    // Lafortune diffuse lobe
+    VeryRoughTerms beckmann, vernold_harvey;       // Eq. 4/5 with F_Beck, F_VH (§3.2)
+    OrenNayarTerms oren_nayar;
 
     std::size_t size() const { return geom.size(); }
+    const VeryRoughTerms& very_rough(GeometricFactor factor) const {
+        return factor == GeometricFactor::Beckmann ? beckmann : vernold_harvey;
+    }
 };
 
+// The geometry-only terms of every model, computed once per table (the geometries of a BrdfTable
+// are valid: check::geometry holds).
 Prepared prepare(const std::vector<Geometry>& geom, const std::vector<double>& d_normalised,
                  const std::vector<double>& w, Radiometry radiometry) {
     Prepared p;
@@ -94,21 +96,23 @@ Prepared prepare(const std::vector<Geometry>& geom, const std::vector<double>& d
         p.sum_w += w[j];
         p.sum_wdd += w[j] * p.d[j] * p.d[j];
     }
+    p.beckmann = VeryRoughTerms(geom, GeometricFactor::Beckmann, radiometry);
+    p.vernold_harvey = VeryRoughTerms(geom, GeometricFactor::VernoldHarvey, radiometry);
+    p.oren_nayar = OrenNayarTerms(geom);
     return p;
 }
 
 // Very-rough brightness, Eq. 4 (Gaussian) / Eq. 5 (exponential) as published with F_Beck or F_VH,
-// times the radiometric factor of §3.3: the library's very_rough_brightness at each geometry.
+// times the radiometric factor of §3.3: very_rough_brightness at each geometry, from the
+// geometry-only terms (precomputed_terms.hpp).
 void very_rough_prediction(const Prepared& p, GeometricFactor factor, Correlation c,
                            double sigma_over_T, std::vector<double>& out) {
     out.resize(p.size());
-    for (std::size_t j = 0; j < p.size(); ++j)
-        out[j] = very_rough_brightness(p.geom[j], sigma_over_T, c, factor, p.radiometry);
+    p.very_rough(factor).brightness(sigma_over_T, c, out);
 }
 
 // Lafortune diffuse lobe E = (cos θi cos θs)^n cos θi (models.hpp), via precomputed logarithms.
-void lafortune_prediction(const Prepared& p, double n, std::vector<double>& out) {
-    out.resize(p.size());
+void lafortune_prediction(const Prepared& p, double n, std::span<double> out) {
     for (std::size_t j = 0; j < p.size(); ++j)
         out[j] = p.cos_i[j] * std::exp(n * p.log_cos_i_cos_s[j]);
 }
@@ -116,7 +120,7 @@ void lafortune_prediction(const Prepared& p, double n, std::vector<double>& out)
 // Oren–Nayar with inter-reflection (models.hpp).
 void oren_nayar_prediction(const Prepared& p, const OrenNayarParams& on, std::vector<double>& out) {
     out.resize(p.size());
-    for (std::size_t j = 0; j < p.size(); ++j) out[j] = oren_nayar_radiance(p.geom[j], on);
+    p.oren_nayar.radiance(on, out);
 }
 
 // min over K of Σ w (K M − d)²; K returned through `gain`. A model that is zero everywhere
@@ -168,7 +172,7 @@ ErrorMeasures measures(const Prepared& p, const std::vector<double>& M) {
 // by variable projection, a grid start over the bounds (no start value needed), Levenberg–Marquardt
 // with the bounds honoured, covariance of (θ, gain) from the Jacobian, identifiability checked.
 
-using Prediction = std::function<void(std::span<const double> theta, std::vector<double>& out)>;
+using Prediction = std::function<void(std::span<const double> theta, std::span<double> out)>;
 
 // The engine's problem for one model family over the used measurements.
 LeastSquaresProblem fit_problem(const Prepared& p, std::vector<ParameterSpec> parameters,
@@ -179,10 +183,8 @@ LeastSquaresProblem fit_problem(const Prepared& p, std::vector<ParameterSpec> pa
     P.weights = p.w;
     P.residual = ResidualType::Absolute;
     P.gain = GainMode::Profiled;
-    P.model = [predict = std::move(predict), M = std::vector<double>()](
-                  std::span<const double> theta, std::span<double> out) mutable {
-        predict(theta, M);
-        std::copy(M.begin(), M.end(), out.begin());
+    P.model = [predict = std::move(predict)](std::span<const double> theta, std::span<double> out) {
+        predict(theta, out);
         return true;
     };
     return P;
@@ -235,8 +237,9 @@ void fit_very_rough(const Prepared& p, ModelResult& r, GeometricFactor factor, C
                     double lower, double upper) {
     run_fit(p, r,
             fit_problem(p, {fit_parameter("sigma_over_T", lower, upper, Transform::Log, 41)},
-                        [&p, factor, c](std::span<const double> theta, std::vector<double>& out) {
-                            very_rough_prediction(p, factor, c, theta[0], out);
+                        [&terms = p.very_rough(factor), c](std::span<const double> theta,
+                                                           std::span<double> out) {
+                            terms.brightness(theta[0], c, out);
                         }));
 }
 
@@ -244,7 +247,7 @@ void fit_very_rough(const Prepared& p, ModelResult& r, GeometricFactor factor, C
 void fit_lafortune(const Prepared& p, ModelResult& r, double lower, double upper) {
     run_fit(p, r,
             fit_problem(p, {fit_parameter("n", lower, upper, Transform::Log, 41)},
-                        [&p](std::span<const double> theta, std::vector<double>& out) {
+                        [&p](std::span<const double> theta, std::span<double> out) {
                             lafortune_prediction(p, theta[0], out);
                         }));
 }
@@ -254,9 +257,9 @@ void fit_lafortune(const Prepared& p, ModelResult& r, double lower, double upper
 // is Lambert's, ρ_ON · (first term), so ρ_ON and the gain trade off exactly: NotIdentifiable.
 void fit_oren_nayar(const Prepared& p, ModelResult& r, double sigma_max) {
     constexpr double kRhoMin = 1e-3;
-    // L = ρ A(σ) + ρ² B(σ) (L1 ∝ ρ, L2 ∝ ρ², models.hpp): A and B from two calls of the core model
-    // at ρ = 1 and ρ = 1/2, cached for the last few σ (the Jacobian perturbs σ and ρ in turn), so
-    // that a change of ρ alone (the grid's inner axis, the ρ column) costs no model call.
+    // L = ρ A(σ) + ρ² B(σ) (L1 ∝ ρ, L2 ∝ ρ², precomputed_terms.hpp), A and B cached for the
+    // last few σ (the Jacobian perturbs σ and ρ in turn), so that a change of ρ alone (the grid's
+    // inner axis, the ρ column) costs no evaluation of the components.
     struct Components {
         double sigma = -1.0;
         std::vector<double> A, B;
@@ -264,7 +267,6 @@ void fit_oren_nayar(const Prepared& p, ModelResult& r, double sigma_max) {
     struct Cache {
         std::array<Components, 4> entries;
         std::size_t next = 0;
-        std::vector<double> L1, Lh;
     };
     auto cache = std::make_shared<Cache>();
     auto components = [&p, cache](double sigma) -> const Components& {
@@ -272,14 +274,9 @@ void fit_oren_nayar(const Prepared& p, ModelResult& r, double sigma_max) {
             if (c.sigma == sigma) return c;
         Components& c = cache->entries[cache->next];
         cache->next = (cache->next + 1) % cache->entries.size();
-        oren_nayar_prediction(p, {sigma, 1.0}, cache->L1);
-        oren_nayar_prediction(p, {sigma, 0.5}, cache->Lh);
         c.A.resize(p.size());
         c.B.resize(p.size());
-        for (std::size_t j = 0; j < p.size(); ++j) {
-            c.B[j] = 2.0 * (cache->L1[j] - 2.0 * cache->Lh[j]);
-            c.A[j] = cache->L1[j] - c.B[j];
-        }
+        p.oren_nayar.components(sigma, c.A, c.B);
         c.sigma = sigma;
         return c;
     };
@@ -287,10 +284,9 @@ void fit_oren_nayar(const Prepared& p, ModelResult& r, double sigma_max) {
             fit_problem(p,
                         {fit_parameter("sigma_rad", 0.0, sigma_max, Transform::Linear, 16),
                          fit_parameter("albedo", kRhoMin, 1.0, Transform::Linear, 21)},
-                        [&p, components](std::span<const double> theta, std::vector<double>& out) {
+                        [&p, components](std::span<const double> theta, std::span<double> out) {
                             const Components& c = components(theta[0]);
                             const double rho = theta[1];
-                            out.resize(p.size());
                             for (std::size_t j = 0; j < p.size(); ++j)
                                 out[j] = rho * c.A[j] + rho * rho * c.B[j];
                         }));
@@ -324,9 +320,9 @@ TwoPointEstimate two_point_estimate(const BrdfTable& table, const std::vector<bo
         }
         if (m->theta_v_rad > o.normal_view_tolerance_rad) {
             t.reason = "measurement " + std::to_string(m->index) +
-                       " has theta_v = " + fmt(rad_to_deg(m->theta_v_rad)) +
+                       " has theta_v = " + format_significant(rad_to_deg(m->theta_v_rad), 6) +
                        " deg: Eq. 16-19 need the viewer on the normal (theta_v <= " +
-                       fmt(rad_to_deg(o.normal_view_tolerance_rad)) + " deg)";
+                       format_significant(rad_to_deg(o.normal_view_tolerance_rad), 6) + " deg)";
             return t;
         }
     }
@@ -334,7 +330,8 @@ TwoPointEstimate two_point_estimate(const BrdfTable& table, const std::vector<bo
     for (const BrdfMeasurement* m : {&m1, &m2})
         if (!(m->value > 0.0))
             bad += (bad.empty() ? "" : " and ") + std::string("measurement ") +
-                   std::to_string(m->index) + " has f = " + fmt(m->value, "%.6g") + " <= 0";
+                   std::to_string(m->index) + " has f = " + format_significant(m->value, 6) +
+                   " <= 0";
     if (!bad.empty()) {
         t.reason = bad +
                    ": the ratio E1/E2 needs two positive brightness values (non-positive "
@@ -529,8 +526,9 @@ Comparison compare_brdf(const BrdfTable& table, const ComparisonOptions& o) {
                                      m.value,
                                      "saturated",
                                      {"all"},
-                                     "overflow fraction " + fmt(*m.overflow_fraction) + " > " +
-                                         fmt(*o.max_overflow_fraction) +
+                                     "overflow fraction " +
+                                         format_significant(*m.overflow_fraction, 6) + " > " +
+                                         format_significant(*o.max_overflow_fraction, 6) +
                                          ": left out of every sum, fit and estimate"});
             continue;
         }
@@ -608,7 +606,7 @@ Comparison compare_brdf(const BrdfTable& table, const ComparisonOptions& o) {
         ModelResult& r = result(ComparisonModel::Lafortune);
         const auto steps = static_cast<long>(
             std::floor((o.lafortune_n_max - o.lafortune_n_min) / o.lafortune_n_step + 1e-9));
-        std::vector<double> M;
+        std::vector<double> M(p.size());
         double best_err = kInf, best_n = o.lafortune_n_min;
         long best_k = 0;
         for (long k = 0; k <= steps; ++k) {
@@ -622,15 +620,18 @@ Comparison compare_brdf(const BrdfTable& table, const ComparisonOptions& o) {
             }
         }
         r.available = true;
-        r.method = "exhaustive search of n_d in [" + fmt(o.lafortune_n_min) + ", " +
-                   fmt(o.lafortune_n_max) + "] in steps of " + fmt(o.lafortune_n_step) +
-                   " for the lowest Table-4 error (" + std::to_string(steps + 1) + " values)";
+        r.method = "exhaustive search of n_d in [" + format_significant(o.lafortune_n_min, 6) +
+                   ", " + format_significant(o.lafortune_n_max, 6) + "] in steps of " +
+                   format_significant(o.lafortune_n_step, 6) + " for the lowest Table-4 error (" +
+                   std::to_string(steps + 1) + " values)";
         r.evaluations = static_cast<int>(steps + 1);
         const bool at_bound = best_k == 0 || best_k == steps;
         r.fit_status = at_bound ? SolverStatus::AtBound : SolverStatus::Converged;
-        r.fit_message = at_bound ? "n_d = " + fmt(best_n) + " is an end of the search interval"
+        r.fit_message = at_bound ? "n_d = " + format_significant(best_n, 6) +
+                                       " is an end of the search interval"
                                  : "interior minimum of the search";
         r.parameters = {{"n", best_n, std::nullopt}};
+        r.prediction.resize(p.size());
         lafortune_prediction(p, best_n, r.prediction);
         r.errors = measures(p, r.prediction);
     }

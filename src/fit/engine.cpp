@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <cstdio>
 #include <exception>
 #include <memory>
 #include <numeric>
@@ -16,6 +15,7 @@
 
 #include "roughscope/core/errors.hpp"
 #include "roughscope/core/names.hpp"
+#include "roughscope/core/numbers.hpp"
 
 namespace roughscope {
 
@@ -56,14 +56,6 @@ namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-
-std::string fmt(double x, int digits = 6) {
-    if (std::isnan(x)) return "nan";
-    if (std::isinf(x)) return x > 0 ? "inf" : "-inf";
-    char buf[64];
-    std::snprintf(buf, sizeof buf, "%.*g", digits, x);
-    return buf;
-}
 
 double residual_of(ResidualType rt, double sw, double KM, double y) {
     switch (rt) {
@@ -115,20 +107,21 @@ void validate(const LeastSquaresProblem& P, const LeastSquaresOptions& O) {
         if (P.gain != GainMode::None && s.name == "gain")
             throw InvalidArgument(nm + ": the name 'gain' is reserved for the fitted gain");
         if (std::isnan(s.lower) || std::isnan(s.upper) || !(s.lower < s.upper))
-            throw InvalidArgument(nm + " bounds [" + fmt(s.lower) + ", " + fmt(s.upper) +
+            throw InvalidArgument(nm + " bounds [" + format_message(s.lower, 6) + ", " +
+                                  format_message(s.upper, 6) +
                                   "] are invalid: need lower < upper (±inf allowed)");
         if (s.transform == Transform::Log && !(s.lower >= 0.0))
-            throw InvalidArgument(nm + " lower bound = " + fmt(s.lower) +
+            throw InvalidArgument(nm + " lower bound = " + format_message(s.lower, 6) +
                                   " is negative, but a log-transformed parameter must lie in "
                                   "[0, inf); use Transform::Linear");
         if (s.initial) {
             check::finite("initial " + s.name, *s.initial);
             if (*s.initial < s.lower || *s.initial > s.upper)
-                throw InvalidArgument("initial " + s.name + " = " + fmt(*s.initial) +
-                                      " is outside its bounds [" + fmt(s.lower) + ", " +
-                                      fmt(s.upper) + "]");
+                throw InvalidArgument("initial " + s.name + " = " + format_message(*s.initial, 6) +
+                                      " is outside its bounds [" + format_message(s.lower, 6) +
+                                      ", " + format_message(s.upper, 6) + "]");
             if (s.transform == Transform::Log && !(*s.initial > 0.0))
-                throw InvalidArgument("initial " + s.name + " = " + fmt(*s.initial) +
+                throw InvalidArgument("initial " + s.name + " = " + format_message(*s.initial, 6) +
                                       " must be > 0 (log-transformed parameter)");
         } else {
             const double lo = s.start_lower.value_or(s.lower);
@@ -136,9 +129,11 @@ void validate(const LeastSquaresProblem& P, const LeastSquaresOptions& O) {
             if (!std::isfinite(lo) || !std::isfinite(hi) || !(lo < hi) || lo < s.lower ||
                 hi > s.upper || (s.transform == Transform::Log && !(lo > 0.0)))
                 throw InvalidArgument(
-                    nm + " has no initial value and its start range [" + fmt(lo) + ", " + fmt(hi) +
+                    nm + " has no initial value and its start range [" + format_message(lo, 6) +
+                    ", " + format_message(hi, 6) +
                     "] cannot be gridded: give an initial value or a finite range " +
-                    "inside the bounds [" + fmt(s.lower) + ", " + fmt(s.upper) + "]" +
+                    "inside the bounds [" + format_message(s.lower, 6) + ", " +
+                    format_message(s.upper, 6) + "]" +
                     (s.transform == Transform::Log ? " with a positive lower end" : ""));
             if (s.grid_points == 1 || s.grid_points < 0)
                 throw InvalidArgument(nm + " grid_points = " + std::to_string(s.grid_points) +
@@ -157,13 +152,13 @@ void validate(const LeastSquaresProblem& P, const LeastSquaresOptions& O) {
         const double y = P.data[i];
         if (!std::isfinite(y)) check::finite(at("data", i), y);
         if (P.residual != ResidualType::Absolute && !(y > 0.0))
-            throw InvalidArgument(at("data", i) + " = " + fmt(y) + " must be > 0 for " +
-                                  std::string(to_string(P.residual)) +
+            throw InvalidArgument(at("data", i) + " = " + format_message(y, 6) +
+                                  " must be > 0 for " + std::string(to_string(P.residual)) +
                                   " residuals (valid range (0, inf)); use absolute residuals");
         if (!P.weights.empty()) {
             const double wi = P.weights[i];
             if (!(std::isfinite(wi) && wi >= 0.0))
-                throw InvalidArgument(at("weights", i) + " = " + fmt(wi) +
+                throw InvalidArgument(at("weights", i) + " = " + format_message(wi, 6) +
                                       " is outside the valid range [0, inf)");
             sum_w += wi;
         }
@@ -182,7 +177,7 @@ void validate(const LeastSquaresProblem& P, const LeastSquaresOptions& O) {
     if (O.num_starts < 1)
         throw InvalidArgument("num_starts = " + std::to_string(O.num_starts) + " must be >= 1");
     if (!(O.rank_tolerance > 0.0 && O.rank_tolerance < 1.0))
-        throw InvalidArgument("rank_tolerance = " + fmt(O.rank_tolerance) +
+        throw InvalidArgument("rank_tolerance = " + format_message(O.rank_tolerance, 6) +
                               " is outside the valid range (0, 1)");
 }
 
@@ -210,8 +205,14 @@ class Evaluator {
         }
     }
     // Bounds of the optimised variable j (the gain, j = n, is unbounded).
-    double lower(int j) const { return j < n_ ? lower_[static_cast<std::size_t>(j)] : -kInf; }
-    double upper(int j) const { return j < n_ ? upper_[static_cast<std::size_t>(j)] : kInf; }
+    double lower(int j) const {
+        if (j < n_) return lower_[static_cast<std::size_t>(j)];
+        return -kInf;
+    }
+    double upper(int j) const {
+        if (j < n_) return upper_[static_cast<std::size_t>(j)];
+        return kInf;
+    }
     int n() const { return n_; }
     std::size_t size() const { return P_.data.size(); }
     GainMode gain() const { return gain_; }
@@ -463,7 +464,7 @@ std::vector<std::vector<double>> grid_starts(const Evaluator& e, const LeastSqua
     double total = 1.0;
     for (const auto& a : axes) total *= static_cast<double>(a.size());
     if (total > 1e6)
-        throw InvalidArgument("grid start: " + fmt(total) +
+        throw InvalidArgument("grid start: " + format_message(total, 6) +
                               " points (more than 1e6); give initial values or fewer points");
     std::vector<std::pair<double, std::vector<double>>> scored;
     std::vector<std::size_t> idx(free.size(), 0);
@@ -555,7 +556,7 @@ std::vector<int> unidentified(const Eigen::MatrixXd& J, const std::vector<int>& 
         for (std::size_t a = 0; a < live.size(); ++a)
             S.col(static_cast<Eigen::Index>(a)) = J.col(live[a]) / J.col(live[a]).norm();
         Eigen::JacobiSVD<Eigen::MatrixXd> svd(S, Eigen::ComputeThinV);
-        const Eigen::VectorXd sv = svd.singularValues();
+        const Eigen::VectorXd& sv = svd.singularValues();
         const Eigen::MatrixXd& V = svd.matrixV();
         std::vector<bool> flagged(live.size(), false);
         for (Eigen::Index k = 0; k < sv.size(); ++k) {
@@ -579,7 +580,7 @@ bool inverse_normal_matrix(const Eigen::MatrixXd& J, const std::vector<int>& col
     for (std::size_t a = 0; a < cols.size(); ++a)
         S.col(static_cast<Eigen::Index>(a)) = J.col(cols[a]);
     Eigen::JacobiSVD<Eigen::MatrixXd> svd(S, Eigen::ComputeThinV);
-    const Eigen::VectorXd sv = svd.singularValues();
+    const Eigen::VectorXd& sv = svd.singularValues();
     if (!(sv(sv.size() - 1) > 1e-12 * sv(0))) return false;
     const Eigen::VectorXd inv2 = sv.array().square().inverse();
     const Eigen::MatrixXd Cs = svd.matrixV() * inv2.asDiagonal() * svd.matrixV().transpose();
@@ -640,7 +641,8 @@ double profiled_sse(const LeastSquaresProblem& problem, std::span<const double> 
     if (!e.residuals(u.data(), mode, false, r.data(), gain)) return kInf;
     double sse = 0.0;
     for (double v : r) sse += v * v;
-    return std::isfinite(sse) ? sse : kInf;
+    if (!std::isfinite(sse)) return kInf;
+    return sse;
 }
 
 const FitParameter& LeastSquaresResult::parameter(std::string_view name) const {
@@ -658,12 +660,12 @@ std::string LeastSquaresResult::brief_report() const {
                     " model evaluations); N = " + std::to_string(num_data) +
                     ", p = " + std::to_string(num_parameters) + ";";
     for (const auto& p : parameters) {
-        s += " " + p.name + " = " + fmt(p.value);
-        if (covariance_available && !p.at_bound) s += " +/- " + fmt(p.std_error, 3);
+        s += " " + p.name + " = " + format_message(p.value, 6);
+        if (covariance_available && !p.at_bound) s += " +/- " + format_message(p.std_error, 3);
         if (p.at_bound) s += " (at bound)";
         s += ";";
     }
-    s += " SSE = " + fmt(sse) + ", AIC = " + fmt(aic) + ". " + message;
+    s += " SSE = " + format_message(sse, 6) + ", AIC = " + format_message(aic, 6) + ". " + message;
     return s;
 }
 
@@ -850,8 +852,9 @@ LeastSquaresResult solve_least_squares(const LeastSquaresProblem& P, const Least
         std::string list;
         for (int j : at) {
             const FitParameter& fp = res.parameters[static_cast<std::size_t>(j)];
-            list += (list.empty() ? "" : ", ") + fp.name + " = " + fmt(fp.value) + " in [" +
-                    fmt(fp.lower) + ", " + fmt(fp.upper) + "]";
+            list += (list.empty() ? "" : ", ") + fp.name + " = " + format_message(fp.value, 6) +
+                    " in [" + format_message(fp.lower, 6) + ", " + format_message(fp.upper, 6) +
+                    "]";
         }
         res.message += "; on a bound: " + list;
         if (res.status == SolverStatus::Converged) res.status = SolverStatus::AtBound;

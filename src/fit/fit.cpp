@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <cstdio>
 #include <limits>
 #include <memory>
 #include <span>
@@ -15,6 +14,8 @@
 
 #include "roughscope/core/errors.hpp"
 #include "roughscope/core/names.hpp"
+#include "roughscope/core/numbers.hpp"
+#include "roughscope/scattering/precomputed_terms.hpp"
 #include "roughscope/scattering/validity.hpp"
 
 namespace roughscope {
@@ -39,21 +40,14 @@ namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
-std::string fmt(double x, int digits = 6) {
-    if (std::isnan(x)) return "nan";
-    if (std::isinf(x)) return x > 0 ? "inf" : "-inf";
-    char buf[64];
-    std::snprintf(buf, sizeof buf, "%.*g", digits, x);
-    return buf;
-}
-
 int model_parameter_count(const FitOptions& o) { return o.model == FitModel::VeryRough ? 1 : 2; }
 
 void check_bounds(std::string_view name, double lo, double hi) {
     check::positive(std::string(name) + " lower bound", lo);
     check::positive(std::string(name) + " upper bound", hi);
     if (!(lo < hi))
-        throw InvalidArgument(std::string(name) + " bounds [" + fmt(lo) + ", " + fmt(hi) +
+        throw InvalidArgument(std::string(name) + " bounds [" + format_message(lo, 6) + ", " +
+                              format_message(hi, 6) +
                               "] are empty: the lower bound must be below the upper bound");
 }
 
@@ -61,8 +55,9 @@ void check_initial(std::string_view name, const std::optional<double>& v, double
     if (!v) return;
     check::positive(std::string("initial ") + std::string(name), *v);
     if (*v < lo || *v > hi)
-        throw InvalidArgument("initial " + std::string(name) + " = " + fmt(*v) +
-                              " is outside its bounds [" + fmt(lo) + ", " + fmt(hi) + "]");
+        throw InvalidArgument("initial " + std::string(name) + " = " + format_message(*v, 6) +
+                              " is outside its bounds [" + format_message(lo, 6) + ", " +
+                              format_message(hi, 6) + "]");
 }
 
 void check_options(const FitOptions& o) {
@@ -135,19 +130,37 @@ LeastSquaresProblem make_problem(const std::vector<Measurement>& ms, const FitOp
         P.weights.push_back(m.weight);
     }
     std::vector<Geometry> geoms;
+    geoms.reserve(ms.size());
     for (const auto& m : ms) geoms.push_back(m.geometry);
-    P.model = [geoms, o](std::span<const double> theta, std::span<double> out) {
-        try {
-            for (std::size_t i = 0; i < geoms.size(); ++i) {
-                out[i] = model_brightness(geoms[i], theta.data(), o);
-                // B must be positive: it underflows to 0 far outside the lobe.
-                if (!(std::isfinite(out[i]) && out[i] > 0.0)) return false;
+    if (o.model == FitModel::VeryRough) {
+        // Eq. 4 / Eq. 5 × radiometric factor from the geometry-only terms, computed once
+        // (precomputed_terms.hpp): very_rough_brightness to rounding, at one exponential per
+        // measurement.
+        auto terms = std::make_shared<const VeryRoughTerms>(geoms, o.factor, o.radiometry);
+        P.model = [terms, c = o.correlation](std::span<const double> theta, std::span<double> out) {
+            try {
+                terms->brightness(theta[0], c, out);
+            } catch (const Error&) {
+                return false;
             }
-        } catch (const Error&) {
-            return false;
-        }
-        return true;
-    };
+            // B must be positive: it underflows to 0 far outside the lobe.
+            return std::all_of(out.begin(), out.end(),
+                               [](double b) { return std::isfinite(b) && b > 0.0; });
+        };
+    } else {
+        P.model = [geoms, o](std::span<const double> theta, std::span<double> out) {
+            try {
+                for (std::size_t i = 0; i < geoms.size(); ++i) {
+                    out[i] = model_brightness(geoms[i], theta.data(), o);
+                    // B must be positive: it underflows to 0 far outside the lobe.
+                    if (!(std::isfinite(out[i]) && out[i] > 0.0)) return false;
+                }
+            } catch (const Error&) {
+                return false;
+            }
+            return true;
+        };
+    }
     if (o.model == FitModel::VeryRough) {
         ParameterSpec s = bounded("sigma_over_T", o.sigma_over_T_min, o.sigma_over_T_max);
         s.initial = o.initial_sigma_over_T;
@@ -164,17 +177,19 @@ LeastSquaresProblem make_problem(const std::vector<Measurement>& ms, const FitOp
     double sigma0 = 0.0, T0 = 0.0;
     if (!(o.initial_sigma_um && o.initial_T_um)) {
         // Eq. 3 in logs is linear: ln E − ln(v_z² F² rad) = c − σ² v_z² − (T²/4) v_xy².
-        Eigen::MatrixXd A(ms.size(), 3);
-        Eigen::VectorXd y(ms.size());
-        for (std::size_t i = 0; i < ms.size(); ++i) {
-            const Geometry& g = ms[i].geometry;
+        const auto rows = static_cast<Eigen::Index>(ms.size());
+        Eigen::MatrixXd A(rows, 3);
+        Eigen::VectorXd y(rows);
+        for (Eigen::Index i = 0; i < rows; ++i) {
+            const Measurement& m = ms[static_cast<std::size_t>(i)];
+            const Geometry& g = m.geometry;
             const ScatteringVector v = scattering_vector(g, o.wavelength_um);
-            const double sw = std::sqrt(ms[i].weight);
+            const double sw = std::sqrt(m.weight);
             const double F2 = geometric_factor_squared(o.factor, g);
             A(i, 0) = sw;
             A(i, 1) = -sw * v.vz * v.vz;
             A(i, 2) = -sw * v.vxy2() / 4.0;
-            y(i) = sw * (std::log(ms[i].brightness) -
+            y(i) = sw * (std::log(m.brightness) -
                          std::log(v.vz * v.vz * F2 * radiometric_factor(o.radiometry, g)));
         }
         const Eigen::VectorXd c = A.colPivHouseholderQr().solve(y);
@@ -232,9 +247,7 @@ std::string correlation_label(Correlation c) {
 double fit_model_brightness(const Geometry& geom, const std::vector<double>& parameters,
                             const FitOptions& options) {
     check_options(options);
-    check::polar_angle("theta_i", geom.theta_i_rad);
-    check::polar_angle("theta_s", geom.theta_s_rad);
-    check::azimuth("phi_s", geom.phi_s_rad);
+    check::geometry(geom);
     const int n = model_parameter_count(options);
     if (static_cast<int>(parameters.size()) != n)
         throw InvalidArgument("parameters: " + std::to_string(parameters.size()) + " given, the " +
@@ -268,12 +281,12 @@ std::string FitResult::brief_report() const {
         std::to_string(iterations) + " iterations; N = " + std::to_string(num_measurements) +
         ", p = " + std::to_string(num_parameters) + ";";
     for (const auto& p : parameters) {
-        s += " " + p.name + " = " + fmt(p.value);
-        if (covariance_available && !p.at_bound) s += " +/- " + fmt(p.std_error, 3);
+        s += " " + p.name + " = " + format_message(p.value, 6);
+        if (covariance_available && !p.at_bound) s += " +/- " + format_message(p.std_error, 3);
         if (p.at_bound) s += " (at bound)";
         s += ";";
     }
-    s += " SSE = " + fmt(sse) + ", AIC = " + fmt(aic) + ". " + message;
+    s += " SSE = " + format_message(sse, 6) + ", AIC = " + format_message(aic, 6) + ". " + message;
     return s;
 }
 
@@ -314,6 +327,7 @@ FitResult fit_roughness(const std::vector<Measurement>& measurements, const FitO
     RoughnessEstimate& est = result.estimate;
     est.correlation = options.correlation;
     std::vector<Geometry> geoms;
+    geoms.reserve(measurements.size());
     for (const auto& m : measurements) geoms.push_back(m.geometry);
     auto se = [&](int j) {
         return result.covariance_available ? result.parameters[j].std_error : 0.0;
@@ -344,9 +358,9 @@ FitResult fit_roughness(const std::vector<Measurement>& measurements, const FitO
     fill_derived_quantities(est, geoms);
     for (const auto& fp : result.parameters)
         if (fp.at_bound)
-            est.warnings.push_back(fp.name + " = " + fmt(fp.value) +
-                                   " is at a bound of its range [" + fmt(fp.lower) + ", " +
-                                   fmt(fp.upper) +
+            est.warnings.push_back(fp.name + " = " + format_message(fp.value, 6) +
+                                   " is at a bound of its range [" + format_message(fp.lower, 6) +
+                                   ", " + format_message(fp.upper, 6) +
                                    "]: the data do not constrain it there; its standard error "
                                    "is not meaningful");
     if (result.status == SolverStatus::NotIdentifiable)
