@@ -252,14 +252,144 @@ void fit_lafortune(const Prepared& p, ModelResult& r, double lower, double upper
                         }));
 }
 
+// Whether σ_ON = 0 is a minimum of the profiled Oren–Nayar SSE for every ρ ∈ [rho_min, 1]: the
+// slope dSSE/d(σ²) of fit_oren_nayar's comment is positive at both ends of the ρ range (it is
+// linear in ρ). A'(0) and B'(0) by a difference in s = σ² (the components are analytic in s).
+bool lambert_minimum(const Prepared& p, double rho_min, int& evaluations) {
+    const std::size_t n = p.size();
+    std::vector<double> A0(n), B0(n), A1(n), B1(n);
+    constexpr double kSigma = 1e-4, kS = kSigma * kSigma;
+    p.oren_nayar.components(0.0, A0, B0);
+    p.oren_nayar.components(kSigma, A1, B1);
+    evaluations += 2;
+    const double lambda = optimal_gain(A0, p.d, p.w, ResidualType::Absolute);
+    if (!(lambda > 0.0) || !std::isfinite(lambda)) return false;
+    double alpha = 0.0, beta = 0.0, scale = 0.0;
+    for (std::size_t j = 0; j < n; ++j) {
+        const double res = p.w[j] * (lambda * A0[j] - p.d[j]);
+        alpha += res * (A1[j] - A0[j]) / kS;
+        beta += res * B1[j] / kS;
+        scale += std::abs(res) * (std::abs(A1[j] - A0[j]) + rho_min * std::abs(B1[j])) / kS;
+    }
+    // A margin well above the O(s) error of the differences and the rounding of the sums.
+    const double margin = 1e-6 * scale;
+    return alpha + rho_min * beta > margin && alpha + beta > margin;
+}
+
+// The Oren–Nayar fit's result at σ_ON = 0 (lambert_minimum holds): the engine's verdict there
+// (NotIdentifiable: albedo and gain trade off exactly; σ_ON held by its lower bound), with the
+// start's albedo and the Lambert gain, no covariance.
+void finish_at_lambert(const Prepared& p, ModelResult& r, double rho, double sigma_max,
+                       int evaluations) {
+    std::vector<double> A(p.size()), B(p.size());
+    p.oren_nayar.components(0.0, A, B);
+    r.prediction.resize(p.size());
+    for (std::size_t j = 0; j < p.size(); ++j) r.prediction[j] = rho * A[j] + rho * rho * B[j];
+    r.evaluations = evaluations + 1;
+    r.available = true;
+    r.fit_status = SolverStatus::NotIdentifiable;
+    r.errors = measures(p, r.prediction);
+    r.parameters = {{"sigma_rad", 0.0, std::nullopt},
+                    {"albedo", rho, std::nullopt},
+                    {"gain", r.errors.gain, std::nullopt}};
+    r.covariance.clear();
+    r.fit_message =
+        "Lambert limit: the grid start has sigma_rad = 0 and the slope of the profiled SSE in "
+        "sigma_rad^2 is positive there for every albedo, so the fit ends at the start; the "
+        "Jacobian is rank deficient: the data do not determine albedo, gain (a parameter without "
+        "effect, repeated geometries or constant data, or parameters that trade off exactly); on "
+        "a bound: sigma_rad = 0 in [0, " +
+        format_message(sigma_max, 6) + "]";
+}
+
 // Oren–Nayar (σ_ON, ρ_ON): a 16 × 21 grid over σ_ON ∈ [0, sigma_max] rad, ρ_ON ∈ [0.001, 1]
 // (ρ → 0 leaves the shape of the first term alone with an infinite gain). At σ_ON = 0 the model
 // is Lambert's, ρ_ON · (first term), so ρ_ON and the gain trade off exactly: NotIdentifiable.
+//
+// With L = ρ A(σ) + ρ² B(σ) (L1 ∝ ρ, L2 ∝ ρ², precomputed_terms.hpp) the SSE with the gain
+// profiled out is, for each σ, a rational function of ρ of five weighted sums:
+//   SSE(σ, ρ) = Σw d² − (ρ Σw A d + ρ² Σw B d)² / (ρ² Σw A² + 2ρ³ Σw A B + ρ⁴ Σw B²),
+// so the grid start (the engine's grid, in the engine's order) costs one evaluation of A and B
+// per σ, and the engine starts from its best point.
+//
+// The Lambert limit: the model depends on σ through σ² only, so with s = σ², at s = 0 and the
+// Lambert gain λ = K ρ (K M = λ A(0)), by variable projection
+//   dSSE/ds = 2λ (Σ w r A'(0) + ρ Σ w r B'(0)),   r = λ A(0) − d   (' = d/ds),
+// linear in ρ. When the grid start lies at σ = 0 and this slope is positive at both ends of the
+// ρ range, and a finer scan up to the grid's next σ finds nothing lower, σ = 0 is taken as the
+// minimum (held by its bound) for every ρ; the profiled SSE does not depend
+// on ρ there: the fit ends at the start, with the engine's NotIdentifiable verdict (albedo and gain
+// trade off exactly; σ on its bound), without a solver run that would only creep along the flat
+// direction.
 void fit_oren_nayar(const Prepared& p, ModelResult& r, double sigma_max) {
     constexpr double kRhoMin = 1e-3;
-    // L = ρ A(σ) + ρ² B(σ) (L1 ∝ ρ, L2 ∝ ρ², precomputed_terms.hpp), A and B cached for the
-    // last few σ (the Jacobian perturbs σ and ρ in turn), so that a change of ρ alone (the grid's
-    // inner axis, the ρ column) costs no evaluation of the components.
+    constexpr int kSigmaPoints = 16, kRhoPoints = 21;
+    const std::size_t n = p.size();
+    std::vector<double> A(n), B(n);
+    int evaluations = 0;
+    // Weighted sums of σ's components; false when the profiled SSE is undefined at every ρ.
+    struct Sums {
+        double ad = 0, bd = 0, aa = 0, ab = 0, bb = 0;
+    };
+    auto sums = [&](double sigma) {
+        p.oren_nayar.components(sigma, A, B);
+        ++evaluations;
+        Sums S;
+        for (std::size_t j = 0; j < n; ++j) {
+            const double w = p.w[j];
+            S.ad += w * A[j] * p.d[j];
+            S.bd += w * B[j] * p.d[j];
+            S.aa += w * A[j] * A[j];
+            S.ab += w * A[j] * B[j];
+            S.bb += w * B[j] * B[j];
+        }
+        return S;
+    };
+    auto profiled = [&p](const Sums& S, double rho) -> double {
+        const double md = rho * S.ad + rho * rho * S.bd;
+        const double mm = rho * rho * (S.aa + 2.0 * rho * S.ab + rho * rho * S.bb);
+        if (!(mm > 0.0) || !std::isfinite(mm)) return kInf;
+        const double sse = p.sum_wdd - md * md / mm;
+        if (!std::isfinite(sse)) return kInf;
+        return sse;
+    };
+    // The engine's grid (engine.cpp, grid_starts): σ the inner axis, the first lowest point wins.
+    std::vector<Sums> by_sigma(kSigmaPoints);
+    for (int k = 0; k < kSigmaPoints; ++k)
+        by_sigma[static_cast<std::size_t>(k)] = sums(sigma_max * k / (kSigmaPoints - 1));
+    double best = kInf, sigma0 = 0.0, rho0 = kRhoMin;
+    for (int m = 0; m < kRhoPoints; ++m) {
+        const double rho = kRhoMin + (1.0 - kRhoMin) * m / (kRhoPoints - 1);
+        for (int k = 0; k < kSigmaPoints; ++k) {
+            const double sse = profiled(by_sigma[static_cast<std::size_t>(k)], rho);
+            if (sse < best) {
+                best = sse;
+                sigma0 = sigma_max * k / (kSigmaPoints - 1);
+                rho0 = rho;
+            }
+        }
+    }
+
+    // A finer scan between σ = 0 and the grid's next σ (a dip there, where the ρ² term wins
+    // beyond the slope at 0, sends the fit to the engine).
+    auto no_dip = [&] {
+        constexpr int kFine = 10;
+        for (int k = 1; k < kFine; ++k) {
+            const Sums S = sums(sigma_max / (kSigmaPoints - 1) * k / kFine);
+            for (int m = 0; m < kRhoPoints; ++m)
+                if (profiled(S, kRhoMin + (1.0 - kRhoMin) * m / (kRhoPoints - 1)) < best)
+                    return false;
+        }
+        return true;
+    };
+    if (std::isfinite(best) && sigma0 == 0.0 && lambert_minimum(p, kRhoMin, evaluations) &&
+        no_dip()) {
+        finish_at_lambert(p, r, rho0, sigma_max, evaluations);
+        return;
+    }
+
+    // L = ρ A(σ) + ρ² B(σ), A and B cached for the last few σ (the Jacobian perturbs σ and ρ in
+    // turn), so that a change of ρ alone costs no evaluation of the components.
     struct Components {
         double sigma = -1.0;
         std::vector<double> A, B;
@@ -280,16 +410,22 @@ void fit_oren_nayar(const Prepared& p, ModelResult& r, double sigma_max) {
         c.sigma = sigma;
         return c;
     };
+    ParameterSpec sigma_spec = fit_parameter("sigma_rad", 0.0, sigma_max, Transform::Linear, 16);
+    ParameterSpec rho_spec = fit_parameter("albedo", kRhoMin, 1.0, Transform::Linear, 21);
+    // At σ = 0 the grid's ρ values tie up to rounding (the start there is the engine's own grid).
+    if (std::isfinite(best) && sigma0 > 0.0) {
+        sigma_spec.initial = sigma0;
+        rho_spec.initial = rho0;
+    }
     run_fit(p, r,
-            fit_problem(p,
-                        {fit_parameter("sigma_rad", 0.0, sigma_max, Transform::Linear, 16),
-                         fit_parameter("albedo", kRhoMin, 1.0, Transform::Linear, 21)},
+            fit_problem(p, {sigma_spec, rho_spec},
                         [&p, components](std::span<const double> theta, std::span<double> out) {
                             const Components& c = components(theta[0]);
                             const double rho = theta[1];
                             for (std::size_t j = 0; j < p.size(); ++j)
                                 out[j] = rho * c.A[j] + rho * rho * c.B[j];
                         }));
+    r.evaluations += evaluations;
 }
 
 // ---------------------------------------------------------------------------------------------
