@@ -147,7 +147,7 @@ namespace {
 CLI::Validator number_validator(std::function<bool(double)> ok, std::string range,
                                 std::string tag) {
     return CLI::Validator(
-        [ok = std::move(ok), range](std::string& text) -> std::string {
+        [ok = std::move(ok), range = std::move(range)](std::string& text) -> std::string {
             std::string reason;
             const auto value = parse_double(text, reason);
             if (!value) return "'" + std::string(trim(text)) + "' is " + reason + "; " + range;
