@@ -2,6 +2,8 @@
 #include "common.hpp"
 
 #include <algorithm>
+#include <cmath>
+#include <cstdio>
 #include <exception>
 #include <iostream>
 
@@ -106,6 +108,19 @@ int run_app(CLI::App& app, int argc, char** argv) {
 // ---------------------------------------------------------------------------------------------
 // Numbers
 
+std::string format_fixed(double value, int decimals, std::string_view name) {
+    if (!std::isfinite(value)) {
+        throw roughscope::Error("internal error: " + std::string(name) +
+                                " is not a finite number; refusing to print it");
+    }
+    if (decimals < 0 || decimals > 17)
+        throw roughscope::InvalidArgument("decimals = " + std::to_string(decimals) +
+                                          " is outside the valid range [0, 17]");
+    char buf[400];  // %.17f of the largest double needs 309 + 1 + 17 characters
+    std::snprintf(buf, sizeof buf, "%.*f", decimals, value);
+    return buf;
+}
+
 json finite_number(double value, std::string_view name) {
     if (!std::isfinite(value)) {
         throw roughscope::Error("internal error: " + std::string(name) +
@@ -132,7 +147,7 @@ namespace {
 CLI::Validator number_validator(std::function<bool(double)> ok, std::string range,
                                 std::string tag) {
     return CLI::Validator(
-        [ok = std::move(ok), range](std::string& text) -> std::string {
+        [ok = std::move(ok), range = std::move(range)](std::string& text) -> std::string {
             std::string reason;
             const auto value = parse_double(text, reason);
             if (!value) return "'" + std::string(trim(text)) + "' is " + reason + "; " + range;
@@ -196,6 +211,17 @@ CLI::Option* add_range_option(CLI::App& app, const std::string& flag, double& va
 }
 
 bool given(const CLI::Option* option) { return option != nullptr && option->count() > 0; }
+
+std::optional<Correlation> parse_correlation_or_both(std::string_view name) {
+    if (name_matches("both", name)) return std::nullopt;
+    try {
+        return parse_correlation(name);
+    } catch (const roughscope::InvalidArgument&) {
+        throw_unknown_name("correlation", name,
+                           std::string(to_string(Correlation::Gaussian)) + ", " +
+                               std::string(to_string(Correlation::Exponential)) + ", both");
+    }
+}
 
 CLI::Option* add_factor_option(CLI::App& app, GeometricFactor& factor) {
     return add_enum_option(app, "--factor", factor, parse_geometric_factor,

@@ -29,6 +29,7 @@
 #include "roughscope/io/csv.hpp"
 #include "roughscope/io/data_locator.hpp"
 #include "roughscope/io/output_file.hpp"
+#include "roughscope/scattering/beckmann.hpp"
 #include "roughscope/scattering/factors.hpp"
 
 namespace roughscope::cli {
@@ -92,6 +93,11 @@ inline double round_significant(double value, int digits = kPrintDigits) {
 inline std::string format_result(double value, std::string_view name = "result") {
     return roughscope::format_significant(value, kPrintDigits, name);
 }
+
+// `decimals` digits after the decimal point ("%.*f", as the paper prints its tables). The library
+// has no fixed-decimals formatter; this is the CLI's one. Throws roughscope::Error naming `name`
+// if value is NaN or infinite.
+std::string format_fixed(double value, int decimals, std::string_view name = "value");
 
 // JSON number rounded to kPrintDigits significant digits; throws roughscope::Error naming `name`
 // if the value is not finite.
@@ -182,6 +188,11 @@ CLI::Option* add_enum_option(CLI::App& app, const std::string& flag, Enum& var, 
         description);
     return opt;
 }
+
+// One correlation function or both side by side (`estimate slope`, `estimate fit`): "both" →
+// std::nullopt, else the library's parse_correlation. An unknown name throws InvalidArgument
+// "correlation '<name>' is not recognised; valid values: gaussian, exponential, both".
+std::optional<Correlation> parse_correlation_or_both(std::string_view name);
 
 // --factor: the geometric factor (vh by default), shared by `model` and `estimate`.
 CLI::Option* add_factor_option(CLI::App& app, GeometricFactor& factor);

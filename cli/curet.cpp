@@ -7,8 +7,8 @@
 // --out FILE` (python_runner.hpp); its error message, if any, becomes this command's error.
 #include "roughscope/brdf/curet.hpp"
 
+#include <array>
 #include <cmath>
-#include <cstdio>
 #include <filesystem>
 #include <memory>
 #include <optional>
@@ -31,14 +31,16 @@ namespace fs = std::filesystem;
 
 enum class Format { Text, Json, Csv, Markdown };
 
-Format parse_format(std::string_view name) {
-    if (name == "text") return Format::Text;
-    if (name == "json") return Format::Json;
-    if (name == "csv") return Format::Csv;
-    if (name == "markdown" || name == "md") return Format::Markdown;
-    throw roughscope::InvalidArgument("format '" + std::string(name) +
-                                      "' is not one of: text, json, csv, markdown");
-}
+// --format names, in the library's enum-name scheme (roughscope/core/names.hpp).
+constexpr std::array<NameEntry<Format>, 5> kFormatNames{{
+    {"text", Format::Text},
+    {"json", Format::Json},
+    {"csv", Format::Csv},
+    {"markdown", Format::Markdown},
+    {"md", Format::Markdown},  // alias
+}};
+
+Format parse_format(std::string_view name) { return parse_name(kFormatNames, "format", name); }
 
 struct Args {
     int sample = 0;
@@ -81,11 +83,11 @@ std::string ascii(std::string_view s) {
     return out;
 }
 
+// Six significant digits for the text tables (the library's format_significant); throws on
+// NaN/inf (never printed). A -0 read from a data file stays "-0" in the data-issue list.
 std::string short_number(double v, std::string_view name) {
-    format_result(v, name);  // throws on NaN/inf
-    char buf[64];
-    std::snprintf(buf, sizeof buf, "%.6g", v);
-    return buf;
+    if (v == 0.0 && std::signbit(v)) return "-0";
+    return roughscope::format_significant(v, 6, name);
 }
 
 std::string text_report(const Comparison& c) {

@@ -30,16 +30,9 @@
 namespace roughscope::cli {
 namespace {
 
-// Correlation choice of `estimate slope` / `estimate fit`: one, or both side by side.
-enum class CorrelationChoice { Gaussian, Exponential, Both };
-
-CorrelationChoice parse_correlation_choice(std::string_view name) {
-    if (name == "both") return CorrelationChoice::Both;
-    if (name == "gaussian") return CorrelationChoice::Gaussian;
-    if (name == "exponential") return CorrelationChoice::Exponential;
-    throw roughscope::InvalidArgument("correlation '" + std::string(name) +
-                                      "' is not one of: gaussian, exponential, both");
-}
+// Correlation choice of `estimate slope` / `estimate fit`: one (Gaussian or exponential), or both
+// side by side (std::nullopt; parse_correlation_or_both in common.hpp).
+using CorrelationChoice = std::optional<Correlation>;
 
 // ---------------------------------------------------------------------------------------------
 // Shared pieces: the brightness ratio, the two geometries, noise, output.
@@ -270,7 +263,7 @@ struct SlopeArgs {
     RatioArgs ratio;
     PairArgs pair;
     double noise = 0.0, sigma_um = 0.0, wavelength_um = 0.555;
-    CorrelationChoice correlation = CorrelationChoice::Both;
+    CorrelationChoice correlation = std::nullopt;  // both
     GeometricFactor factor = GeometricFactor::VernoldHarvey;
     Radiometry radiometry = Radiometry::Radiance;
     CLI::Option *o_noise{}, *o_sigma{};
@@ -295,7 +288,7 @@ RoughnessEstimate slope_for(const SlopeArgs& a, SlopeInput in, Correlation c) {
     try {
         return estimate_slope(in);
     } catch (const NoSolution& e) {
-        if (a.correlation != CorrelationChoice::Both) throw;
+        if (a.correlation) throw;
         throw NoSolution(std::string(e.what()) + "; use --correlation " +
                          (c == Correlation::Gaussian ? "exponential" : "gaussian") +
                          " to estimate with the other correlation function alone");
@@ -306,10 +299,8 @@ void run_slope(const SlopeArgs& a) {
     const auto [g1, g2] = geometries_from(a.pair);
     const SlopeInput in = slope_input(a, g1, g2, ratio_from(a.ratio));
     std::optional<RoughnessEstimate> eg, ee;
-    if (a.correlation != CorrelationChoice::Exponential)
-        eg = slope_for(a, in, Correlation::Gaussian);
-    if (a.correlation != CorrelationChoice::Gaussian)
-        ee = slope_for(a, in, Correlation::Exponential);
+    if (a.correlation != Correlation::Exponential) eg = slope_for(a, in, Correlation::Gaussian);
+    if (a.correlation != Correlation::Gaussian) ee = slope_for(a, in, Correlation::Exponential);
     emit(a.out, serialize::slope_estimate_json(in, eg, ee, given(a.o_noise)));
 }
 
@@ -319,7 +310,7 @@ void run_slope(const SlopeArgs& a) {
 struct FitArgs {
     std::string measurements_path;
     FitModel model = FitModel::VeryRough;
-    CorrelationChoice correlation = CorrelationChoice::Both;
+    CorrelationChoice correlation = std::nullopt;  // both
     GeometricFactor factor = GeometricFactor::VernoldHarvey;
     Radiometry radiometry = Radiometry::Radiance;
     Regime regime = Regime::SlightlyRough;
@@ -401,13 +392,11 @@ void run_fit(const FitArgs& a) {
     if (given(a.o_initial_sigma_over_T)) options["initial_sigma_over_T"] = a.initial_sigma_over_T;
     if (given(a.o_initial_sigma)) options["initial_sigma_um"] = a.initial_sigma_um;
     if (given(a.o_initial_T)) options["initial_T_um"] = a.initial_T_um;
-    if (a.correlation != CorrelationChoice::Both)
-        options["correlation"] =
-            a.correlation == CorrelationChoice::Gaussian ? "gaussian" : "exponential";
+    if (a.correlation) options["correlation"] = std::string(to_string(*a.correlation));
     const FitOptions o = serialize::fit_options_from(options);
 
     json out;
-    if (a.correlation == CorrelationChoice::Both) {
+    if (!a.correlation) {  // both
         const CorrelationComparison c = compare_correlations(ms, o);
         out = serialize::fit_estimate_json(o, ms.size(), c, a.residuals);
         if (!a.out.json_output) {
@@ -498,7 +487,7 @@ void register_estimate(CLI::App& app) {
         add_ratio_options(*cmd, a.ratio);
         add_pair_options(*cmd, a.pair);
         add_factor_option(*cmd, a.factor);
-        add_enum_option(*cmd, "--correlation", a.correlation, parse_correlation_choice,
+        add_enum_option(*cmd, "--correlation", a.correlation, parse_correlation_or_both,
                         "both (default), gaussian (Eq. 17) or exponential (Eq. 19)");
         add_pair_radiometry_option(*cmd, a.radiometry);
         a.o_noise = add_noise_option(*cmd, a.noise);
@@ -524,7 +513,7 @@ void register_estimate(CLI::App& app) {
             "phi_s = phi_i + 180 is the specular plane)");
         add_enum_option(*cmd, "--model", a.model, parse_fit_model,
                         "very_rough (default: sigma/T) or slightly_rough (sigma and T)");
-        add_enum_option(*cmd, "--correlation", a.correlation, parse_correlation_choice,
+        add_enum_option(*cmd, "--correlation", a.correlation, parse_correlation_or_both,
                         "both (default: fit both, compare by AIC), gaussian or exponential");
         add_factor_option(*cmd, a.factor);
         add_enum_option(*cmd, "--radiometry", a.radiometry, parse_radiometry,

@@ -7,6 +7,7 @@
 #include "roughscope/serialize/model.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <filesystem>
 #include <iostream>
@@ -33,32 +34,23 @@ namespace {
 
 enum class ModelKind { BK, Lambert, OrenNayar, OrenNayarQualitative, Lafortune };
 
-constexpr const char* kModelNames = "bk, lambert, oren-nayar, oren-nayar-qualitative, lafortune";
+// --model names, in the library's enum-name scheme (roughscope/core/names.hpp): parsed
+// case-insensitively with '-' equal to '_'.
+constexpr std::array<NameEntry<ModelKind>, 5> kModelNames{{
+    {"bk", ModelKind::BK},
+    {"lambert", ModelKind::Lambert},
+    {"oren_nayar", ModelKind::OrenNayar},
+    {"oren_nayar_qualitative", ModelKind::OrenNayarQualitative},
+    {"lafortune", ModelKind::Lafortune},
+}};
 
-ModelKind parse_model(std::string_view name) {
-    if (name == "bk") return ModelKind::BK;
-    if (name == "lambert") return ModelKind::Lambert;
-    if (name == "oren_nayar") return ModelKind::OrenNayar;
-    if (name == "oren_nayar_qualitative") return ModelKind::OrenNayarQualitative;
-    if (name == "lafortune") return ModelKind::Lafortune;
-    throw roughscope::InvalidArgument("unknown model '" + std::string(name) +
-                                      "' (expected one of " + kModelNames + ")");
-}
+ModelKind parse_model(std::string_view name) { return parse_name(kModelNames, "model", name); }
 
+// The name printed in the output ("oren-nayar", the spelling of the command line's help).
 std::string model_name(ModelKind m) {
-    switch (m) {
-        case ModelKind::BK:
-            return "bk";
-        case ModelKind::Lambert:
-            return "lambert";
-        case ModelKind::OrenNayar:
-            return "oren-nayar";
-        case ModelKind::OrenNayarQualitative:
-            return "oren-nayar-qualitative";
-        case ModelKind::Lafortune:
-            return "lafortune";
-    }
-    return "?";
+    std::string name(name_of(kModelNames, m));
+    std::replace(name.begin(), name.end(), '_', '-');
+    return name;
 }
 
 // Everything the command line can set. Owned by the subcommand's callback (shared_ptr).

@@ -6,7 +6,6 @@
 // they are not part of the repository. The library recomputes them (serialize/paper_tables.hpp,
 // where the agreement marks are defined); this file only prints the document as text or JSON.
 #include <cmath>
-#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -45,19 +44,13 @@ std::string mark(const json& c) {
     return a == "exact" ? "=" : a == "within_rounding" ? "~" : "DIFFERS";
 }
 
-std::string num(double x, int decimals) {
-    char buf[64];
-    std::snprintf(buf, sizeof buf, "%.*f", decimals, x);
-    return buf;
-}
-
 double value(const json& j, const char* key) { return j.at(key).get<double>(); }
 
 // "printed  recomputed  mark" cells of one checked quantity.
 void add_cells(std::vector<std::string>& cells, const json& c, int printed_decimals,
                int recomputed_decimals) {
-    cells.push_back(num(value(c, "printed"), printed_decimals));
-    cells.push_back(num(value(c, "recomputed"), recomputed_decimals));
+    cells.push_back(format_fixed(value(c, "printed"), printed_decimals));
+    cells.push_back(format_fixed(value(c, "recomputed"), recomputed_decimals));
     cells.push_back(mark(c));
 }
 
@@ -92,17 +85,18 @@ void run_tables(const Args& a) {
         std::vector<std::vector<std::string>> cells;
         for (const json& row : t["rows"]) {
             std::vector<std::string> c = {row["surface"].get<std::string>(),
-                                          num(value(row, "R_spec"), 3)};
+                                          format_fixed(value(row, "R_spec"), 3)};
             add_cells(c, row["sigma_um"], 3, 4);
-            c.push_back(num(value(row, "E1_over_E2"), 3));
+            c.push_back(format_fixed(value(row, "E1_over_E2"), 3));
             add_cells(c, row["T_um"], 3, 4);
             add_cells(c, row["sigma_over_T"], 3, 4);
             cells.push_back(std::move(c));
         }
         text << "Table 1 (slightly rough; sigma from R_spec by Eq. 13 at theta = "
-             << num(value(cond, "specular_theta_deg"), 0)
+             << format_fixed(value(cond, "specular_theta_deg"), 0)
              << " deg, T from the printed sigma and E1/E2 by Eq. 15 at "
-             << num(value(cond, "theta1_deg"), 0) << "/" << num(value(cond, "theta2_deg"), 0)
+             << format_fixed(value(cond, "theta1_deg"), 0) << "/"
+             << format_fixed(value(cond, "theta2_deg"), 0)
              << " deg, lambda = " << value(cond, "lambda_um") << " um, R0 = 1, F_VH)\n";
         print_table(text,
                     {"surface", "R_spec", "sigma", "sigma*", "", "E1/E2", "T", "T*", "", "sigma/T",
@@ -115,7 +109,7 @@ void run_tables(const Args& a) {
         std::vector<std::vector<std::string>> cells;
         for (const json& row : t["rows"]) {
             std::vector<std::string> c = {row["surface"].get<std::string>(),
-                                          num(value(row, "E1_over_E2"), 3)};
+                                          format_fixed(value(row, "E1_over_E2"), 3)};
             add_cells(c, row["sigma_over_T_G"], 4, 4);
             add_cells(c, row["sigma_over_T_E"], 4, 4);
             add_cells(c, row["theta_K_deg"], 0, 2);
@@ -123,7 +117,8 @@ void run_tables(const Args& a) {
             cells.push_back(std::move(c));
         }
         text << "\nTable 2 (very rough; sigma/T from E1/E2 by Eq. 17 and 19 at "
-             << num(value(cond, "theta1_deg"), 0) << "/" << num(value(cond, "theta2_deg"), 0)
+             << format_fixed(value(cond, "theta1_deg"), 0) << "/"
+             << format_fixed(value(cond, "theta2_deg"), 0)
              << " deg, F_VH; theta_K and xi_K from the printed sigma/T_G)\n";
         print_table(text,
                     {"surface", "E1/E2", "s/T_G", "s/T_G*", "", "s/T_E", "s/T_E*", "", "theta_K",
@@ -136,14 +131,14 @@ void run_tables(const Args& a) {
         std::vector<std::vector<std::string>> cells;
         for (const json& row : t["rows"]) {
             std::vector<std::string> c = {row["sample"].get<std::string>(),
-                                          num(value(row, "E1_over_E2"), 6)};
+                                          format_fixed(value(row, "E1_over_E2"), 6)};
             add_cells(c, row["sigma_over_T_G"], 4, 4);
             add_cells(c, row["sigma_over_T_E"], 4, 4);
             cells.push_back(std::move(c));
         }
         text << "\nTable 3 (CUReT; sigma/T from E1/E2 by Eq. 17 and 19 at "
-             << num(value(cond, "theta1_deg"), 1) << "/" << num(value(cond, "theta2_deg"), 1)
-             << " deg, F_VH)\n";
+             << format_fixed(value(cond, "theta1_deg"), 1) << "/"
+             << format_fixed(value(cond, "theta2_deg"), 1) << " deg, F_VH)\n";
         print_table(text, {"sample", "E1/E2", "s/T_G", "s/T_G*", "", "s/T_E", "s/T_E*", ""}, cells);
     }
     text << "\n* recomputed from the printed inputs.  = same at the printed digits;  ~ within the "

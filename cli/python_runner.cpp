@@ -78,12 +78,18 @@ void run_python_module(const std::string& module, const std::vector<std::string>
     std::vector<std::string> argv_text{interpreter, "-m", module};
     argv_text.insert(argv_text.end(), args.begin(), args.end());
     std::vector<char*> argv;
+    argv.reserve(argv_text.size() + 1);
     for (auto& s : argv_text) argv.push_back(s.data());
     argv.push_back(nullptr);
     std::string pythonpath;
     if (const auto pkg = package_dir_beside_executable()) {
         const char* old = std::getenv("PYTHONPATH");
-        pythonpath = pkg->string() + (old && *old ? ":" + std::string(old) : std::string());
+        pythonpath = pkg->string();
+        if (old && *old) {  // appended piecewise: GCC 12's -Wrestrict misfires on
+                            // ":" + string
+            pythonpath += ':';
+            pythonpath += old;
+        }
     }
 
     Pipe in, err;
@@ -107,7 +113,8 @@ void run_python_module(const std::string& module, const std::vector<std::string>
     in.close(0);
     err.close(1);
 
-    // Feed the document; a child that exits early closes the pipe (EPIPE, not SIGPIPE).
+    // Feed the document; a child that exits early closes the pipe (EPIPE, not
+    // SIGPIPE).
     struct sigaction ignore {
     }, previous{};
     ignore.sa_handler = SIG_IGN;

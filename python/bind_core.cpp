@@ -254,7 +254,9 @@ std::array<double, N> values_at(const std::array<Operand, N>& ops, ssize_t i) {
 template <std::size_t N, class F>
 py::object map_double(const std::array<const char*, N>& names,
                       const std::array<py::handle, N>& values, F f, bool parallel = true) {
-    auto [ops, b] = broadcast<N>(names, values);
+    auto operands = broadcast<N>(names, values);
+    auto& ops = operands.first;  // not a structured binding (the lambdas below name it)
+    auto& b = operands.second;
     py::array_t<double> out = make_output(b);
     double* o = out.mutable_data();
     for_each_element(b, parallel, [&](ssize_t i) { o[i] = std::apply(f, values_at(ops, i)); });
@@ -271,6 +273,7 @@ Geometry geometry_deg(double theta_i_deg, double theta_s_deg, double phi_s_deg) 
 template <class Enum, std::size_t K>
 std::vector<std::string> enum_names(const std::array<Enum, K>& values) {
     std::vector<std::string> names;
+    names.reserve(K);
     for (Enum e : values) names.emplace_back(to_string(e));
     return names;
 }
@@ -296,8 +299,10 @@ py::object very_rough_brightness_py(py::handle theta_i_deg, py::handle theta_s_d
                                     const std::string& radiometry) {
     const BrightnessBatchModel model{parse_correlation(correlation), parse_geometric_factor(factor),
                                      parse_radiometry(radiometry)};
-    auto [ops, b] = broadcast<4>({"theta_i_deg", "theta_s_deg", "phi_s_deg", "sigma_over_T"},
+    auto operands = broadcast<4>({"theta_i_deg", "theta_s_deg", "phi_s_deg", "sigma_over_T"},
                                  {theta_i_deg, theta_s_deg, phi_s_deg, sigma_over_T});
+    auto& ops = operands.first;  // not a structured binding (the lambdas below name it)
+    auto& b = operands.second;
     if (b.scalar) {  // one value: the library's own function
         const double x = very_rough_brightness(
             geometry_deg(ops[0].data[0], ops[1].data[0], ops[2].data[0]), ops[3].data[0],
@@ -449,7 +454,9 @@ void bind_core(py::module_& m) {
     m.def(
         "geometry_from_vectors",
         [](py::handle N, py::handle L, py::handle V, double unit_tolerance) {
-            auto [ops, b] = broadcast<3>({"N", "L", "V"}, {N, L, V}, 3);
+            auto operands = broadcast<3>({"N", "L", "V"}, {N, L, V}, 3);
+            auto& ops = operands.first;  // not a structured binding (the lambdas below name it)
+            auto& b = operands.second;
             py::array_t<double> ti = make_output(b), ts = make_output(b), ps = make_output(b);
             py::array_t<bool> visible(b.shape);
             double *oi = ti.mutable_data(), *os = ts.mutable_data(), *op = ps.mutable_data();
@@ -487,8 +494,10 @@ vectors, arrays of the leading shape otherwise.)doc");
         "geometry_from_two_azimuths",
         [](py::handle theta_i_deg, py::handle phi_i_deg, py::handle theta_v_deg,
            py::handle phi_v_deg) {
-            auto [ops, b] = broadcast<4>({"theta_i_deg", "phi_i_deg", "theta_v_deg", "phi_v_deg"},
+            auto operands = broadcast<4>({"theta_i_deg", "phi_i_deg", "theta_v_deg", "phi_v_deg"},
                                          {theta_i_deg, phi_i_deg, theta_v_deg, phi_v_deg});
+            auto& ops = operands.first;  // not a structured binding (the lambdas below name it)
+            auto& b = operands.second;
             py::array_t<double> ti = make_output(b), ts = make_output(b), ps = make_output(b);
             double *oi = ti.mutable_data(), *os = ts.mutable_data(), *op = ps.mutable_data();
             for_each_element(b, true, [&](ssize_t i) {
@@ -513,9 +522,11 @@ phi_s_deg) with phi_s_deg in [0, 360).)doc");
         "scattering_vector",
         [](py::handle theta_i_deg, py::handle theta_s_deg, py::handle phi_s_deg,
            py::handle wavelength_um) {
-            auto [ops, b] =
+            auto operands =
                 broadcast<4>({"theta_i_deg", "theta_s_deg", "phi_s_deg", "wavelength_um"},
                              {theta_i_deg, theta_s_deg, phi_s_deg, wavelength_um});
+            auto& ops = operands.first;  // not a structured binding (the lambdas below name it)
+            auto& b = operands.second;
             py::array_t<double> vx = make_output(b), vy = make_output(b), vz = make_output(b);
             double *ox = vx.mutable_data(), *oy = vy.mutable_data(), *oz = vz.mutable_data();
             for_each_element(b, true, [&](ssize_t i) {
@@ -623,10 +634,12 @@ F_Beck(0, 0, ·) = 1; retro (θ, θ, 180): 1/cos²θ. Angles in degrees.)doc");
             opt.regime = parse_regime(regime);
             opt.radiometry = parse_radiometry(radiometry);
             opt.auto_tolerance = auto_tolerance;
-            auto [ops, b] = broadcast<8>({"theta_i_deg", "theta_s_deg", "phi_s_deg", "sigma_um",
+            auto operands = broadcast<8>({"theta_i_deg", "theta_s_deg", "phi_s_deg", "sigma_um",
                                           "T_um", "wavelength_um", "patch_x_um", "patch_y_um"},
                                          {theta_i_deg, theta_s_deg, phi_s_deg, sigma_um, T_um,
                                           wavelength_um, patch_x_um, patch_y_um});
+            auto& ops = operands.first;  // not a structured binding (the lambdas below name it)
+            auto& b = operands.second;
             py::array_t<double> coh = make_output(b), dif = make_output(b), tot = make_output(b),
                                 bri = make_output(b), gg = make_output(b);
             py::array_t<std::uint8_t> reg(b.shape), cls(b.shape);
@@ -871,7 +884,9 @@ cos³θ exp(−k² ([T sin θ]² + [2σ cos θ]²)), k = 2π/λ. Lengths in µm.
     m.def(
         "roughness_class",
         [](py::handle g) {
-            auto [ops, b] = broadcast<1>({"g"}, {g});
+            auto operands = broadcast<1>({"g"}, {g});
+            auto& ops = operands.first;  // not a structured binding (the lambdas below name it)
+            auto& b = operands.second;
             py::array_t<std::uint8_t> codes(b.shape);
             std::uint8_t* oc = codes.mutable_data();
             for_each_element(b, true, [&](ssize_t i) {

@@ -3,6 +3,7 @@
 // serializer (roughscope/serialize/comparison.hpp): the document of `roughscope curet --json`
 // as Python objects. The options become a ComparisonOptions in one place,
 // serialize::comparison_options_from, which the CLI calls too.
+#include <array>
 #include <optional>
 #include <string>
 #include <vector>
@@ -17,12 +18,23 @@
 #include "roughscope/brdf/curet.hpp"
 #include "roughscope/brdf/table.hpp"
 #include "roughscope/core/errors.hpp"
+#include "roughscope/core/names.hpp"
 #include "roughscope/serialize/comparison.hpp"
 
 namespace py = pybind11;
 
 namespace roughscope::python {
 namespace {
+
+// compare_all(format=...): names in the library's enum-name scheme (roughscope/core/names.hpp),
+// case-insensitive, as the CLI's --format.
+enum class AllFormat { Dict, Csv, Markdown };
+constexpr std::array<NameEntry<AllFormat>, 4> kAllFormatNames{{
+    {"dict", AllFormat::Dict},
+    {"csv", AllFormat::Csv},
+    {"markdown", AllFormat::Markdown},
+    {"md", AllFormat::Markdown},  // alias, as for the CLI
+}};
 
 py::array_t<double> vector_array(const std::vector<double>& v) {
     return py::array_t<double>(static_cast<py::ssize_t>(v.size()), v.data());
@@ -193,16 +205,20 @@ void bind_curet(py::module_& m) {
                 const ComparisonOptions o =
                     make_options(py::none(), py::none(), py::none(), py::none(), py::none(), fits,
                                  radiometry, max_overflow);
-                if (format != "dict" && format != "csv" && format != "markdown")
-                    throw InvalidArgument("format '" + format +
-                                          "' is not one of: dict, csv, markdown");
+                const AllFormat f = parse_name(kAllFormatNames, "format", format);
                 std::vector<Comparison> all;
                 {
                     py::gil_scoped_release release;
                     all = compare_curet_all(db, o, threads);
                 }
-                if (format == "csv") return py::str(serialize::to_csv(all));
-                if (format == "markdown") return py::str(serialize::to_markdown(all));
+                switch (f) {
+                    case AllFormat::Csv:
+                        return py::str(serialize::to_csv(all));
+                    case AllFormat::Markdown:
+                        return py::str(serialize::to_markdown(all));
+                    case AllFormat::Dict:
+                        break;
+                }
                 return to_python(serialize::to_json(all, series));
             },
             py::kw_only(), py::arg("fits") = true, py::arg("radiometry") = "radiance",
@@ -218,7 +234,8 @@ void bind_curet(py::module_& m) {
                 .string();
         },
         py::arg("data_dir") = py::none(),
-        "The CUReT directory: data_dir, else ../shared/data/curet, else $ROUGHSCOPE_CURET "
+        "The CUReT directory: data_dir, else $ROUGHSCOPE_SHARED_DIR/data/curet, else "
+        "../shared/data/curet searched upward from the current directory, else $ROUGHSCOPE_CURET "
         "(DataError saying where to get the database otherwise)");
     m.def(
         "curet_load",

@@ -21,6 +21,7 @@
 
 #include "bindings.hpp"
 #include "roughscope/core/errors.hpp"
+#include "roughscope/core/names.hpp"
 #include "roughscope/estimation/estimation.hpp"
 #include "roughscope/fit/fit.hpp"
 #include "roughscope/scattering/beckmann.hpp"
@@ -110,6 +111,19 @@ double rad(double deg) { return deg_to_rad(deg); }
 GeometricFactor factor_of(const std::string& s) { return parse_geometric_factor(s); }
 Correlation correlation_of(const std::string& s) { return parse_correlation(s); }
 Radiometry radiometry_of(const std::string& s) { return parse_radiometry(s); }
+
+// correlation="both" → std::nullopt (both side by side), else the library's parse_correlation; the
+// same rule as the CLI's --correlation (case-insensitive, listing the valid names on error).
+std::optional<Correlation> correlation_or_both(const std::string& s) {
+    if (name_matches("both", s)) return std::nullopt;
+    try {
+        return parse_correlation(s);
+    } catch (const InvalidArgument&) {
+        throw_unknown_name("correlation", s,
+                           std::string(to_string(Correlation::Gaussian)) + ", " +
+                               std::string(to_string(Correlation::Exponential)) + ", both");
+    }
+}
 
 Geometry geometry_deg(double ti, double ts, double ps) {
     return make_geometry(rad(ti), rad(ts), rad(ps));
@@ -354,14 +368,13 @@ void bind_estimation(py::module_& m) {
             const auto [n1, n2] = noise_pair(noise);
             in.noise = {n1, n2};
             in.sigma_um = sigma_um;
-            const bool both = correlation == "both";
-            const Correlation c = both ? Correlation::Gaussian : correlation_of(correlation);
+            const std::optional<Correlation> c = correlation_or_both(correlation);  // none: both
             std::optional<RoughnessEstimate> eg, ee;
-            if (both || c == Correlation::Gaussian) {
+            if (c != Correlation::Exponential) {
                 in.correlation = Correlation::Gaussian;
                 eg = estimate_slope(in);
             }
-            if (both || c == Correlation::Exponential) {
+            if (c != Correlation::Gaussian) {
                 in.correlation = Correlation::Exponential;
                 ee = estimate_slope(in);
             }

@@ -1,15 +1,43 @@
-// Umbrella header: the whole public API of the roughscope library.
+// Umbrella header: the whole public API of the roughscope library, every public header of every
+// topic (docs/architecture.md). Link roughscope::roughscope. The version macros are in the
+// generated <roughscope/version.hpp>.
 #pragma once
 
-#include "roughscope/brdf/comparison.hpp"
-#include "roughscope/brdf/curet.hpp"
-#include "roughscope/brdf/table.hpp"
+// core: errors and argument checks, the enum-name scheme, number parsing and formatting
 #include "roughscope/core/errors.hpp"
-#include "roughscope/estimation/estimation.hpp"
-#include "roughscope/fit/fit.hpp"
+#include "roughscope/core/names.hpp"
+#include "roughscope/core/numbers.hpp"
+
+// io: the CSV reader, atomic output files, the reference-data locator
+#include "roughscope/io/csv.hpp"
+#include "roughscope/io/data_locator.hpp"
+#include "roughscope/io/output_file.hpp"
+
+// scattering: geometry, factors, B-K (Eq. 1-5), retro forms, validity, comparison models, batch
+// kernel
 #include "roughscope/scattering/beckmann.hpp"
+#include "roughscope/scattering/brightness_batch.hpp"
 #include "roughscope/scattering/factors.hpp"
 #include "roughscope/scattering/geometry.hpp"
 #include "roughscope/scattering/reflectance_models.hpp"
 #include "roughscope/scattering/retro.hpp"
 #include "roughscope/scattering/validity.hpp"
+
+// estimation: the closed forms of §4, the two-geometry solver, uncertainty
+#include "roughscope/estimation/estimation.hpp"
+
+// fit: the least-squares engine and the roughness fits
+#include "roughscope/fit/engine.hpp"
+#include "roughscope/fit/fit.hpp"
+
+// brdf: BRDF tables, CUReT, the model comparison
+#include "roughscope/brdf/comparison.hpp"
+#include "roughscope/brdf/curet.hpp"
+#include "roughscope/brdf/table.hpp"
+
+// serialize: every result type to JSON, CSV and Markdown
+#include "roughscope/serialize/comparison.hpp"
+#include "roughscope/serialize/estimation.hpp"
+#include "roughscope/serialize/json.hpp"
+#include "roughscope/serialize/model.hpp"
+#include "roughscope/serialize/paper_tables.hpp"

@@ -3,7 +3,7 @@
 Loading::
 
     from roughscope import curet
-    db = curet.load()                 # ../shared/data/curet, else $ROUGHSCOPE_CURET
+    db = curet.load()                 # the shared data/curet (see find_directory)
     db.brdf.shape                     # (61, 205) BRDF values f in 1/sr (non-positive ones kept)
     db.brightness                     # f * cos(theta_i): camera-like brightness (§5.3)
     db.angles["theta_s_deg"]          # geometry in the paper's frame (degrees)
@@ -120,7 +120,13 @@ class CuretData:
 
 
 def find_directory(data_dir=None):
-    """The CUReT directory: data_dir, else ../shared/data/curet, else $ROUGHSCOPE_CURET."""
+    """The CUReT directory: data_dir, else data/curet in the shared folder.
+
+    The shared folder is found by the library's one rule (io/data_locator.hpp, also
+    ``roughscope.curet_data_dir()``): $ROUGHSCOPE_SHARED_DIR when set, else ../shared searched
+    upward from the current directory; the older $ROUGHSCOPE_CURET is the last resort. Raises
+    roughscope.DataError naming the files needed and where they come from otherwise.
+    """
     return _core.curet_find_directory(None if data_dir is None else str(data_dir))
 
 

@@ -173,7 +173,7 @@ std::string issues_summary(const Comparison& c) {
     return s;
 }
 
-std::string md_escape(std::string s) {
+std::string md_escape(const std::string& s) {
     std::string out;
     for (char ch : s) {
         if (ch == '|')

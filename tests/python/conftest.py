@@ -8,6 +8,7 @@ reason, instead of skipping anything.
 import json
 import os
 import pathlib
+import subprocess
 import sys
 
 import pytest
@@ -23,8 +24,11 @@ except ImportError as exc:  # pragma: no cover - a set-up error, reported verbat
 
 REPO_ROOT = pathlib.Path(__file__).resolve().parents[2]
 # The library's locator (io/data_locator.hpp): $ROUGHSCOPE_SHARED_DIR, else ../shared upward from
-# the working directory and from the repository. None when absent.
+# the working directory and from the repository. None when absent. Tests reach these through the
+# fixtures below (`paper_tables`, `paper_tables_path`, `curet_dir`) or `needs_curet`, which skip
+# visibly when the data are missing and fail under ROUGHSCOPE_REQUIRE_SHARED_DATA=1.
 PAPER_TABLES = roughscope._core.paper_tables_path([REPO_ROOT])
+CURET_DIR = roughscope._core.curet_data_dir([REPO_ROOT])
 
 
 def need_shared(path, relative):
@@ -38,11 +42,46 @@ def need_shared(path, relative):
 
 
 @pytest.fixture(scope="session")
-def paper_tables():
+def paper_tables_path():
+    """Path of the paper's printed tables (reference/paper-tables.json); skip (or fail) if absent."""
+    return need_shared(PAPER_TABLES, "reference/paper-tables.json")
+
+
+@pytest.fixture(scope="session")
+def paper_tables(paper_tables_path):
     """The paper's Tables 1–4 (kept beside the repository, never inside it); skip if absent."""
-    need_shared(PAPER_TABLES, "reference/paper-tables.json")
-    with open(PAPER_TABLES, encoding="utf-8") as f:
+    with open(paper_tables_path, encoding="utf-8") as f:
         return json.load(f)
+
+
+@pytest.fixture(scope="session")
+def curet_dir():
+    """The CUReT directory (data/curet: table.txt, abrdf.dat); skip (or fail) if absent."""
+    return need_shared(CURET_DIR, "data/curet")
+
+
+# For tests that read CURET_DIR directly: the same skip-or-fail rule as the fixture.
+needs_curet = pytest.mark.usefixtures("curet_dir")
+
+
+# ---------------------------------------------------------------------------------------------
+# The command-line tool: $ROUGHSCOPE_CLI (ctest sets it), else <repo>/build/bin/roughscope.
+
+def cli_path():
+    """Path of the roughscope executable; fails the test when it is not built."""
+    env = os.environ.get("ROUGHSCOPE_CLI")
+    path = pathlib.Path(env) if env else REPO_ROOT / "build" / "bin" / "roughscope"
+    if not path.is_file():
+        pytest.fail(f"roughscope CLI not found at {path} (set ROUGHSCOPE_CLI or build build/)")
+    return str(path.resolve())  # absolute: some tests run it from another directory
+
+
+def cli_json(*args, timeout=600):
+    """Runs `roughscope ARGS --json`, asserts exit 0 and returns the parsed document."""
+    proc = subprocess.run([cli_path(), *map(str, args), "--json"], capture_output=True,
+                          text=True, timeout=timeout)
+    assert proc.returncode == 0, f"exit {proc.returncode}: {proc.stderr}"
+    return json.loads(proc.stdout)
 
 
 @pytest.fixture

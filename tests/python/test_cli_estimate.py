@@ -1,38 +1,30 @@
 """Tests of `roughscope estimate ...` and `roughscope paper tables`.
 
-Numbers are checked against the paper's tables (../shared/reference/paper-tables.json, skipped when
-absent) or the paper's equations evaluated here with Python's math module. Every success test has
-bad-input companions asserting the exit code and a one-line message. The CLI is found through
-ROUGHSCOPE_CLI (ctest sets it), else build/bin/roughscope.
+Numbers are checked against the paper's tables (the shared reference/paper-tables.json, through
+conftest.py's `paper_tables_path` fixture) or the paper's equations evaluated here with Python's
+math module. Every success test has bad-input companions asserting the exit code and a one-line
+message. The CLI is found by conftest.cli_path: ROUGHSCOPE_CLI (ctest sets it), else
+build/bin/roughscope.
 """
 
 import csv
 import json
 import math
-import os
 import random
 import re
 import subprocess
-from pathlib import Path
 
 import pytest
 
-REPO = Path(__file__).resolve().parents[2]
-PAPER_TABLES = REPO.parent / "shared" / "reference" / "paper-tables.json"
+from conftest import REPO_ROOT as REPO
+from conftest import cli_path
+
 EXIT_USAGE, EXIT_NO_SOLUTION, EXIT_DATA = 2, 3, 4
 NAN_RE = re.compile(r"\b(nan|inf|infinity)\b", re.IGNORECASE)
 
 
-def _cli():
-    env = os.environ.get("ROUGHSCOPE_CLI")
-    path = Path(env) if env else REPO / "build" / "bin" / "roughscope"
-    if not path.is_file():
-        pytest.fail(f"roughscope CLI not found at {path} (set ROUGHSCOPE_CLI or build build/)")
-    return str(path)
-
-
 def run(*args, check=True, cwd=None):
-    proc = subprocess.run([_cli(), *map(str, args)], capture_output=True, text=True, timeout=300,
+    proc = subprocess.run([cli_path(), *map(str, args)], capture_output=True, text=True, timeout=300,
                           cwd=cwd)
     if check:
         assert proc.returncode == 0, f"exit {proc.returncode}: {proc.stderr}"
@@ -109,6 +101,17 @@ def test_slope_errors():
     assert_error(p, EXIT_USAGE, "--ratio excludes")
     p = run("estimate", "slope", "--ratio", "1.1", "--theta1", "30", check=False)
     assert_error(p, EXIT_USAGE, "--theta2")
+    p = run("estimate", "slope", "--ratio", "1.1", "--theta1", "30", "--theta2", "45",
+            "--correlation", "lorentzian", check=False)
+    assert_error(p, EXIT_USAGE, "--correlation", "lorentzian", "gaussian, exponential, both")
+
+
+def test_correlation_names_are_case_insensitive():
+    # the library's name scheme (core/names.hpp): any case, '-' == '_'
+    base = ("estimate", "slope", "--ratio", "1.091", "--theta1", "30", "--theta2", "45")
+    assert run_json(*base, "--correlation", "BOTH") == run_json(*base)
+    one = run_json(*base, "--correlation", "Exponential")
+    assert one["sigma_over_T_gaussian"] is None and one["sigma_over_T_exponential"] > 0
 
 
 # ---- estimate specular / correlation-length ------------------------------------------------------
@@ -239,8 +242,8 @@ def test_output_file_is_atomic(tmp_path):
 
 # ---- paper tables --------------------------------------------------------------------------------
 
-def test_paper_tables(paper_tables):
-    out = run_json("paper", "tables", "--reference", PAPER_TABLES)
+def test_paper_tables(paper_tables_path):
+    out = run_json("paper", "tables", "--reference", paper_tables_path)
     for row in out["table3"]["rows"]:
         assert row["sigma_over_T_G"]["agreement"] == "exact"
         assert row["sigma_over_T_E"]["agreement"] == "exact"
@@ -251,7 +254,7 @@ def test_paper_tables(paper_tables):
     for row in out["table1"]["rows"]:
         for k in ("sigma_um", "T_um", "sigma_over_T"):
             assert row[k]["agreement"] in ("exact", "within_rounding"), (row["surface"], k)
-    text = run("paper", "tables", "--reference", PAPER_TABLES).stdout
+    text = run("paper", "tables", "--reference", paper_tables_path).stdout
     assert "Table 1" in text and "Table 3" in text and "DIFFERS" not in text.split("*")[0]
     # default path: ../shared/reference/paper-tables.json relative to the working directory
     assert run("paper", "tables", cwd=REPO).returncode == 0

@@ -12,23 +12,13 @@ hand the fallback is build/bin/roughscope in the repository.
 import csv
 import json
 import math
-import os
 import re
 import subprocess
-from pathlib import Path
 
 import pytest
 
-REPO = Path(__file__).resolve().parents[2]
-
-
-def _cli_path():
-    env = os.environ.get("ROUGHSCOPE_CLI")
-    path = Path(env) if env else REPO / "build" / "bin" / "roughscope"
-    if not path.is_file():
-        pytest.fail(f"roughscope CLI not found at {path} (set ROUGHSCOPE_CLI or build build/)")
-    return str(path)
-
+from conftest import REPO_ROOT as REPO
+from conftest import cli_path
 
 NAN_RE = re.compile(r"\b(nan|inf|infinity)\b", re.IGNORECASE)
 
@@ -38,7 +28,7 @@ EXIT_USAGE, EXIT_NO_SOLUTION, EXIT_DATA = 2, 3, 4
 
 def run(*args, check=True):
     """Runs the CLI; returns the CompletedProcess. With check, asserts exit 0."""
-    proc = subprocess.run([_cli_path(), *map(str, args)], capture_output=True, text=True,
+    proc = subprocess.run([cli_path(), *map(str, args)], capture_output=True, text=True,
                           timeout=120)
     assert not NAN_RE.search(proc.stdout), f"NaN/inf printed: {proc.stdout!r}"
     if check:
@@ -328,11 +318,13 @@ def test_lambert_is_cos_theta_i():
                      0.5, 1e-9)
 
 
-@pytest.mark.parametrize("model", ["oren-nayar", "oren-nayar-qualitative"])
+@pytest.mark.parametrize("model", ["oren-nayar", "oren-nayar-qualitative", "Oren_Nayar"])
 def test_oren_nayar_with_zero_slope_is_lambert(model):
     out = run_json("model", "--model", model, "--on-sigma", 0, "--albedo", 0.8, "--theta-i", 40,
                    "--theta-s", 20, "--phi-s", 90)
     assert rel_close(out["brightness"], 0.8 / math.pi * math.cos(math.radians(40)), 1e-9)
+    # the library's name scheme: any case, '-' == '_'; printed with '-' as on the command line
+    assert out["model"] == model.lower().replace("_", "-")
 
 
 def test_oren_nayar_rough_brightens_retro_relative_to_lambert():
@@ -483,7 +475,7 @@ SOT = ("--sigma-over-T", "0.5")
     ((*RETRO, *SOT, "--factor", "foo"), ("--factor", "vh")),
     ((*RETRO, *SOT, "--regime", "medium"), ("--regime", "very_rough")),
     ((*RETRO, *SOT, "--radiometry", "flux"), ("--radiometry", "radiance")),
-    ((*RETRO, *SOT, "--model", "phong"), ("--model", "lambert")),
+    ((*RETRO, *SOT, "--model", "phong"), ("--model", "phong", "bk, lambert, oren_nayar")),
     ((*RETRO, "--sigma", "1", "--T", "1", "--wavelength", "0"), ("--wavelength",)),
     ((*RETRO, "--sigma", "1", "--T", "1", "--patch-x", "-5"), ("--patch-x",)),
     ((*RETRO, *SOT, "--theta-i", "10"), ("--retro", "--theta-i")),

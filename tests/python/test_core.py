@@ -6,7 +6,6 @@ Every success test has a bad-input partner asserting the error type.
 """
 
 import math
-import os
 import pathlib
 import re
 import subprocess

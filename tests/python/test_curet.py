@@ -1,7 +1,8 @@
 """Tests of the CUReT comparison through the Python module and the `roughscope curet` command.
 
-Real data: ../shared/data/curet (tests needing it skip, saying so, when it is absent).
-Printed values: ../shared/reference/paper-tables.json. Both found by io/data_locator.hpp. Independent checks: the paper's
+Real data: the shared data/curet; printed values: the shared reference/paper-tables.json. Both are
+found by conftest.py (io/data_locator.hpp); tests needing them skip, saying so, when they are
+absent, and fail under ROUGHSCOPE_REQUIRE_SHARED_DATA=1. Independent checks: the paper's
 Tables 3 and 4, facts of the data README (43 non-positive values, measurements 81 and 112), and
 synthetic tables generated here with numpy from Eq. 5 written out by hand.
 """
@@ -10,7 +11,6 @@ import json
 import math
 import os
 import subprocess
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -19,49 +19,24 @@ import roughscope
 import roughscope._core
 from roughscope import curet
 
-REPO = Path(__file__).resolve().parents[2]
-# io/data_locator.hpp: $ROUGHSCOPE_SHARED_DIR, else ../shared upward (None when absent); missing
-# data skip, or fail at collection under ROUGHSCOPE_REQUIRE_SHARED_DATA=1.
-CURET_DIR = roughscope._core.curet_data_dir([REPO])
-TABLES = roughscope._core.paper_tables_path([REPO])
-if roughscope._core.shared_data_required() and (CURET_DIR is None or TABLES is None):
-    raise RuntimeError("ROUGHSCOPE_REQUIRE_SHARED_DATA=1 but the shared data were not found: " +
-                       roughscope._core.shared_search_description("data/curet"))
-
-needs_curet = pytest.mark.skipif(
-    CURET_DIR is None,
-    reason="CUReT data not found: " + roughscope._core.shared_search_description("data/curet"),
-)
-needs_tables = pytest.mark.skipif(
-    TABLES is None,
-    reason="paper tables not found: " +
-    roughscope._core.shared_search_description("reference/paper-tables.json"))
+# The shared data through conftest.py (io/data_locator.hpp: $ROUGHSCOPE_SHARED_DIR, else ../shared
+# upward): missing data skip visibly, or fail under ROUGHSCOPE_REQUIRE_SHARED_DATA=1.
+from conftest import CURET_DIR, cli_path, needs_curet
+from conftest import REPO_ROOT as REPO
 
 
 @pytest.fixture(scope="module")
-def db():
-    if CURET_DIR is None:
-        pytest.skip("CUReT data not found")
-    return curet.load(CURET_DIR)
+def db(curet_dir):
+    return curet.load(curet_dir)
 
 
 @pytest.fixture(scope="module")
-def paper():
-    if TABLES is None:
-        pytest.skip("paper tables not found")
-    return json.loads(TABLES.read_text(encoding="utf-8"))
-
-
-def _cli():
-    env = os.environ.get("ROUGHSCOPE_CLI")
-    path = Path(env) if env else REPO / "build" / "bin" / "roughscope"
-    if not path.is_file():
-        pytest.fail(f"roughscope CLI not found at {path} (set ROUGHSCOPE_CLI or build build/)")
-    return str(path)
+def paper(paper_tables):
+    return paper_tables
 
 
 def run_cli(*args, cwd=None):
-    return subprocess.run([_cli(), "curet", *args], capture_output=True, text=True, cwd=cwd,
+    return subprocess.run([cli_path(), "curet", *args], capture_output=True, text=True, cwd=cwd,
                           timeout=300)
 
 
@@ -112,7 +87,6 @@ def test_bad_sample_and_channel_raise_value_error(db):
 
 
 @needs_curet
-@needs_tables
 def test_table3_recomputed(db, paper):
     for row in paper["table3_curet_parameters"]["rows"]:
         r = db.compare(row["sample"], fits=False, series=False)
@@ -127,7 +101,6 @@ def test_table3_recomputed(db, paper):
 
 
 @needs_curet
-@needs_tables
 def test_table4_recomputed(db, paper):
     keys = ["bk_gaussian", "bk_exponential", "vh_gaussian", "vh_exponential"]
     for row in paper["table4_curet_errors"]["rows"]:
@@ -236,6 +209,13 @@ def test_compare_table_from_arrays_and_csv_recovers_the_slope(tmp_path):
     p = run_cli("--table", str(path), "--pair", "1,2", "--json", "--no-fits")
     assert p.returncode == 0, p.stderr
     assert json.loads(p.stdout)["sigma_over_T_exponential"] == pytest.approx(0.7, rel=1e-9)
+    # --format names: the library's scheme (any case, "md" an alias of "markdown")
+    md = run_cli("--table", str(path), "--pair", "1,2", "--no-fits", "--format", "MD")
+    assert md.returncode == 0 and md.stdout == run_cli("--table", str(path), "--pair", "1,2",
+                                                       "--no-fits", "--format", "markdown").stdout
+    p = run_cli("--table", str(path), "--format", "xml")
+    assert p.returncode == 2 and p.stdout == "" and "--format" in p.stderr
+    assert "text, json, csv, markdown" in p.stderr
 
 
 def test_bad_tables_raise_value_error(tmp_path):
@@ -293,7 +273,7 @@ def test_cli_errors_are_one_line_with_exit_codes(tmp_path):
     # no database anywhere: a clear error, nothing on stdout
     env = {k: v for k, v in os.environ.items()
            if k not in ("ROUGHSCOPE_CURET", "ROUGHSCOPE_SHARED_DIR")}
-    q = subprocess.run([_cli(), "curet", "--sample", "25"], capture_output=True, text=True,
+    q = subprocess.run([cli_path(), "curet", "--sample", "25"], capture_output=True, text=True,
                        cwd=tmp_path, env=env, timeout=60)
     assert q.returncode == 4 and q.stdout == ""
     assert "ROUGHSCOPE_CURET" in q.stderr and "abrdf.dat" in q.stderr

@@ -214,6 +214,17 @@ def test_estimate_warnings_and_known_sigma():
         rs.estimate_slope(1.1, 30, 45, sigma_um=0.0)
 
 
+def test_estimate_slope_correlation_names():
+    # the library's name scheme, as the CLI's --correlation: any case; "both" side by side
+    both = rs.estimate_slope(1.091, 30, 45, correlation="both")
+    assert rs.estimate_slope(1.091, 30, 45, correlation="BOTH") == both
+    assert both["sigma_over_T_gaussian"] > 0 and both["sigma_over_T_exponential"] > 0
+    g = rs.estimate_slope(1.091, 30, 45, correlation="Gaussian")
+    assert g["sigma_over_T_exponential"] is None
+    with pytest.raises(rs.InvalidArgument, match="gaussian, exponential, both"):
+        rs.estimate_slope(1.091, 30, 45, correlation="lorentzian")
+
+
 def test_estimate_specular_and_correlation_length():
     e = rs.estimate_sigma_specular(E_tot=100.0, E_dif=98.6, theta_deg=14, noise=0.01)
     assert e["sigma_um"] == pytest.approx(eq13(0.014, 14))

@@ -3,16 +3,16 @@ function gives the same document for the same inputs, because both print what th
 serializer (roughscope/serialize) builds. Same keys (recursively, in any order), numbers equal to
 1e-12 relative, strings and booleans equal, null ↔ None.
 
-CUReT cases need <repo>/../shared/data/curet and skip, saying so, without it (the paper tables
-likewise need ../shared/reference/paper-tables.json, through the `paper_tables` fixture).
+CUReT cases need the shared data/curet and the paper-tables cases reference/paper-tables.json,
+found by conftest.py's locator (io/data_locator.hpp: $ROUGHSCOPE_SHARED_DIR, else ../shared
+searched upward); they skip, saying so, without them, and fail under
+ROUGHSCOPE_REQUIRE_SHARED_DATA=1.
 `roughscope model` has no Python counterpart and is not compared.
 """
 
 import json
 import math
-import os
 import subprocess
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -20,23 +20,7 @@ import pytest
 import roughscope as rs
 from roughscope import curet
 
-REPO = Path(__file__).resolve().parents[2]
-CURET_DIR = REPO.parent / "shared" / "data" / "curet"
-
-
-def _cli():
-    env = os.environ.get("ROUGHSCOPE_CLI")
-    path = Path(env) if env else REPO / "build" / "bin" / "roughscope"
-    if not path.is_file():
-        pytest.fail(f"roughscope CLI not found at {path} (set ROUGHSCOPE_CLI or build build/)")
-    return str(path)
-
-
-def cli_json(*args):
-    proc = subprocess.run([_cli(), *map(str, args), "--json"], capture_output=True, text=True,
-                          timeout=600)
-    assert proc.returncode == 0, f"exit {proc.returncode}: {proc.stderr}"
-    return json.loads(proc.stdout)
+from conftest import CURET_DIR, cli_json, cli_path, needs_curet
 
 
 def assert_same(cli, py, path="$"):
@@ -181,12 +165,6 @@ def test_curet_table(tmp_path):
                 curet.compare_table(path, pair=[1, 2], series=True))
 
 
-needs_curet = pytest.mark.skipif(
-    not (CURET_DIR / "abrdf.dat").is_file(),
-    reason=f"CUReT data not found at {CURET_DIR} (abrdf.dat, table.txt); not part of the repo",
-)
-
-
 @needs_curet
 @pytest.mark.parametrize("sample, cli_args, kwargs", [
     (25, ["--no-fits"], dict(fits=False, series=False)),
@@ -215,7 +193,7 @@ def test_paper_tables_bad_reference_fails_in_both(paper_tables, tmp_path):
     broken = {k: v for k, v in paper_tables.items() if k != "table2_very_rough"}
     ref = tmp_path / "broken.json"
     ref.write_text(json.dumps(broken), encoding="utf-8")
-    proc = subprocess.run([_cli(), "paper", "tables", "--reference", str(ref)],
+    proc = subprocess.run([cli_path(), "paper", "tables", "--reference", str(ref)],
                           capture_output=True, text=True, timeout=60)
     assert proc.returncode == 4 and "missing key 'table2_very_rough'" in proc.stderr
     with pytest.raises(rs.DataError, match="missing key 'table2_very_rough'"):

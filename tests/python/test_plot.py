@@ -3,10 +3,8 @@ CLI's `roughscope curet --plot`, which pipes the comparison into it: success pat
 whose Python message reaches the user as one `roughscope: error: ...` line."""
 
 import json
-import os
 import subprocess
 import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -14,16 +12,9 @@ import pytest
 import roughscope as rs
 from roughscope import curet, plot
 
-REPO = Path(__file__).resolve().parents[2]
+from conftest import cli_path
+
 PNG = b"\x89PNG\r\n\x1a\n"
-
-
-def _cli():
-    env = os.environ.get("ROUGHSCOPE_CLI")
-    path = Path(env) if env else REPO / "build" / "bin" / "roughscope"
-    if not path.is_file():
-        pytest.fail(f"roughscope CLI not found at {path} (set ROUGHSCOPE_CLI or build build/)")
-    return str(path)
 
 
 @pytest.fixture(scope="module")
@@ -82,7 +73,7 @@ def test_function_raises(table, tmp_path):
 
 
 def _cli_plot(table, out, env=None):
-    return subprocess.run([_cli(), "curet", "--table", str(table), "--pair", "1,2", "--no-fits",
+    return subprocess.run([cli_path(), "curet", "--table", str(table), "--pair", "1,2", "--no-fits",
                            "--plot", str(out)], capture_output=True, text=True, env=env,
                           timeout=300)
 
