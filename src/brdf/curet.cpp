@@ -227,7 +227,7 @@ fs::path find_curet_directory(const std::optional<fs::path>& explicit_dir) {
     // ../shared/data/curet from the current directory upward.
     if (auto located = io::curet_data_dir()) return *located;
     if (const char* env = std::getenv("ROUGHSCOPE_CURET"); env && *env) {
-        const fs::path dir(env);
+        fs::path dir(env);
         if (!has_curet_files(dir))
             throw DataError("ROUGHSCOPE_CURET = " + dir.string() + " does not hold " +
                             kNeededFiles + "; get them from " + kWhereFrom);

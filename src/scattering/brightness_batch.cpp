@@ -50,6 +50,8 @@ void apply_generic(MathFn fn, const double* x, double* y, Index n) {
 // glibc's libmvec (linked through libm): AVX2 4-lane and AVX-512 8-lane exp, ≤ 4 ulp.
 #pragma GCC push_options
 #pragma GCC target("avx2,fma")
+// The name is fixed by the x86-64 vector function ABI that libmvec implements.
+// NOLINTNEXTLINE(bugprone-reserved-identifier,readability-identifier-naming)
 extern "C" __m256d _ZGVdN4v_exp(__m256d);
 // x^(−3/2) = 1/(x √x), IEEE sqrt and division.
 __m256d inv_pow32_avx2(__m256d x) {
@@ -80,6 +82,8 @@ void apply_avx2(MathFn fn, const double* x, double* y, Index n) {
 
 #pragma GCC push_options
 #pragma GCC target("avx512f")
+// The name is fixed by the x86-64 vector function ABI that libmvec implements.
+// NOLINTNEXTLINE(bugprone-reserved-identifier,readability-identifier-naming)
 extern "C" __m512d _ZGVeN8v_exp(__m512d);
 // x^(−3/2) without the divider (its sqrt + div cost ~10% of the Eq. 5 kernel): y ≈ 1/√x from
 // vrsqrt14pd (relative error < 2^−14), two Newton steps y += y (1 − x y²)/2 (error ~1.5 e² each,
@@ -156,20 +160,20 @@ constexpr Index kBlock = 512;
 
 template <AngleUnit U>
 struct Unit {
-    static constexpr bool deg = U == AngleUnit::Degrees;
-    static constexpr double kToRad = deg ? kPi / 180.0 : 1.0;
-    static constexpr const char* kThetaI = deg ? "theta_i_deg" : "theta_i";
-    static constexpr const char* kThetaS = deg ? "theta_s_deg" : "theta_s";
-    static constexpr const char* kPhiS = deg ? "phi_s_deg" : "phi_s";
+    static constexpr bool kDegrees = U == AngleUnit::Degrees;
+    static constexpr double kToRad = kDegrees ? kPi / 180.0 : 1.0;
+    static constexpr const char* kThetaI = kDegrees ? "theta_i_deg" : "theta_i";
+    static constexpr const char* kThetaS = kDegrees ? "theta_s_deg" : "theta_s";
+    static constexpr const char* kPhiS = kDegrees ? "phi_s_deg" : "phi_s";
     // One turn = kTurn1 + kTurn2 (Cody–Waite; kTurn1 · k exact for |k| < 2^20).
     // Degrees: 360 exactly. Radians: 4 × fdlibm's pio2_1, pio2_1t (33 + 53 bits of 2π).
-    static constexpr double kTurn1 = deg ? 360.0 : 6.28318530693650245667e+00;
-    static constexpr double kTurn2 = deg ? 0.0 : 2.43084020260247689973e-10;
-    static constexpr double kInvTurn = deg ? 1.0 / 360.0 : 1.0 / (2.0 * kPi);
+    static constexpr double kTurn1 = kDegrees ? 360.0 : 6.28318530693650245667e+00;
+    static constexpr double kTurn2 = kDegrees ? 0.0 : 2.43084020260247689973e-10;
+    static constexpr double kInvTurn = kDegrees ? 1.0 / 360.0 : 1.0 / (2.0 * kPi);
     // |φs| below this: the reduction above is exact (degrees) or within ~1e-16 rad (radians).
-    static constexpr double kWide = deg ? 0x1p44 : 0x1p22;
-    static constexpr double kHalfToRad = deg ? kPi / 360.0 : 0.5;  // φ/2 in radians
-    static constexpr double kTurn = deg ? 360.0 : 2.0 * kPi;       // for std::fmod beyond kWide
+    static constexpr double kWide = kDegrees ? 0x1p44 : 0x1p22;
+    static constexpr double kHalfToRad = kDegrees ? kPi / 360.0 : 0.5;  // φ/2 in radians
+    static constexpr double kTurn = kDegrees ? 360.0 : 2.0 * kPi;  // for std::fmod beyond kWide
 };
 
 // Finds the first bad element of [begin, end) and throws the library's error for it (called only
@@ -200,21 +204,21 @@ void validate(const Inputs& in, Index begin, Index end, Index& at) {
 // sin x and cos x for |x| <= π/4 (fdlibm's __kernel_sin / __kernel_cos minimax polynomials, ~1
 // ulp).
 [[gnu::always_inline]] inline double kernel_sin(double x) {
-    constexpr double S1 = -1.66666666666666324348e-01, S2 = 8.33333333332248946124e-03,
-                     S3 = -1.98412698298579493134e-04, S4 = 2.75573137070700676789e-06,
-                     S5 = -2.50507602534068634195e-08, S6 = 1.58969099521155010221e-10;
+    constexpr double kS1 = -1.66666666666666324348e-01, kS2 = 8.33333333332248946124e-03,
+                     kS3 = -1.98412698298579493134e-04, kS4 = 2.75573137070700676789e-06,
+                     kS5 = -2.50507602534068634195e-08, kS6 = 1.58969099521155010221e-10;
     const double z = x * x;
-    const double r = S2 + z * (S3 + z * (S4 + z * (S5 + z * S6)));
-    return x + (z * x) * (S1 + z * r);
+    const double r = kS2 + z * (kS3 + z * (kS4 + z * (kS5 + z * kS6)));
+    return x + (z * x) * (kS1 + z * r);
 }
 [[gnu::always_inline]] inline double kernel_cos(double x) {
-    constexpr double C1 = 4.16666666666666019037e-02, C2 = -1.38888888888741095749e-03,
-                     C3 = 2.48015872894767294178e-05, C4 = -2.75573143513906633035e-07,
-                     C5 = 2.08757232129817482790e-09, C6 = -1.13596475577881948265e-11;
+    constexpr double kC1 = 4.16666666666666019037e-02, kC2 = -1.38888888888741095749e-03,
+                     kC3 = 2.48015872894767294178e-05, kC4 = -2.75573143513906633035e-07,
+                     kC5 = 2.08757232129817482790e-09, kC6 = -1.13596475577881948265e-11;
     const double z = x * x;
-    // 1 + z q with q = −1/2 + z (C1 + ...): the last step (an FMA where the ISA has one) adds
+    // 1 + z q with q = −1/2 + z (kC1 + ...): the last step (an FMA where the ISA has one) adds
     // |z q| <= 0.31 to 1, so the result (>= 0.7) is within ~1 ulp.
-    const double q = -0.5 + z * (C1 + z * (C2 + z * (C3 + z * (C4 + z * (C5 + z * C6)))));
+    const double q = -0.5 + z * (kC1 + z * (kC2 + z * (kC3 + z * (kC4 + z * (kC5 + z * kC6)))));
     return 1.0 + z * q;
 }
 // c ? a : b for doubles as a bitwise select: both sides are evaluated, so GCC cannot sink them
