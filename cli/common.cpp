@@ -7,6 +7,8 @@
 #include <exception>
 #include <iostream>
 
+#include "roughscope/core/text.hpp"
+
 namespace roughscope::cli {
 
 namespace {
@@ -19,15 +21,6 @@ std::string one_line(std::string_view message) {
         if (c == '\n' || c == '\r') c = ' ';
     }
     return s;
-}
-
-std::string join(const std::vector<std::string>& items, std::string_view sep) {
-    std::string out;
-    for (std::size_t i = 0; i < items.size(); ++i) {
-        if (i) out += sep;
-        out += items[i];
-    }
-    return out;
 }
 
 // Shortest form of a limit for messages ("90", "0.5").

@@ -7,6 +7,7 @@
 #include "roughscope/core/errors.hpp"
 #include "roughscope/core/names.hpp"
 #include "roughscope/core/numbers.hpp"
+#include "roughscope/core/text.hpp"
 
 // io: the CSV reader, atomic output files, the reference-data locator
 #include "roughscope/io/csv.hpp"

@@ -645,13 +645,18 @@ double profiled_sse(const LeastSquaresProblem& problem, std::span<const double> 
     return sse;
 }
 
-const FitParameter& LeastSquaresResult::parameter(std::string_view name) const {
+const FitParameter& find_parameter(const std::vector<FitParameter>& parameters,
+                                   std::string_view name) {
     for (const auto& p : parameters)
         if (p.name == name) return p;
     std::string names;
     for (const auto& p : parameters) names += (names.empty() ? "" : ", ") + p.name;
     throw InvalidArgument("fit parameter '" + std::string(name) +
                           "' does not exist; have: " + names);
+}
+
+const FitParameter& LeastSquaresResult::parameter(std::string_view name) const {
+    return find_parameter(parameters, name);
 }
 
 std::string LeastSquaresResult::brief_report() const {

@@ -263,12 +263,7 @@ double fit_model_brightness(const Geometry& geom, const std::vector<double>& par
 }
 
 const FitParameter& FitResult::parameter(std::string_view name) const {
-    for (const auto& p : parameters)
-        if (p.name == name) return p;
-    std::string names;
-    for (const auto& p : parameters) names += (names.empty() ? "" : ", ") + p.name;
-    throw InvalidArgument("fit parameter '" + std::string(name) +
-                          "' does not exist; have: " + names);
+    return find_parameter(parameters, name);
 }
 
 std::string FitResult::brief_report() const {

@@ -11,18 +11,10 @@
 
 #include "roughscope/core/errors.hpp"
 #include "roughscope/core/numbers.hpp"
+#include "roughscope/core/text.hpp"
 
 namespace roughscope::io {
 namespace {
-
-std::string join(const std::vector<std::string>& items, std::string_view sep) {
-    std::string out;
-    for (std::size_t i = 0; i < items.size(); ++i) {
-        if (i) out += sep;
-        out += items[i];
-    }
-    return out;
-}
 
 bool is_space(char c) {
     return c == ' ' || c == '\t' || c == '\r' || c == '\n' || c == '\v' || c == '\f';

@@ -88,19 +88,35 @@ void add_slope_checks(Json& out, const Json& row, const std::string& where, doub
         });
 }
 
-Json table1(const Json& reference, const std::string& where) {
-    const std::string w = where + ": table1_slightly_rough";
-    const Json& t = need(reference, "table1_slightly_rough", where);
+// What every printed table has: its conditions and the incidence angles θ1, θ2 of its ratio.
+struct PrintedTable {
+    std::string where;  // "<file>: <key>", for messages
+    const Json& table;
+    const Json& conditions;
+    double theta1_rad;
+    double theta2_rad;
+};
+
+PrintedTable open_table(const Json& reference, const char* key, const std::string& where) {
+    std::string w = where + ": " + key;
+    const Json& t = need(reference, key, where);
     const Json& cond = need(t, "conditions", w);
-    const double theta_rad = deg_to_rad(num_at(cond, "specular_theta_deg", w));
     const double theta1_rad = deg_to_rad(num_at(cond, "theta1_deg", w));
     const double theta2_rad = deg_to_rad(num_at(cond, "theta2_deg", w));
-    const double wavelength_um = num_at(cond, "lambda_um", w);
+    return {std::move(w), t, cond, theta1_rad, theta2_rad};
+}
+
+Json table1(const Json& reference, const std::string& where) {
+    const PrintedTable t = open_table(reference, "table1_slightly_rough", where);
+    const std::string& w = t.where;
+    const double theta_rad = deg_to_rad(num_at(t.conditions, "specular_theta_deg", w));
+    const double theta1_rad = t.theta1_rad, theta2_rad = t.theta2_rad;
+    const double wavelength_um = num_at(t.conditions, "lambda_um", w);
     const auto T_of = [&](const Inputs& x) {  // x = {σ, E1/E2}: Eq. 15
         return correlation_length_from_ratio(x[1], x[0], theta1_rad, theta2_rad, wavelength_um);
     };
     Json rows = Json::array();
-    for (const Json& row : rows_of(t, w)) {
+    for (const Json& row : rows_of(t.table, w)) {
         const std::string wr = w + " row";
         const double R_spec = num_at(row, "R_spec", wr);
         const double sigma_um = num_at(row, "sigma_um", wr);
@@ -116,17 +132,15 @@ Json table1(const Json& reference, const std::string& where) {
                                   [&](const Inputs& x) { return x[0] / T_of(x); });
         rows.push_back(std::move(r));
     }
-    return {{"conditions", cond}, {"rows", rows}};
+    return {{"conditions", t.conditions}, {"rows", rows}};
 }
 
 Json table2(const Json& reference, const std::string& where) {
-    const std::string w = where + ": table2_very_rough";
-    const Json& t = need(reference, "table2_very_rough", where);
-    const Json& cond = need(t, "conditions", w);
-    const double theta1_rad = deg_to_rad(num_at(cond, "theta1_deg", w));
-    const double theta2_rad = deg_to_rad(num_at(cond, "theta2_deg", w));
+    const PrintedTable t = open_table(reference, "table2_very_rough", where);
+    const std::string& w = t.where;
+    const double theta1_rad = t.theta1_rad, theta2_rad = t.theta2_rad;
     Json rows = Json::array();
-    for (const Json& row : rows_of(t, w)) {
+    for (const Json& row : rows_of(t.table, w)) {
         const std::string wr = w + " row";
         const double ratio = num_at(row, "E1_over_E2", wr);
         Json r = {{"surface", text_at(row, "surface", wr)}, {"E1_over_E2", number(ratio)}};
@@ -140,17 +154,15 @@ Json table2(const Json& reference, const std::string& where) {
                                   [](const Inputs& x) { return 100.0 * caron_xi_K(x[0]); });
         rows.push_back(std::move(r));
     }
-    return {{"conditions", cond}, {"rows", rows}};
+    return {{"conditions", t.conditions}, {"rows", rows}};
 }
 
 Json table3(const Json& reference, const std::string& where) {
-    const std::string w = where + ": table3_curet_parameters";
-    const Json& t = need(reference, "table3_curet_parameters", where);
-    const Json& cond = need(t, "conditions", w);
-    const double theta1_rad = deg_to_rad(num_at(cond, "theta1_deg", w));
-    const double theta2_rad = deg_to_rad(num_at(cond, "theta2_deg", w));
+    const PrintedTable t = open_table(reference, "table3_curet_parameters", where);
+    const std::string& w = t.where;
+    const double theta1_rad = t.theta1_rad, theta2_rad = t.theta2_rad;
     Json rows = Json::array();
-    for (const Json& row : rows_of(t, w)) {
+    for (const Json& row : rows_of(t.table, w)) {
         const std::string wr = w + " row";
         const double ratio = num_at(row, "E1_over_E2", wr);
         std::string name = text_at(row, "name", wr);
@@ -163,7 +175,7 @@ Json table3(const Json& reference, const std::string& where) {
         add_slope_checks(r, row, wr, ratio, 6, theta1_rad, theta2_rad);
         rows.push_back(std::move(r));
     }
-    return {{"conditions", cond}, {"rows", rows}};
+    return {{"conditions", t.conditions}, {"rows", rows}};
 }
 
 }  // namespace

@@ -133,6 +133,10 @@ struct FitParameter {
     bool at_bound = false;  // the solution sits on a bound: its std_error is not meaningful
 };
 
+// The parameter called `name`; throws InvalidArgument listing the names there are.
+const FitParameter& find_parameter(const std::vector<FitParameter>& parameters,
+                                   std::string_view name);
+
 struct LeastSquaresResult {
     SolverStatus status = SolverStatus::Failed;
     std::string message;                        // Ceres' termination message and the engine's notes
