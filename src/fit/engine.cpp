@@ -659,19 +659,26 @@ const FitParameter& LeastSquaresResult::parameter(std::string_view name) const {
     return find_parameter(parameters, name);
 }
 
-std::string LeastSquaresResult::brief_report() const {
-    std::string s = "roughscope least squares: " + std::string(to_string(status)) + " after " +
-                    std::to_string(iterations) + " iterations (" + std::to_string(evaluations) +
-                    " model evaluations); N = " + std::to_string(num_data) +
-                    ", p = " + std::to_string(num_parameters) + ";";
+std::string brief_report_tail(const std::vector<FitParameter>& parameters,
+                              bool covariance_available, double sse, double aic,
+                              const std::string& message) {
+    std::string s;
     for (const auto& p : parameters) {
         s += " " + p.name + " = " + format_message(p.value, 6);
         if (covariance_available && !p.at_bound) s += " +/- " + format_message(p.std_error, 3);
         if (p.at_bound) s += " (at bound)";
         s += ";";
     }
-    s += " SSE = " + format_message(sse, 6) + ", AIC = " + format_message(aic, 6) + ". " + message;
-    return s;
+    return s + " SSE = " + format_message(sse, 6) + ", AIC = " + format_message(aic, 6) + ". " +
+           message;
+}
+
+std::string LeastSquaresResult::brief_report() const {
+    std::string s = "roughscope least squares: " + std::string(to_string(status)) + " after " +
+                    std::to_string(iterations) + " iterations (" + std::to_string(evaluations) +
+                    " model evaluations); N = " + std::to_string(num_data) +
+                    ", p = " + std::to_string(num_parameters) + ";";
+    return s + brief_report_tail(parameters, covariance_available, sse, aic, message);
 }
 
 LeastSquaresResult solve_least_squares(const LeastSquaresProblem& P, const LeastSquaresOptions& O) {

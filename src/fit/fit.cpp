@@ -275,14 +275,7 @@ std::string FitResult::brief_report() const {
         std::string(to_string(options.loss)) + "): " + std::string(to_string(status)) + " after " +
         std::to_string(iterations) + " iterations; N = " + std::to_string(num_measurements) +
         ", p = " + std::to_string(num_parameters) + ";";
-    for (const auto& p : parameters) {
-        s += " " + p.name + " = " + format_message(p.value, 6);
-        if (covariance_available && !p.at_bound) s += " +/- " + format_message(p.std_error, 3);
-        if (p.at_bound) s += " (at bound)";
-        s += ";";
-    }
-    s += " SSE = " + format_message(sse, 6) + ", AIC = " + format_message(aic, 6) + ". " + message;
-    return s;
+    return s + brief_report_tail(parameters, covariance_available, sse, aic, message);
 }
 
 FitResult fit_roughness(const std::vector<Measurement>& measurements, const FitOptions& options) {

@@ -133,6 +133,12 @@ struct FitParameter {
     bool at_bound = false;  // the solution sits on a bound: its std_error is not meaningful
 };
 
+// The end of a brief report: " name = value +/- std_error; ...; SSE = ..., AIC = .... message"
+// (std_error only when the covariance is available and the parameter is not on a bound).
+std::string brief_report_tail(const std::vector<FitParameter>& parameters,
+                              bool covariance_available, double sse, double aic,
+                              const std::string& message);
+
 // The parameter called `name`; throws InvalidArgument listing the names there are.
 const FitParameter& find_parameter(const std::vector<FitParameter>& parameters,
                                    std::string_view name);
