@@ -28,7 +28,7 @@ ASAN_CONFIGURE_FLAGS = -G Ninja \
 	-DROUGHSCOPE_BUILD_PYTHON=OFF \
 	-DROUGHSCOPE_BUILD_BENCH=OFF \
 	-DROUGHSCOPE_SANITIZE=ON \
-	-DROUGHSCOPE_WERROR=$(ROUGHSCOPE_WERROR)
+	-DROUGHSCOPE_WERROR=OFF
 
 .PHONY: all deps configure build test demo sanitize bench lint format clean
 
@@ -51,7 +51,8 @@ demo: build
 		$(PYTHON) -m roughscope.report --out $(REPORT_DIR)
 	@echo "Report: $(REPORT_DIR)/index.html"
 
-# C++ tests only (ctest label "cpp"), under AddressSanitizer + UBSan.
+# C++ tests only (ctest label "cpp"), under AddressSanitizer + UBSan. Warnings are not errors
+# here: GCC's flow warnings give false positives under -fsanitize (the Release build has -Werror).
 sanitize: deps
 	$(CMAKE) -S . -B $(ASAN_BUILD) $(ASAN_CONFIGURE_FLAGS)
 	$(CMAKE) --build $(ASAN_BUILD) -j $(JOBS) --target roughscope_tests
