@@ -55,7 +55,7 @@ demo: build
 # here: GCC's flow warnings give false positives under -fsanitize (the Release build has -Werror).
 sanitize: deps
 	$(CMAKE) -S . -B $(ASAN_BUILD) $(ASAN_CONFIGURE_FLAGS)
-	$(CMAKE) --build $(ASAN_BUILD) -j $(JOBS) --target roughscope_tests
+	$(CMAKE) --build $(ASAN_BUILD) -j $(JOBS)
 	ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
 		$(CTEST) --test-dir $(ASAN_BUILD) --output-on-failure -j $(JOBS) -L '^cpp$$' --no-tests=error
 
