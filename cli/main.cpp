@@ -19,6 +19,9 @@ int main(int argc, char** argv) {
     // Errors are printed by run_app as one line; never dump the whole help on failure.
     app.failure_message(CLI::FailureMessage::simple);
 
+    // Ctrl-C or SIGTERM during a long write removes the pending temporary output files.
+    roughscope::io::install_output_cleanup_handlers();
+
     roughscope::cli::register_model(app);
     roughscope::cli::register_estimate(app);
     roughscope::cli::register_paper(app);
