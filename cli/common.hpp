@@ -4,7 +4,8 @@
 //  * Angles are given and printed in degrees, lengths in micrometres.
 //  * Every failure prints exactly ONE line `roughscope: error: <message>` on stderr and exits with
 //    a code from ExitCode below. Results are never printed as NaN/inf (format_result and
-//    finite_number throw instead); outputs are written atomically (write_file_atomic).
+//    finite_number throw instead); every output goes through io::OutputFile (atomic replace of
+//    regular files, written through symlinks, direct to devices/FIFOs/stdout).
 //  * Subcommand callbacks report errors by throwing: roughscope::InvalidArgument (or
 //    cli::UsageError) for bad input, roughscope::NoSolution, roughscope::DataError for files.
 #pragma once
@@ -115,15 +116,20 @@ std::string dump_json(const json& value);
 // Files
 
 // The library's writers and CSV reader (roughscope/io/output_file.hpp, roughscope/io/csv.hpp):
-//  * write_file_atomic(path, content): temporary file in the same directory, renamed over `path`;
-//    DataError("cannot write <path>: <reason>") and nothing left behind on failure;
-//  * write_output(path or nullopt, content): atomically to the file, else to stdout;
-//  * read_csv_with_header(path, required, optional): every row of a CSV file with a header
-//    (comments, blank lines, CRLF, UTF-8 BOM accepted; strict numbers; DataError
-//    "<file>:<line>: <reason>" naming the column);
+//  * OutputFile / open_output(path or nullopt): the streaming sink (write chunks, then commit;
+//    destroyed without commit = nothing changed). A regular file is replaced atomically (temporary
+//    file + rename, mode kept), a symlink is written through, a device, FIFO or "-" directly; a
+//    file the user may not write is a DataError. DataError("cannot write <path>: <reason>");
+//  * write_file_atomic(path, content), write_output(path or nullopt, content): the same for a
+//    whole content at once (stdout when no path);
+//  * io::CsvReader: streams the rows of a CSV file with a header (comments, blank lines, CRLF,
+//    UTF-8 BOM accepted; strict numbers; DataError "<file>:<line>: <reason>" naming the column);
+//    read_csv_with_header(path, required, optional) reads every row at once (small files only);
 //  * csv_field(text): quotes a field only if it contains a comma, quote or line break.
 using roughscope::io::csv_field;
 using roughscope::io::CsvRow;
+using roughscope::io::open_output;
+using roughscope::io::OutputFile;
 using roughscope::io::write_file_atomic;
 using roughscope::io::write_output;
 inline std::vector<CsvRow> read_csv_with_header(const std::filesystem::path& path,

@@ -8,12 +8,15 @@
 // Angles in degrees, lengths in µm. See docs/estimation.md and docs/cli.md. The JSON documents
 // are built by the library (roughscope/serialize/estimation.hpp), the same as the Python
 // module's dicts; this file parses flags, calls the estimators and prints.
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <memory>
 #include <optional>
 #include <sstream>
 #include <string>
+#include <system_error>
 #include <vector>
 
 #include "commands.hpp"
@@ -326,39 +329,68 @@ struct FitArgs {
 };
 
 // Reads theta_i, phi_i, theta_s, phi_s, brightness[, weight] (degrees); errors name file:line.
+// An upper bound of the data rows of a measurements file: its line count, and at most one row per
+// 10 bytes (the shortest row, "0,0,0,0,1\n"). 0 if it cannot be read (the reader reports that).
+std::size_t max_rows(const std::filesystem::path& path) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) return 0;
+    std::error_code ec;
+    const auto size = std::filesystem::file_size(path, ec);
+    if (ec) return 0;
+    std::vector<char> buffer(std::size_t{1} << 16);
+    std::size_t lines = 1;
+    while (in) {
+        in.read(buffer.data(), static_cast<std::streamsize>(buffer.size()));
+        const auto n = static_cast<std::size_t>(in.gcount());
+        lines += static_cast<std::size_t>(std::count(buffer.begin(), buffer.begin() + n, '\n'));
+        if (n == 0) break;
+    }
+    return std::min<std::size_t>(lines, static_cast<std::size_t>(size / 10 + 1));
+}
+
+// Streamed row by row: only the measurements are kept, not the rows.
 std::vector<Measurement> read_measurements(const std::filesystem::path& path) {
-    const auto rows = read_csv_with_header(
-        path, {"theta_i", "phi_i", "theta_s", "phi_s", "brightness"}, {"weight"});
+    io::CsvReader reader(path, {"theta_i", "phi_i", "theta_s", "phi_s", "brightness"}, {"weight"});
+    const std::size_t c_ti = *reader.column_index("theta_i");
+    const std::size_t c_pi = *reader.column_index("phi_i");
+    const std::size_t c_ts = *reader.column_index("theta_s");
+    const std::size_t c_ps = *reader.column_index("phi_s");
+    const std::size_t c_b = *reader.column_index("brightness");
+    const std::optional<std::size_t> c_w = reader.column_index("weight");
     std::vector<Measurement> ms;
-    ms.reserve(rows.size());
-    for (const auto& row : rows) {
-        const std::string where = path.string() + ":" + std::to_string(row.line) + ": ";
+    ms.reserve(max_rows(path));  // one allocation, no slack
+    CsvRow row;
+    while (reader.next(row)) {
         try {
-            for (const char* col : {"theta_i", "theta_s"}) {
-                const double v = row.at(col);
+            for (const auto& [c, col] : {std::pair{c_ti, "theta_i"}, {c_ts, "theta_s"}}) {
+                const double v = *row.value(c);
                 if (!(v >= 0.0 && v < 90.0))
                     throw roughscope::InvalidArgument(
                         "column '" + std::string(col) + "': " + format_result(v, col) +
                         " is outside the valid range [0, 90) degrees");
             }
-            const double b = row.at("brightness");
+            const double b = *row.value(c_b);
             if (!(b > 0.0))
                 throw roughscope::InvalidArgument("column 'brightness': " + format_result(b) +
                                                   " must be > 0");
-            const double w = row.find("weight").value_or(1.0);
+            const double w = c_w ? row.value(*c_w).value_or(1.0) : 1.0;
             if (!(w > 0.0))
                 throw roughscope::InvalidArgument("column 'weight': " + format_result(w) +
                                                   " must be > 0");
             const Geometry g = geometry_from_two_azimuths(
-                deg_to_rad(row.at("theta_i")), deg_to_rad(row.at("phi_i")),
-                deg_to_rad(row.at("theta_s")), deg_to_rad(row.at("phi_s")));
+                deg_to_rad(*row.value(c_ti)), deg_to_rad(*row.value(c_pi)),
+                deg_to_rad(*row.value(c_ts)), deg_to_rad(*row.value(c_ps)));
             ms.push_back({g, b, w});
         } catch (const roughscope::DataError&) {
             throw;
         } catch (const roughscope::InvalidArgument& e) {
-            throw roughscope::DataError(where + e.what());
+            std::string where = path.string();
+            where.append(":").append(std::to_string(row.line)).append(": ").append(e.what());
+            throw roughscope::DataError(where);
         }
     }
+    if (ms.empty())
+        throw roughscope::DataError(reader.source() + ": no data rows after the header");
     return ms;
 }
 

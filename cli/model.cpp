@@ -437,26 +437,72 @@ std::string human_text(const json& record) {
     return os.str();
 }
 
-std::string csv_text(const std::vector<json>& records) {
+// CSV header line: the keys of a record.
+std::string csv_header(const json& record) {
     std::string out;
     bool first = true;
-    for (const auto& [key, value] : records.front().items()) {
+    for (const auto& [key, value] : record.items()) {
         if (!first) out += ',';
         out += csv_field(key);
         first = false;
     }
     out += '\n';
-    for (const auto& rec : records) {
-        first = true;
-        for (const auto& [key, value] : rec.items()) {
-            if (!first) out += ',';
-            out += csv_field(cell_text(value));
-            first = false;
-        }
-        out += '\n';
-    }
     return out;
 }
+
+// One CSV line: the values of a record.
+void append_csv_line(std::string& out, const json& record) {
+    bool first = true;
+    for (const auto& [key, value] : record.items()) {
+        if (!first) out += ',';
+        out += csv_field(cell_text(value));
+        first = false;
+    }
+    out += '\n';
+}
+
+std::string csv_text(const json& record) {
+    std::string out = csv_header(record);
+    append_csv_line(out, record);
+    return out;
+}
+
+// Writes the records of `model --csv` one at a time: CSV (header from the first record) or a JSON
+// array byte-identical to serialize::dump of the whole array, without holding the records.
+class RecordWriter {
+  public:
+    RecordWriter(io::OutputFile& out, bool json_output) : out_(out), json_(json_output) {}
+
+    void add(json record) {
+        chunk_.clear();
+        if (json_) {
+            // The element as the whole array's dump indents it: "[\n" + element + "\n]\n".
+            json one = json::array();
+            one.push_back(std::move(record));
+            const std::string text = serialize::dump(one);
+            chunk_.append(count_ == 0 ? "[\n" : ",\n");
+            chunk_.append(text, 2, text.size() - 5);
+        } else {
+            if (count_ == 0) chunk_ = csv_header(record);
+            append_csv_line(chunk_, record);
+        }
+        out_.write(chunk_);
+        ++count_;
+    }
+
+    // Closes the array (JSON); the caller commits the output.
+    void finish() {
+        if (json_ && count_ > 0) out_.write("\n]\n");
+    }
+
+    std::size_t count() const { return count_; }
+
+  private:
+    io::OutputFile& out_;
+    bool json_;
+    std::size_t count_ = 0;
+    std::string chunk_;
+};
 
 Roughness roughness_from_flags(const Args& a) {
     Roughness r;
@@ -467,13 +513,14 @@ Roughness roughness_from_flags(const Args& a) {
 }
 
 // Per-row roughness: row columns override the flags (see docs/cli.md).
-Roughness roughness_for_row(const Args& a, const CsvRow& row, const std::string& where) {
+template <class Where>
+Roughness roughness_for_row(const Args& a, const CsvRow& row, const Where& where_of) {
     Roughness r = roughness_from_flags(a);
     const auto s = row.find("sigma_um");
     const auto t = row.find("T_um");
     const auto m = row.find("sigma_over_T");
     if (m && (s || t)) {
-        throw roughscope::DataError(where +
+        throw roughscope::DataError(where_of() +
                                     "give either sigma_um,T_um or sigma_over_T on a row, "
                                     "not both");
     }
@@ -486,23 +533,23 @@ Roughness roughness_for_row(const Args& a, const CsvRow& row, const std::string&
         if (t) r.T_um = *t;
     }
     if (r.sigma_um.has_value() != r.T_um.has_value()) {
-        throw roughscope::DataError(where + "missing " + (r.sigma_um ? "T_um" : "sigma_um") +
+        throw roughscope::DataError(where_of() + "missing " + (r.sigma_um ? "T_um" : "sigma_um") +
                                     ": the B-K model needs both sigma_um and T_um (column or "
                                     "--sigma/--T), or sigma_over_T");
     }
     if (!r.sigma_um && !r.sigma_over_T) {
-        throw roughscope::DataError(where +
+        throw roughscope::DataError(where_of() +
                                     "no roughness: give --sigma and --T or "
                                     "--sigma-over-T, or columns sigma_um,T_um or "
                                     "sigma_over_T");
     }
     if (r.sigma_over_T && !(*r.sigma_over_T > 0.0)) {
-        throw roughscope::DataError(
-            where + "column 'sigma_over_T': " + format_result(*r.sigma_over_T) + " must be > 0");
+        throw roughscope::DataError(where_of() + "column 'sigma_over_T': " +
+                                    format_result(*r.sigma_over_T) + " must be > 0");
     }
     for (auto [v, col] : {std::pair{r.sigma_um, "sigma_um"}, {r.T_um, "T_um"}}) {
         if (v && !(*v > 0.0)) {
-            throw roughscope::DataError(where + "column '" + std::string(col) +
+            throw roughscope::DataError(where_of() + "column '" + std::string(col) +
                                         "': " + format_result(*v) + " must be > 0 um");
         }
     }
@@ -524,7 +571,7 @@ void run_model(const Args& a) {
         if (a.json_output) {
             text = serialize::dump(record);
         } else if (output) {
-            text = csv_text({record});
+            text = csv_text(record);
         } else {
             text = human_text(record);
         }
@@ -532,14 +579,24 @@ void run_model(const Args& a) {
         return;
     }
 
+    // Streamed: one row read, evaluated and written at a time (memory independent of the number
+    // of rows). The output is committed only when every row succeeded.
     const std::filesystem::path csv_path(a.csv_path);
-    const auto rows = read_csv_with_header(csv_path, {"theta_i", "theta_s", "phi_s"},
-                                           {"sigma_um", "T_um", "sigma_over_T"});
-    std::vector<json> records;
-    records.reserve(rows.size());
-    for (const auto& row : rows) {
-        const std::string where = csv_path.string() + ":" + std::to_string(row.line) + ": ";
-        const double ti = row.at("theta_i"), ts = row.at("theta_s"), ps = row.at("phi_s");
+    io::CsvReader reader(csv_path, {"theta_i", "theta_s", "phi_s"},
+                         {"sigma_um", "T_um", "sigma_over_T"});
+    const std::size_t c_ti = *reader.column_index("theta_i");
+    const std::size_t c_ts = *reader.column_index("theta_s");
+    const std::size_t c_ps = *reader.column_index("phi_s");
+    io::OutputFile out = io::open_output(output);
+    RecordWriter writer(out, a.json_output);
+    CsvRow row;
+    while (reader.next(row)) {
+        const double ti = *row.value(c_ti), ts = *row.value(c_ts), ps = *row.value(c_ps);
+        const auto where = [&] {
+            std::string w = csv_path.string();
+            w.append(":").append(std::to_string(row.line)).append(": ");
+            return w;
+        };
         try {
             check_polar_deg(ti, "column 'theta_i'");
             check_polar_deg(ts, "column 'theta_s'");
@@ -547,16 +604,19 @@ void run_model(const Args& a) {
                 a.model == ModelKind::BK ? roughness_for_row(a, row, where) : Roughness{};
             const Point p =
                 point_from(make_geometry(deg_to_rad(ti), deg_to_rad(ts), deg_to_rad(ps)));
-            records.push_back(evaluate(a, p, r));
+            writer.add(evaluate(a, p, r));
         } catch (const UsageError&) {
             throw;  // about the flags, not the row
         } catch (const roughscope::DataError&) {
             throw;
         } catch (const roughscope::InvalidArgument& e) {
-            throw roughscope::DataError(where + e.what());
+            throw roughscope::DataError(where() + e.what());
         }
     }
-    write_output(output, a.json_output ? serialize::dump(json(records)) : csv_text(records));
+    if (writer.count() == 0)
+        throw roughscope::DataError(reader.source() + ": no data rows after the header");
+    writer.finish();
+    out.commit();
 }
 
 }  // namespace

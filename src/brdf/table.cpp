@@ -59,6 +59,8 @@ BrdfTable parse_brdf_csv(std::istream& in, std::string_view source_name,
     BrdfTable table;
     table.name = std::string(source_name);
     const bool has_channel = reader.has_column("channel");
+    // Without a measurement column the indices are the row numbers, distinct by construction.
+    const bool has_index = reader.has_column("measurement");
     std::set<int> seen_index;
     std::set<std::string> channels_seen;
     std::size_t data_rows = 0;
@@ -66,7 +68,7 @@ BrdfTable parse_brdf_csv(std::istream& in, std::string_view source_name,
     while (reader.next(row)) {
         ++data_rows;
         if (has_channel) {
-            const std::string& ch = row.text.at("channel");
+            const std::string& ch = row.text("channel");
             channels_seen.insert(ch);
             if (options.channel && ch != *options.channel) continue;
         }
@@ -75,11 +77,11 @@ BrdfTable parse_brdf_csv(std::istream& in, std::string_view source_name,
         if (const auto idx = row.find("measurement")) {
             if (*idx != std::floor(*idx) || *idx < 1 || *idx > 1e9)
                 fail(source_name, row.line,
-                     "column measurement: '" + row.text.at("measurement") +
+                     "column measurement: '" + row.text("measurement") +
                          "' is not a positive integer");
             index = static_cast<int>(*idx);
         }
-        if (!seen_index.insert(index).second)
+        if (has_index && !seen_index.insert(index).second)
             fail(source_name, row.line, "duplicate measurement " + std::to_string(index));
         try {
             table.measurements.push_back(

@@ -289,19 +289,19 @@ bool bounded_difference(F&& f, std::vector<double>& x, std::size_t j, double lo,
     const double xj = x[j];
     const double h = 1e-6 * std::max(1.0, std::abs(xj));
     double a = std::max(lo, xj - h), b = std::min(hi, xj + h);
-    std::vector<double> fa, fb;
+    // f(b) is evaluated into d itself (one residual vector less at a time: N can be 1e6).
+    std::vector<double> fa;
     x[j] = b;
-    const bool okb = b > xj && f(x.data(), fb);
+    const bool okb = b > xj && f(x.data(), d);
     x[j] = a;
     const bool oka = a < xj && f(x.data(), fa);
     x[j] = xj;
     if (!okb) b = xj;
     if (!oka) a = xj;
     if (!(b > a)) return false;
-    const std::vector<double>& up = okb ? fb : f0;
+    if (!okb) d = f0;
     const std::vector<double>& dn = oka ? fa : f0;
-    d.resize(f0.size());
-    for (std::size_t i = 0; i < f0.size(); ++i) d[i] = (up[i] - dn[i]) / (b - a);
+    for (std::size_t i = 0; i < f0.size(); ++i) d[i] = (d[i] - dn[i]) / (b - a);
     return true;
 }
 
@@ -328,7 +328,9 @@ class EngineCost final : public ceres::CostFunction {
             last_r_.assign(r, r + N);
         }
         if (J == nullptr || J[0] == nullptr) return true;
-        std::vector<double> xv(x[0], x[0] + size), r0(r, r + N), d;
+        // last_r_ holds the residuals r at x (no copy of N values).
+        const std::vector<double>& r0 = last_r_;
+        std::vector<double> xv(x[0], x[0] + size), d;
         auto f = [this, N](const double* xx, std::vector<double>& out) {
             out.resize(N);
             return e_.residuals(xx, e_.gain(), true, out.data());

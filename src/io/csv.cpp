@@ -86,17 +86,32 @@ std::string LineReader::where() const { return source_ + ":" + std::to_string(li
 // ---------------------------------------------------------------------------------------------
 // CsvRow, CsvReader
 
-double CsvRow::at(const std::string& column) const {
-    const auto it = values.find(column);
-    if (it == values.end())
-        throw DataError("line " + std::to_string(line) + ": column " + column + " has no value");
-    return it->second;
+std::optional<std::size_t> CsvRow::column(std::string_view name) const {
+    if (!columns) return std::nullopt;
+    const auto it = std::find(columns->begin(), columns->end(), name);
+    if (it == columns->end()) return std::nullopt;
+    return static_cast<std::size_t>(it - columns->begin());
 }
 
-std::optional<double> CsvRow::find(const std::string& column) const {
-    const auto it = values.find(column);
-    if (it == values.end()) return std::nullopt;
-    return it->second;
+double CsvRow::at(std::string_view column_name) const {
+    const auto c = column(column_name);
+    if (!c || !present[*c])
+        throw DataError("line " + std::to_string(line) + ": column " + std::string(column_name) +
+                        " has no value");
+    return numbers[*c];
+}
+
+std::optional<double> CsvRow::find(std::string_view column_name) const {
+    const auto c = column(column_name);
+    if (!c) return std::nullopt;
+    return value(*c);
+}
+
+const std::string& CsvRow::text(std::string_view column_name) const {
+    const auto c = column(column_name);
+    if (!c)
+        throw DataError("line " + std::to_string(line) + ": no column " + std::string(column_name));
+    return cells[*c];
 }
 
 CsvReader::CsvReader(const std::filesystem::path& path, std::vector<std::string> required,
@@ -113,8 +128,12 @@ CsvReader::CsvReader(std::istream& in, std::string source, std::vector<std::stri
     read_header();
 }
 
-bool CsvReader::has_column(std::string_view name) const {
-    return std::find(header_.begin(), header_.end(), name) != header_.end();
+bool CsvReader::has_column(std::string_view name) const { return column_index(name).has_value(); }
+
+std::optional<std::size_t> CsvReader::column_index(std::string_view name) const {
+    const auto it = std::find(header_.begin(), header_.end(), name);
+    if (it == header_.end()) return std::nullopt;
+    return static_cast<std::size_t>(it - header_.begin());
 }
 
 void CsvReader::read_header() {
@@ -148,6 +167,7 @@ void CsvReader::read_header() {
             else
                 kind_.push_back(0);
         }
+        shared_header_ = std::make_shared<const std::vector<std::string>>(header_);
         return;
     }
     throw DataError(lines_.source() + ": no header line (expected columns " +
@@ -159,17 +179,28 @@ bool CsvReader::next(CsvRow& row) {
     while (lines_.next(raw)) {
         const std::string_view line = trim(raw);
         if (line.empty() || line.front() == '#') continue;
-        const auto fields = split_fields(line, ',');
-        if (fields.size() != header_.size())
+        fields_.clear();
+        for (std::size_t start = 0;;) {
+            const auto comma = line.find(',', start);
+            if (comma == std::string_view::npos) {
+                fields_.push_back(line.substr(start));
+                break;
+            }
+            fields_.push_back(line.substr(start, comma - start));
+            start = comma + 1;
+        }
+        if (fields_.size() != header_.size())
             throw DataError(lines_.where() + "expected " + std::to_string(header_.size()) +
                             " fields (" + join(header_, ",") + "), found " +
-                            std::to_string(fields.size()));
+                            std::to_string(fields_.size()));
         row.line = lines_.line_number();
-        row.values.clear();
-        row.text.clear();
-        for (std::size_t c = 0; c < fields.size(); ++c) {
-            const std::string_view cell = trim(fields[c]);
-            row.text.emplace(header_[c], std::string(cell));
+        if (row.columns != shared_header_) row.columns = shared_header_;
+        row.cells.resize(header_.size());
+        row.numbers.assign(header_.size(), 0.0);
+        row.present.assign(header_.size(), 0);
+        for (std::size_t c = 0; c < fields_.size(); ++c) {
+            const std::string_view cell = trim(fields_[c]);
+            row.cells[c].assign(cell);
             if (kind_[c] == 0) continue;
             if (cell.empty() && kind_[c] == 2) continue;  // optional, not given on this row
             std::string reason;
@@ -177,7 +208,8 @@ bool CsvReader::next(CsvRow& row) {
             if (!value)
                 throw DataError(lines_.where() + "column " + header_[c] + ": '" +
                                 std::string(cell) + "' is " + reason);
-            row.values.emplace(header_[c], *value);
+            row.numbers[c] = *value;
+            row.present[c] = 1;
         }
         ++rows_;
         return true;

@@ -19,7 +19,6 @@
 #include <cstddef>
 #include <filesystem>
 #include <iosfwd>
-#include <map>
 #include <memory>
 #include <optional>
 #include <string>
@@ -74,13 +73,28 @@ class LineReader {
 // ---------------------------------------------------------------------------------------------
 // CSV with a header
 
-// One data row.
+// One data row, stored by column in header order (no per-row lookup structures: a row object is
+// reused by CsvReader::next without reallocating).
 struct CsvRow {
-    std::size_t line = 0;                        // 1-based line number in the file
-    std::map<std::string, double> values;        // parsed required + present optional columns
-    std::map<std::string, std::string> text;     // every column, trimmed, as written
-    double at(const std::string& column) const;  // a value; DataError "line N: ..." if absent
-    std::optional<double> find(const std::string& column) const;  // optional column
+    std::size_t line = 0;                                     // 1-based line number in the file
+    std::shared_ptr<const std::vector<std::string>> columns;  // the header (shared, not copied)
+    std::vector<std::string> cells;                           // every column, trimmed, as written
+    std::vector<double> numbers;                              // parsed value of each numeric column
+    std::vector<unsigned char> present;                       // 1 where numbers[c] holds a value
+
+    // Position of a column in the header, or std::nullopt.
+    std::optional<std::size_t> column(std::string_view name) const;
+    // A value: required column, or optional column given on this row; DataError "line N: ..."
+    // if absent.
+    double at(std::string_view column) const;
+    // An optional column's value, std::nullopt when absent or empty on this row.
+    std::optional<double> find(std::string_view column) const;
+    // The same by position (CsvReader::column_index), for loops over many rows.
+    std::optional<double> value(std::size_t column) const {
+        return present[column] ? std::optional<double>(numbers[column]) : std::nullopt;
+    }
+    // The trimmed text of a column; DataError "line N: no column <name>" if there is none.
+    const std::string& text(std::string_view column) const;
 };
 
 // Streams the rows of a CSV file (see the conventions above). The header is read by the
@@ -98,6 +112,8 @@ class CsvReader {
 
     const std::vector<std::string>& header() const { return header_; }
     bool has_column(std::string_view name) const;
+    // Position of a column in the header (for CsvRow::value), or std::nullopt.
+    std::optional<std::size_t> column_index(std::string_view name) const;
     const std::string& source() const { return lines_.source(); }
 
     // Reads the next data row into `row`; false at the end of the file. Throws DataError
@@ -112,7 +128,9 @@ class CsvReader {
 
     LineReader lines_;
     std::vector<std::string> required_, optional_, header_;
-    std::vector<int> kind_;  // per column: 0 = text only, 1 = required, 2 = optional
+    std::shared_ptr<const std::vector<std::string>> shared_header_;
+    std::vector<std::string_view> fields_;  // the fields of the current line (reused)
+    std::vector<int> kind_;                 // per column: 0 = text only, 1 = required, 2 = optional
     std::size_t rows_ = 0;
 };
 

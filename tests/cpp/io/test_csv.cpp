@@ -66,7 +66,7 @@ TEST(Csv, AcceptsBomCrlfCommentsAndBlankLines) {
     EXPECT_EQ(row.line, 4u);
     EXPECT_EQ(row.at("x"), 1.0);
     EXPECT_EQ(row.find("y"), 2.5);
-    EXPECT_EQ(row.text.at("label"), "a");
+    EXPECT_EQ(row.text("label"), "a");
     ASSERT_TRUE(reader.next(row));
     EXPECT_EQ(row.line, 6u);
     EXPECT_EQ(row.at("y"), 40.0);
