@@ -17,10 +17,17 @@ namespace {
                 " is not a finite number; refusing to print it");
 }
 
+// printf's "%.*g" in the C locale: std::to_chars with a precision is specified to give the
+// same characters, without printf's format parsing and multi-precision arithmetic.
 std::string printf_g(double value, int digits) {
     char buf[64];
-    std::snprintf(buf, sizeof buf, "%.*g", digits, value);
-    return buf;
+    const auto [end, ec] =
+        std::to_chars(buf, buf + sizeof buf, value, std::chars_format::general, digits);
+    if (ec != std::errc()) {
+        std::snprintf(buf, sizeof buf, "%.*g", digits, value);
+        return buf;
+    }
+    return std::string(buf, end);
 }
 
 }  // namespace
@@ -118,7 +125,11 @@ std::string format_message(double value, int digits) {
 
 double round_significant(double value, int digits) {
     if (!std::isfinite(value) || value == 0.0) return value;
-    return std::strtod(printf_g(value, digits).c_str(), nullptr);
+    const std::string text = printf_g(value, digits);
+    double rounded = value;
+    if (std::from_chars(text.data(), text.data() + text.size(), rounded).ec != std::errc())
+        return std::strtod(text.c_str(), nullptr);
+    return rounded;
 }
 
 }  // namespace roughscope

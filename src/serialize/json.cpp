@@ -1,9 +1,11 @@
 // JSON building blocks (serialize/json.hpp).
 #include "roughscope/serialize/json.hpp"
 
+#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <system_error>
 
 #include "roughscope/scattering/geometry.hpp"
 
@@ -18,8 +20,16 @@ Json degrees(double radians) {
     if (!std::isfinite(deg)) return nullptr;
     char buf[40];
     for (int digits = 1; digits <= 17; ++digits) {
-        std::snprintf(buf, sizeof buf, "%.*g", digits, deg);
-        const double candidate = std::strtod(buf, nullptr);
+        // "%.*g" and strtod, without printf's format parsing (to_chars with a precision gives
+        // printf's characters; from_chars rounds as strtod).
+        const auto printed =
+            std::to_chars(buf, buf + sizeof buf, deg, std::chars_format::general, digits);
+        double candidate = deg;
+        if (printed.ec != std::errc() ||
+            std::from_chars(buf, printed.ptr, candidate).ec != std::errc()) {
+            std::snprintf(buf, sizeof buf, "%.*g", digits, deg);
+            candidate = std::strtod(buf, nullptr);
+        }
         if (deg_to_rad(candidate) == radians) return candidate;
     }
     return deg;
