@@ -1,0 +1,147 @@
+// I/O benchmarks: the per-row cost of the streaming `roughscope model --csv` path (read a CSV
+// row, evaluate the B–K model of Eq. 1–5, format the record, write it through io::OutputFile)
+// against the pure computation of the same rows, timed in the same run.
+//
+//   build*/bin/roughscope_bench --benchmark_filter='io/'
+//
+// Names: io/model_compute/<rows>      mean_scattered_power at the rows' geometries (the baseline)
+//        io/model_csv/<format>/<rows> the CLI's `model --csv FILE --sigma 1 --T 2 [--json]
+//                                     --output FILE` run in-process on the same rows; counters:
+//                                     ns_per_row, and time_vs_compute = its per-row time over the
+//                                     baseline's (timed once before the runs, same clock)
+//        io/csv_read/<rows>           io::CsvReader alone over the same file (parsing only)
+// The rows cover θi, θs in [0, 80) degrees and φs in [0, 360) (σ = 1 µm, T = 2 µm, λ = 0.555 µm).
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include <benchmark/benchmark.h>
+
+#include "roughscope/core/numbers.hpp"
+#include "roughscope/io/csv.hpp"
+#include "roughscope/scattering/beckmann.hpp"
+#include "roughscope/scattering/geometry.hpp"
+
+#ifdef ROUGHSCOPE_BENCH_HAS_CLI
+#include <CLI/CLI.hpp>
+
+#include "commands.hpp"
+#endif
+
+namespace {
+
+using namespace roughscope;
+namespace fs = std::filesystem;
+
+constexpr std::size_t kRows = 20000;
+
+// The benchmark's input: a CSV file of kRows geometries (degrees) and the same geometries parsed.
+struct Rows {
+    fs::path dir, csv, output;
+    std::vector<Geometry> geometries;
+};
+
+const Rows& rows() {
+    static const Rows r = [] {
+        Rows out;
+        out.dir = fs::temp_directory_path() / "roughscope_bench_io";
+        fs::create_directories(out.dir);
+        out.csv = out.dir / "rows.csv";
+        out.output = out.dir / "out.txt";
+        std::ofstream f(out.csv, std::ios::binary);
+        f << "theta_i,theta_s,phi_s\n";
+        for (std::size_t k = 0; k < kRows; ++k) {
+            const double ti = static_cast<double>(k * 7 % 800) / 10.0;
+            const double ts = static_cast<double>(k * 13 % 800) / 10.0;
+            const double ps = static_cast<double>(k * 17 % 3600) / 10.0;
+            f << ti << ',' << ts << ',' << ps << '\n';
+            out.geometries.push_back(make_geometry(deg_to_rad(ti), deg_to_rad(ts), deg_to_rad(ps)));
+        }
+        return out;
+    }();
+    return r;
+}
+
+ModelOptions model_options() {
+    ModelOptions o;
+    o.wavelength_um = 0.555;
+    return o;
+}
+
+double compute_all(const std::vector<Geometry>& geometries) {
+    const Surface surface{1.0, 2.0, Correlation::Gaussian};
+    const ModelOptions options = model_options();
+    double sum = 0.0;
+    for (const Geometry& g : geometries) sum += mean_scattered_power(g, surface, options).total;
+    return sum;
+}
+
+void BM_model_compute(benchmark::State& state) {
+    const Rows& r = rows();
+    for (auto _ : state) benchmark::DoNotOptimize(compute_all(r.geometries));
+    state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(kRows));
+    state.counters["ns_per_row"] = benchmark::Counter(
+        static_cast<double>(kRows) * 1e-9,
+        benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
+}
+BENCHMARK(BM_model_compute)->Name("io/model_compute/20000")->Unit(benchmark::kMillisecond);
+
+void BM_csv_read(benchmark::State& state) {
+    const Rows& r = rows();
+    for (auto _ : state) {
+        io::CsvReader reader(r.csv, {"theta_i", "theta_s", "phi_s"},
+                             {"sigma_um", "T_um", "sigma_over_T"});
+        io::CsvRow row;
+        double sum = 0.0;
+        while (reader.next(row)) sum += *row.value(0);
+        benchmark::DoNotOptimize(sum);
+    }
+    state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(kRows));
+}
+BENCHMARK(BM_csv_read)->Name("io/csv_read/20000")->Unit(benchmark::kMillisecond);
+
+#ifdef ROUGHSCOPE_BENCH_HAS_CLI
+// Runs `roughscope model --csv ... --output ...` in-process through the CLI's own code.
+void run_cli_model(const Rows& r, bool json) {
+    CLI::App app{"bench", "roughscope"};
+    cli::register_model(app);
+    std::vector<std::string> args = {"roughscope", "model",        "--csv",
+                                     r.csv.string(), "--sigma",    "1",
+                                     "--T",          "2",          "--output",
+                                     r.output.string()};
+    if (json) args.emplace_back("--json");
+    std::vector<char*> argv;
+    for (std::string& a : args) argv.push_back(a.data());
+    app.parse(static_cast<int>(argv.size()), argv.data());
+}
+
+void BM_model_csv(benchmark::State& state, bool json) {
+    const Rows& r = rows();
+    using Clock = std::chrono::steady_clock;
+    const auto t0 = Clock::now();
+    benchmark::DoNotOptimize(compute_all(r.geometries));
+    const double compute_s = std::chrono::duration<double>(Clock::now() - t0).count();
+    double cli_s = 0.0;
+    for (auto _ : state) {
+        const auto t1 = Clock::now();
+        run_cli_model(r, json);
+        cli_s += std::chrono::duration<double>(Clock::now() - t1).count();
+    }
+    const auto n = static_cast<double>(state.iterations());
+    state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(kRows));
+    state.counters["ns_per_row"] = cli_s / n / static_cast<double>(kRows) * 1e9;
+    state.counters["compute_ns_per_row"] = compute_s / static_cast<double>(kRows) * 1e9;
+    state.counters["time_vs_compute"] = (cli_s / n) / compute_s;
+}
+BENCHMARK_CAPTURE(BM_model_csv, csv, false)
+    ->Name("io/model_csv/csv/20000")
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_model_csv, json, true)
+    ->Name("io/model_csv/json/20000")
+    ->Unit(benchmark::kMillisecond);
+#endif
+
+}  // namespace
