@@ -296,10 +296,15 @@ double evaluate_bk(const Args& a, const Point& p, const Roughness& r, json& out)
         options.patch_x_um = a.patch_x_um;
         options.patch_y_um = a.patch_y_um;
         if (p.geom) {
-            const json power = serialize::to_json(mean_scattered_power(*p.geom, surface, options));
-            brightness = power["brightness"].get<double>();
-            for (const char* k : {"coherent", "diffuse", "total", "g", "regime", "roughness_class"})
-                out[k] = power[k];
+            // The keys of serialize::to_json(ScatteredPower), set directly (once per CSV row).
+            const ScatteredPower power = mean_scattered_power(*p.geom, surface, options);
+            brightness = serialize::number(power.brightness).get<double>();
+            out["coherent"] = serialize::number(power.coherent);
+            out["diffuse"] = serialize::number(power.diffuse);
+            out["total"] = serialize::number(power.total);
+            out["g"] = serialize::number(power.g);
+            out["regime"] = std::string(to_string(power.regime));
+            out["roughness_class"] = std::string(to_string(power.roughness_class));
         } else {
             coherent = diffuse = total = 0.0;  // light or viewer below the horizon
         }
@@ -356,7 +361,8 @@ double evaluate_bk(const Args& a, const Point& p, const Roughness& r, json& out)
 
 // Evaluates the chosen model at one point; returns the result record (keys in output order).
 json evaluate(const Args& a, const Point& p, const Roughness& r) {
-    json out;
+    json out = json::object();
+    out.get_ref<json::object_t&>().reserve(32);  // every key of a record without regrowing
     out["model"] = model_name(a.model);
     // Angles of a geometry echoed as the shortest degrees that map to the same radians.
     const auto angle = [&](double deg, const std::optional<double> rad) {
@@ -455,7 +461,11 @@ void append_csv_line(std::string& out, const json& record) {
     bool first = true;
     for (const auto& [key, value] : record.items()) {
         if (!first) out += ',';
-        out += csv_field(cell_text(value));
+        const std::string cell = cell_text(value);
+        if (cell.find_first_of(",\"\n\r") == std::string::npos)
+            out += cell;  // csv_field would return it unchanged
+        else
+            out += csv_field(cell);
         first = false;
     }
     out += '\n';
