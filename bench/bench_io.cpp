@@ -113,6 +113,7 @@ void run_cli_model(const Rows& r, bool json) {
         "1",          "--T",   "2",     "--output",     r.output.string()};
     if (json) args.emplace_back("--json");
     std::vector<char*> argv;
+    argv.reserve(args.size());
     for (std::string& a : args) argv.push_back(a.data());
     app.parse(static_cast<int>(argv.size()), argv.data());
 }

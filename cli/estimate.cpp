@@ -341,8 +341,8 @@ std::size_t max_rows(const std::filesystem::path& path) {
     std::size_t lines = 1;
     while (in) {
         in.read(buffer.data(), static_cast<std::streamsize>(buffer.size()));
-        const auto n = static_cast<std::size_t>(in.gcount());
-        lines += static_cast<std::size_t>(std::count(buffer.begin(), buffer.begin() + n, '\n'));
+        const std::streamsize n = in.gcount();
+        lines += static_cast<std::size_t>(std::count(buffer.data(), buffer.data() + n, '\n'));
         if (n == 0) break;
     }
     return std::min<std::size_t>(lines, static_cast<std::size_t>(size / 10 + 1));
