@@ -137,7 +137,7 @@ def test_dash_writes_to_standard_output(tmp_path, expected):
 def unprivileged():
     """(directory, command prefix): a 0777 folder and the prefix that runs the CLI as a user
     without privileges (setpriv to nobody when the tests run as root)."""
-    directory = pathlib.Path(tempfile.mkdtemp(prefix="roughscope_ro_", dir="/tmp"))
+    directory = pathlib.Path(tempfile.mkdtemp(prefix="roughscope_ro_"))
     directory.chmod(0o777)
     prefix = ()
     if os.geteuid() == 0:
