@@ -130,8 +130,9 @@ std::pair<std::array<Operand, N>, Broadcast> broadcast(const std::array<const ch
     // product of the dimensions may overflow ssize_t).
     double elements = 1.0;
     for (ssize_t n : b.shape) elements *= static_cast<double>(n);
-    check_allocation(elements * static_cast<double>(inner), 1,
-                     "the broadcast result of shape " + shape_string(b.shape));
+    if (elements * static_cast<double>(inner) * 8.0 >= 1e8)
+        check_allocation(elements * static_cast<double>(inner), 1,
+                         "the broadcast result of shape " + shape_string(b.shape));
     b.size = 1;
     for (ssize_t n : b.shape) b.size *= n;
 

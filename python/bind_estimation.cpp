@@ -80,15 +80,14 @@ py::object vectorize(const std::array<const char*, N>& names, const std::array<p
     }
     {
         // Checked before the broadcast views are copied (and the result allocated).
+        const auto view = py::reinterpret_borrow<py::array>(b[0]);
+        std::vector<py::ssize_t> shape(view.shape(), view.shape() + view.ndim());
         double elements = 1.0;
-        std::vector<py::ssize_t> shape;
-        for (py::handle d : py::reinterpret_borrow<py::array>(b[0]).attr("shape")) {
-            elements *= d.cast<double>();
-            shape.push_back(d.cast<py::ssize_t>());
-        }
-        check_allocation(elements, 1,
-                         "the broadcast result of shape " +
-                             py::str(py::tuple(py::cast(shape))).cast<std::string>());
+        for (py::ssize_t d : shape) elements *= static_cast<double>(d);
+        if (elements * 8.0 >= 1e8)
+            check_allocation(elements, 1,
+                             "the broadcast result of shape " +
+                                 py::str(py::tuple(py::cast(shape))).cast<std::string>());
     }
     std::array<DoubleArray, N> c;
     for (std::size_t k = 0; k < N; ++k)

@@ -188,8 +188,11 @@ py::object real_option(const char* name, py::object value, bool pair, bool none_
 
 void check_allocation(double elements, int arrays, const std::string& what) {
     const double bytes = elements * 8.0 * arrays;
-    const long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGE_SIZE);
-    const double memory = pages > 0 && page > 0 ? double(pages) * double(page) : 0.0;
+    if (bytes < 1e8) return;  // the common case, without a system call
+    static const double memory = [] {
+        const long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGE_SIZE);
+        return pages > 0 && page > 0 ? double(pages) * double(page) : 0.0;
+    }();
     if (!(bytes <= 1e18) || (memory > 0.0 && bytes > memory)) {
         const std::string msg = what + " needs " + format_significant(bytes / 1073741824.0, 3) +
                                 " GiB of float64 values, more than this machine's memory (" +
