@@ -3,7 +3,8 @@
 //   estimate specular            σ from the specular reflectance (Eq. 12–13)
 //   estimate correlation-length  T from two diffuse measurements, σ known (Eq. 14–15)
 //   estimate slope               σ/T from a brightness ratio (Eq. 16–19), very rough surfaces
-//   estimate fit                 least squares to N ≥ 3 measurements from a CSV file
+//   estimate fit                 least squares to N measurements from a CSV file (exit 3:
+//                                not identifiable when the data cannot determine the fit)
 //
 // Angles in degrees, lengths in µm. See docs/estimation.md and docs/cli.md. The JSON documents
 // are built by the library (roughscope/serialize/estimation.hpp), the same as the Python

@@ -348,7 +348,10 @@ py::object very_rough_brightness_py(py::handle theta_i_deg, py::handle theta_s_d
 
 std::vector<LafortuneLobe> lobes_from_python(py::handle lobes) {
     std::vector<LafortuneLobe> result;
-    if (py::isinstance<py::dict>(lobes)) lobes = py::list(py::make_tuple(lobes));
+    // One dict is one lobe; the list made of it is held here (a handle alone would dangle).
+    py::object held = py::reinterpret_borrow<py::object>(lobes);
+    if (py::isinstance<py::dict>(lobes)) held = py::list(py::make_tuple(lobes));
+    lobes = held;
     bool sequence_of_dicts = py::isinstance<py::sequence>(lobes) && !py::isinstance<py::str>(lobes);
     if (sequence_of_dicts) {
         auto seq = py::reinterpret_borrow<py::sequence>(lobes);

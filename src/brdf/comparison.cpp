@@ -562,7 +562,7 @@ bool ModelResult::identified() const {
 
 std::optional<double> ModelResult::parameter(std::string_view name) const {
     for (const ModelParameter& p : parameters)
-        if (p.name == name) return p.value;
+        if (p.name == name) return p.identified ? std::optional<double>(p.value) : std::nullopt;
     return std::nullopt;
 }
 

@@ -366,6 +366,10 @@ def test_a_malformed_lafortune_lobe_is_a_value_error():
         assert "lobes" in str(info.value)
     with pytest.raises(TypeError, match=r"lobes\[0\]\['n'\]"):
         rs.lafortune_brdf(30.0, 30.0, 0.0, [{"n": "ten"}])
+    with pytest.raises(TypeError, match=r"lobes\[0\]\['Cx'\]"):  # one dict is one lobe
+        rs.lafortune_brdf(30.0, 30.0, 0.0, {"Cx": "x"})
+    one = {"Cx": -1.0, "Cy": -1.0, "Cz": 1.0, "n": 10.0, "albedo": 0.5}
+    assert rs.lafortune_brdf(30.0, 30.0, 0.0, one) == rs.lafortune_brdf(30.0, 30.0, 0.0, [one])
 
 
 BAD_REAL_VALUES = {"nan": float("nan"), "inf": float("inf"), "-inf": float("-inf"),

@@ -134,6 +134,8 @@ struct ModelResult {
     ErrorMeasures errors;
     std::vector<double> prediction;  // model brightness at each used measurement
 
+    // The value of parameter `name`; none when there is no such parameter or the data do not
+    // determine it (ModelParameter::identified false).
     std::optional<double> parameter(std::string_view name) const;
     // Available, and its parameters are determined by the data: not a NotIdentifiable fit or
     // search none of whose shape parameters (the gain aside) is identified. Only such models

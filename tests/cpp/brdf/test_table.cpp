@@ -482,6 +482,7 @@ TEST(Comparison, OneGeometryIdentifiesNoModel) {
                     EXPECT_FALSE(p.standard_error.has_value());
                 }
         }
+        EXPECT_FALSE(c.result(ComparisonModel::Lafortune).parameter("n").has_value()) << where;
         EXPECT_FALSE(c.winner.has_value()) << where;
         EXPECT_FALSE(c.winner_paper_metric.has_value()) << where;
     }
