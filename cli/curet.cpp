@@ -7,6 +7,7 @@
 // --out FILE` (python_runner.hpp); its error message, if any, becomes this command's error.
 #include "roughscope/brdf/curet.hpp"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <filesystem>
@@ -133,6 +134,10 @@ std::string text_report(const Comparison& c) {
         std::string params;
         for (const ModelParameter& p : r.parameters) {
             if (p.name == "gain") continue;
+            if (!p.identified) {  // no number for what the data do not determine
+                params += (params.empty() ? "" : " ") + p.name + "=not-identifiable";
+                continue;
+            }
             params += (params.empty() ? "" : " ") + p.name + "=" + short_number(p.value, p.name);
             if (p.standard_error && std::isfinite(*p.standard_error))
                 params += "(+-" + short_number(*p.standard_error, p.name) + ")";
@@ -187,6 +192,25 @@ std::string text_report_all(const std::vector<Comparison>& all) {
     header.push_back("issues");
     print_table(out, header, rows);
     return out.str();
+}
+
+// A comparison in which no model is determined by the data (e.g. a one-row table, or every row
+// at one geometry) has no result: NoSolution (exit 3) saying why, instead of arbitrary numbers.
+void require_identified_model(const Comparison& c) {
+    if (std::any_of(c.models.begin(), c.models.end(),
+                    [](const ModelResult& r) { return r.identified(); }))
+        return;
+    std::string why;
+    for (const ModelResult& r : c.models)
+        if (r.available && !r.fit_message.empty()) {
+            why = std::string(to_string(r.model)) + ": " + r.fit_message;
+            break;
+        }
+    if (why.empty() && !c.models.empty()) why = c.models.front().reason;
+    throw roughscope::NoSolution(
+        (c.sample ? "CUReT sample " + std::to_string(c.sample) : "'" + c.name + "'") +
+        ": no model is identifiable from these data (" + why + "; two-point estimate: " +
+        (c.two_point.available ? "available" : c.two_point.reason) + ")");
 }
 
 void draw_plot(const json& document, const fs::path& out_png) {
@@ -271,6 +295,7 @@ void run(Args& a) {
             const CuretDatabase db = load_curet(dir, a.channel);
             c = compare_curet_sample(db, a.sample, o);
         }
+        require_identified_model(c);
         switch (a.format) {
             case Format::Json:
                 text = serialize::dump(serialize::to_json(c, a.series));

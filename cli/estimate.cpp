@@ -3,7 +3,8 @@
 //   estimate specular            σ from the specular reflectance (Eq. 12–13)
 //   estimate correlation-length  T from two diffuse measurements, σ known (Eq. 14–15)
 //   estimate slope               σ/T from a brightness ratio (Eq. 16–19), very rough surfaces
-//   estimate fit                 least squares to N ≥ 3 measurements from a CSV file
+//   estimate fit                 least squares to N measurements from a CSV file (exit 3:
+//                                not identifiable when the data cannot determine the fit)
 //
 // Angles in degrees, lengths in µm. See docs/estimation.md and docs/cli.md. The JSON documents
 // are built by the library (roughscope/serialize/estimation.hpp), the same as the Python
@@ -427,16 +428,33 @@ void run_fit(const FitArgs& a) {
     if (a.correlation) options["correlation"] = std::string(to_string(*a.correlation));
     const FitOptions o = serialize::fit_options_from(options);
 
+    // A fit the data cannot determine is no result: exit 3 (no solution) when no fit is
+    // identifiable; with both correlations and one identifiable, its numbers are printed and the
+    // other's are unknown.
+    auto no_solution = [&](const FitResult& r) {
+        // The library's diagnosis (measurements, distinct geometries, parameters), without the
+        // solver's notes that follow it.
+        const std::size_t end = r.message.find("); ");
+        return roughscope::NoSolution(
+            "estimate fit (" + std::string(to_string(o.model)) + ", " +
+            std::string(to_string(r.options.correlation)) + " correlation): " +
+            (end == std::string::npos ? r.message : r.message.substr(0, end + 1)));
+    };
     json out;
     if (!a.correlation) {  // both
         const CorrelationComparison c = compare_correlations(ms, o);
+        if (c.gaussian.status == SolverStatus::NotIdentifiable &&
+            c.exponential.status == SolverStatus::NotIdentifiable)
+            throw no_solution(c.gaussian);
         out = serialize::fit_estimate_json(o, ms.size(), c, a.residuals);
         if (!a.out.json_output) {
             out["gaussian_fit"] = c.gaussian.brief_report();
             out["exponential_fit"] = c.exponential.brief_report();
         }
     } else {
-        out = serialize::fit_estimate_json(o, ms.size(), fit_roughness(ms, o), a.residuals);
+        const FitResult r = fit_roughness(ms, o);
+        if (r.status == SolverStatus::NotIdentifiable) throw no_solution(r);
+        out = serialize::fit_estimate_json(o, ms.size(), r, a.residuals);
     }
     emit(a.out, out);
 }
@@ -538,7 +556,8 @@ void register_estimate(CLI::App& app) {
         CLI::App* cmd = est->add_subcommand(
             "fit",
             "Least-squares fit of sigma/T (very rough) or sigma and T (slightly rough) and the "
-            "gain K to N >= 3 brightness values at arbitrary geometries (Ceres)");
+            "gain K to brightness values at arbitrary geometries (Ceres; at least as many "
+            "distinct geometries as parameters, else exit 3: not identifiable)");
         a.o_measurements = cmd->add_option(
             "--measurements", a.measurements_path,
             "CSV with header theta_i,phi_i,theta_s,phi_s,brightness[,weight] (degrees; "

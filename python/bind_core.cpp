@@ -73,11 +73,16 @@ std::string shape_string(const std::vector<ssize_t>& shape) {
     return s + ")";
 }
 
+// A numeric argument as contiguous float64 (no copy for a float64 C-contiguous array): TypeError
+// for a non-real type (real_array, bindings.hpp); the conversion of a real array can only fail
+// for want of memory.
 DoubleArray to_double_array(const char* name, py::handle value) {
-    DoubleArray array = DoubleArray::ensure(value);
-    if (!array)
-        throw InvalidArgument(std::string(name) +
-                              " must be a real number or an array-like of real numbers");
+    DoubleArray array = DoubleArray::ensure(real_array(name, value));
+    if (!array) {
+        PyErr_SetString(PyExc_MemoryError,
+                        (std::string(name) + ": no memory for its float64 copy").c_str());
+        throw py::error_already_set();
+    }
     return array;
 }
 
@@ -121,6 +126,13 @@ std::pair<std::array<Operand, N>, Broadcast> broadcast(const std::array<const ch
             }
         }
     }
+    // The result's size, checked before anything of that size is allocated (in double: the
+    // product of the dimensions may overflow ssize_t).
+    double elements = 1.0;
+    for (ssize_t n : b.shape) elements *= static_cast<double>(n);
+    if (elements * static_cast<double>(inner) * 8.0 >= 1e8)
+        check_allocation(elements * static_cast<double>(inner), 1,
+                         "the broadcast result of shape " + shape_string(b.shape));
     b.size = 1;
     for (ssize_t n : b.shape) b.size *= n;
 
@@ -336,19 +348,25 @@ py::object very_rough_brightness_py(py::handle theta_i_deg, py::handle theta_s_d
 
 std::vector<LafortuneLobe> lobes_from_python(py::handle lobes) {
     std::vector<LafortuneLobe> result;
-    if (py::isinstance<py::dict>(lobes)) lobes = py::list(py::make_tuple(lobes));
+    // One dict is one lobe; the list made of it is held here (a handle alone would dangle).
+    py::object held = py::reinterpret_borrow<py::object>(lobes);
+    if (py::isinstance<py::dict>(lobes)) held = py::list(py::make_tuple(lobes));
+    lobes = held;
     bool sequence_of_dicts = py::isinstance<py::sequence>(lobes) && !py::isinstance<py::str>(lobes);
     if (sequence_of_dicts) {
         auto seq = py::reinterpret_borrow<py::sequence>(lobes);
         for (py::handle item : seq)
             if (!py::isinstance<py::dict>(item)) sequence_of_dicts = false;
         if (sequence_of_dicts && py::len(seq) > 0) {
+            std::size_t index = 0;
             for (py::handle item : seq) {
                 auto d = py::reinterpret_borrow<py::dict>(item);
                 LafortuneLobe lobe;
                 for (auto kv : d) {
                     const std::string key = py::str(kv.first);
-                    const double v = py::cast<double>(kv.second);
+                    // TypeError for a non-real value, InvalidArgument (ValueError) for an array.
+                    const std::string where = "lobes[" + std::to_string(index) + "]['" + key + "']";
+                    const double v = real_scalar(where.c_str(), kv.second);
                     if (key == "Cx")
                         lobe.Cx = v;
                     else if (key == "Cy")
@@ -364,6 +382,7 @@ std::vector<LafortuneLobe> lobes_from_python(py::handle lobes) {
                                               "' (expected Cx, Cy, Cz, n, albedo)");
                 }
                 result.push_back(lobe);
+                ++index;
             }
             return result;
         }
@@ -453,7 +472,8 @@ void bind_core(py::module_& m) {
     // ---- Geometry (§2) --------------------------------------------------------------------
     m.def(
         "geometry_from_vectors",
-        [](py::handle N, py::handle L, py::handle V, double unit_tolerance) {
+        [](py::handle N, py::handle L, py::handle V, py::handle unit_tolerance_in) {
+            const double unit_tolerance = real_scalar("unit_tolerance", unit_tolerance_in);
             auto operands = broadcast<3>({"N", "L", "V"}, {N, L, V}, 3);
             auto& ops = operands.first;  // not a structured binding (the lambdas below name it)
             auto& b = operands.second;
@@ -627,7 +647,8 @@ F_Beck(0, 0, ·) = 1; retro (θ, θ, 180): 1/cos²θ. Angles in degrees.)doc");
            py::handle sigma_um, py::handle T_um, const std::string& correlation,
            const std::string& factor, const std::string& regime, const std::string& radiometry,
            py::handle wavelength_um, py::handle patch_x_um, py::handle patch_y_um,
-           double auto_tolerance) {
+           py::handle auto_tolerance_in) {
+            const double auto_tolerance = real_scalar("auto_tolerance", auto_tolerance_in);
             const Correlation corr = parse_correlation(correlation);
             ModelOptions opt;
             opt.factor = parse_geometric_factor(factor);
@@ -990,7 +1011,8 @@ cos³θ exp(−k² ([T sin θ]² + [2σ cos θ]²)), k = 2π/λ. Lengths in µm.
     m.def(
         "lafortune_brdf",
         [](py::handle theta_i_deg, py::handle theta_s_deg, py::handle phi_s_deg, py::handle lobes,
-           double rho_d) {
+           py::handle rho_d_in) {
+            const double rho_d = real_scalar("rho_d", rho_d_in);
             const std::vector<LafortuneLobe> lobe_list = lobes_from_python(lobes);
             return map_double<3>(
                 {"theta_i_deg", "theta_s_deg", "phi_s_deg"}, {theta_i_deg, theta_s_deg, phi_s_deg},

@@ -3,6 +3,7 @@
 // serializer (roughscope/serialize/comparison.hpp): the document of `roughscope curet --json`
 // as Python objects. The options become a ComparisonOptions in one place,
 // serialize::comparison_options_from, which the CLI calls too.
+#include <algorithm>
 #include <array>
 #include <optional>
 #include <string>
@@ -56,9 +57,23 @@ ComparisonOptions make_options(py::object theta1_deg, py::object theta2_deg, py:
                                py::object on_sigma_rad, py::object on_albedo, bool fits,
                                const std::string& radiometry, py::object max_overflow) {
     using namespace py::literals;
-    const py::dict o("theta1_deg"_a = theta1_deg, "theta2_deg"_a = theta2_deg, "pair"_a = pair,
-                     "on_sigma_rad"_a = on_sigma_rad, "on_albedo"_a = on_albedo, "fits"_a = fits,
-                     "radiometry"_a = radiometry, "max_overflow"_a = max_overflow);
+    // Numeric options are checked here (TypeError for a non-real value, bindings.hpp).
+    py::object pair_checked = pair;
+    if (!pair.is_none()) {
+        py::list items;
+        if (py::isinstance<py::str>(pair) || py::isinstance<py::bytes>(pair) ||
+            !py::hasattr(pair, "__iter__"))
+            throw py::type_error("pair must be two measurement numbers (I, J), not " +
+                                 py::str(py::type::of(pair).attr("__name__")).cast<std::string>());
+        for (py::handle item : py::iter(pair)) items.append(integer_scalar("pair", item));
+        pair_checked = items;
+    }
+    const py::dict o(
+        "theta1_deg"_a = real_option("theta1_deg", theta1_deg),
+        "theta2_deg"_a = real_option("theta2_deg", theta2_deg), "pair"_a = pair_checked,
+        "on_sigma_rad"_a = real_option("on_sigma_rad", on_sigma_rad),
+        "on_albedo"_a = real_option("on_albedo", on_albedo), "fits"_a = fits,
+        "radiometry"_a = radiometry, "max_overflow"_a = real_option("max_overflow", max_overflow));
     return serialize::comparison_options_from(from_python(o, "comparison option"));
 }
 
@@ -90,14 +105,24 @@ py::dict table_dict(const BrdfTable& t) {
     return d;
 }
 
-BrdfTable table_from_arrays(
-    py::array_t<double, py::array::c_style | py::array::forcecast> ti,
-    py::array_t<double, py::array::c_style | py::array::forcecast> pi,
-    py::array_t<double, py::array::c_style | py::array::forcecast> ts,
-    py::array_t<double, py::array::c_style | py::array::forcecast> ps,
-    py::array_t<double, py::array::c_style | py::array::forcecast> value,
-    std::optional<py::array_t<double, py::array::c_style | py::array::forcecast>> weight,
-    const std::string& name) {
+using DoubleArray = py::array_t<double, py::array::c_style | py::array::forcecast>;
+
+// A sample number: an integer (TypeError otherwise); values beyond int are clamped to one that no
+// sample has, so the library reports them as unknown.
+int sample_number(py::handle sample) {
+    return static_cast<int>(std::clamp<long long>(integer_scalar("sample", sample), -1, 1000000));
+}
+
+// A numeric array argument: TypeError for a non-real type (real_array, bindings.hpp).
+DoubleArray real_double_array(const char* name, py::handle value) {
+    DoubleArray a = DoubleArray::ensure(real_array(name, value));
+    if (!a) throw py::error_already_set();
+    return a;
+}
+
+BrdfTable table_from_arrays(const DoubleArray& ti, const DoubleArray& pi, const DoubleArray& ts,
+                            const DoubleArray& ps, const DoubleArray& value,
+                            const std::optional<DoubleArray>& weight, const std::string& name) {
     const py::ssize_t n = value.size();
     for (auto [label, arr] : {std::pair{"theta_i_deg", &ti}, std::pair{"phi_i_deg", &pi},
                               std::pair{"theta_s_deg", &ts}, std::pair{"phi_s_deg", &ps}})
@@ -175,13 +200,17 @@ void bind_curet(py::module_& m) {
             "(theta_s = theta_v, phi_s = phi_v - phi_i + 180)")
         .def(
             "sample_table",
-            [](const CuretDatabase& db, int sample) { return table_dict(db.sample_table(sample)); },
+            [](const CuretDatabase& db, py::handle sample) {
+                return table_dict(db.sample_table(sample_number(sample)));
+            },
             py::arg("sample"), "One sample's measurements as a dict of numpy arrays (degrees)")
         .def(
             "compare",
-            [](const CuretDatabase& db, int sample, py::object theta1_deg, py::object theta2_deg,
-               py::object pair, py::object on_sigma_rad, py::object on_albedo, bool fits,
-               const std::string& radiometry, py::object max_overflow, bool series) {
+            [](const CuretDatabase& db, py::handle sample_in, py::object theta1_deg,
+               py::object theta2_deg, py::object pair, py::object on_sigma_rad,
+               py::object on_albedo, bool fits, const std::string& radiometry,
+               py::object max_overflow, bool series) {
+                const int sample = sample_number(sample_in);
                 const ComparisonOptions o = make_options(theta1_deg, theta2_deg, pair, on_sigma_rad,
                                                          on_albedo, fits, radiometry, max_overflow);
                 serialize::Json doc;
@@ -200,8 +229,13 @@ void bind_curet(py::module_& m) {
         .def(
             "compare_all",
             [](const CuretDatabase& db, bool fits, const std::string& radiometry,
-               py::object max_overflow, int threads, const std::string& format,
+               py::object max_overflow, py::handle threads_in, const std::string& format,
                bool series) -> py::object {
+                const long long threads_ll = integer_scalar("threads", threads_in);
+                if (threads_ll < 0 || threads_ll > 1024)
+                    throw InvalidArgument("threads = " + std::to_string(threads_ll) +
+                                          " is outside the valid range [0, 1024]");
+                const int threads = static_cast<int>(threads_ll);
                 const ComparisonOptions o =
                     make_options(py::none(), py::none(), py::none(), py::none(), py::none(), fits,
                                  radiometry, max_overflow);
@@ -247,12 +281,13 @@ void bind_curet(py::module_& m) {
         py::arg("data_dir") = py::none(), py::arg("channel") = "mean",
         "Load the CUReT database (channel: mean, red, green, blue)");
     m.def(
-        "curet_sample_name", [](int s) { return std::string(curet_sample_name(s)); },
+        "curet_sample_name",
+        [](py::handle sample) { return std::string(curet_sample_name(sample_number(sample))); },
         py::arg("sample"), "The paper's name for samples 25, 34, 41; '' otherwise");
     m.def(
         "curet_paper_oren_nayar",
-        [](int s) -> py::object {
-            const auto p = paper_oren_nayar_params(s);
+        [](py::handle sample) -> py::object {
+            const auto p = paper_oren_nayar_params(sample_number(sample));
             if (!p) return py::none();
             return py::make_tuple(p->sigma_rad, p->albedo);
         },
@@ -287,17 +322,17 @@ void bind_curet(py::module_& m) {
         "Compare every model with a BRDF table read from CSV (a dict)");
     m.def(
         "brdf_compare_arrays",
-        [](py::array_t<double, py::array::c_style | py::array::forcecast> theta_i_deg,
-           py::array_t<double, py::array::c_style | py::array::forcecast> phi_i_deg,
-           py::array_t<double, py::array::c_style | py::array::forcecast> theta_s_deg,
-           py::array_t<double, py::array::c_style | py::array::forcecast> phi_s_deg,
-           py::array_t<double, py::array::c_style | py::array::forcecast> value,
-           std::optional<py::array_t<double, py::array::c_style | py::array::forcecast>> weight,
-           const std::string& name, py::object theta1_deg, py::object theta2_deg, py::object pair,
-           py::object on_sigma_rad, py::object on_albedo, bool fits, const std::string& radiometry,
-           bool series) {
-            const BrdfTable t = table_from_arrays(theta_i_deg, phi_i_deg, theta_s_deg, phi_s_deg,
-                                                  value, weight, name);
+        [](py::handle theta_i_deg, py::handle phi_i_deg, py::handle theta_s_deg,
+           py::handle phi_s_deg, py::handle value, py::handle weight, const std::string& name,
+           py::object theta1_deg, py::object theta2_deg, py::object pair, py::object on_sigma_rad,
+           py::object on_albedo, bool fits, const std::string& radiometry, bool series) {
+            std::optional<DoubleArray> w;
+            if (!weight.is_none()) w = real_double_array("weight", weight);
+            const BrdfTable t = table_from_arrays(real_double_array("theta_i_deg", theta_i_deg),
+                                                  real_double_array("phi_i_deg", phi_i_deg),
+                                                  real_double_array("theta_s_deg", theta_s_deg),
+                                                  real_double_array("phi_s_deg", phi_s_deg),
+                                                  real_double_array("value", value), w, name);
             const ComparisonOptions o = make_options(theta1_deg, theta2_deg, pair, on_sigma_rad,
                                                      on_albedo, fits, radiometry, py::none());
             return to_python(serialize::to_json(compare_brdf(t, o), series));
@@ -312,11 +347,18 @@ void bind_curet(py::module_& m) {
         "element j). A dict.");
     m.def(
         "comparison_error_measures",
-        [](std::vector<double> model, std::vector<double> data,
-           std::optional<std::vector<double>> weights) {
-            const ErrorMeasures e = error_measures(
-                model, data,
-                weights ? std::span<const double>(*weights) : std::span<const double>());
+        [](py::handle model, py::handle data, py::handle weights) {
+            auto vector_of = [](const char* name, py::handle h) {
+                const DoubleArray a = real_double_array(name, h);
+                if (a.ndim() != 1)
+                    throw InvalidArgument(std::string(name) + " must be a 1-d sequence of numbers");
+                return std::vector<double>(a.data(), a.data() + a.size());
+            };
+            const std::vector<double> M = vector_of("model", model), D = vector_of("data", data);
+            std::optional<std::vector<double>> wv;
+            if (!weights.is_none()) wv = vector_of("weights", weights);
+            const ErrorMeasures e =
+                error_measures(M, D, wv ? std::span<const double>(*wv) : std::span<const double>());
             py::dict d;
             d["sse"] = e.paper_sse;
             d["rmse"] = e.rmse;

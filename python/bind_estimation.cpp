@@ -61,10 +61,8 @@ py::object vectorize(const std::array<const char*, N>& names, const std::array<p
     bool scalar = true;
     py::list as_list;
     for (std::size_t k = 0; k < N; ++k) {
-        arrays[k] = DoubleArray::ensure(in[k]);
-        if (!arrays[k])
-            throw InvalidArgument(std::string(names[k]) +
-                                  " must be a real number or an array-like of real numbers");
+        arrays[k] = DoubleArray::ensure(real_array(names[k], in[k]));  // TypeError if not real
+        if (!arrays[k]) throw py::error_already_set();
         if (arrays[k].ndim() > 0) scalar = false;
         as_list.append(arrays[k]);
     }
@@ -79,6 +77,17 @@ py::object vectorize(const std::array<const char*, N>& names, const std::array<p
                                arrays[k].shape(), arrays[k].shape() + arrays[k].ndim()))))
                        .cast<std::string>();
         throw InvalidArgument(msg);
+    }
+    {
+        // Checked before the broadcast views are copied (and the result allocated).
+        const auto view = py::reinterpret_borrow<py::array>(b[0]);
+        std::vector<py::ssize_t> shape(view.shape(), view.shape() + view.ndim());
+        double elements = 1.0;
+        for (py::ssize_t d : shape) elements *= static_cast<double>(d);
+        if (elements * 8.0 >= 1e8)
+            check_allocation(elements, 1,
+                             "the broadcast result of shape " +
+                                 py::str(py::tuple(py::cast(shape))).cast<std::string>());
     }
     std::array<DoubleArray, N> c;
     for (std::size_t k = 0; k < N; ++k)
@@ -133,14 +142,12 @@ py::tuple range_tuple(const RatioRange& r) { return py::make_tuple(r.lower, r.up
 
 std::pair<double, double> noise_pair(py::handle noise) {
     if (noise.is_none()) return {0.0, 0.0};  // no noise given: no standard errors
-    if (py::isinstance<py::sequence>(noise) && !py::isinstance<py::str>(noise)) {
-        auto v = noise.cast<std::vector<double>>();
-        if (v.size() != 2)
-            throw InvalidArgument("noise must be a number or a pair (relative noise of E1, E2)");
-        return {v[0], v[1]};
-    }
-    const double x = noise.cast<double>();
-    return {x, x};
+    const DoubleArray a = DoubleArray::ensure(real_array("noise", noise));  // TypeError if not real
+    if (!a) throw py::error_already_set();
+    if (a.ndim() == 0) return {a.data()[0], a.data()[0]};
+    if (a.ndim() != 1 || a.size() != 2)
+        throw InvalidArgument("noise must be a number or a pair (relative noise of E1, E2)");
+    return {a.data()[0], a.data()[1]};
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -150,7 +157,7 @@ std::vector<Measurement> measurements_from(py::handle theta_i_deg, py::handle th
                                            py::handle phi_s_deg, py::handle brightness,
                                            py::handle weight) {
     auto as_1d = [](const char* name, py::handle h) {
-        DoubleArray a = DoubleArray::ensure(h);
+        DoubleArray a = DoubleArray::ensure(real_array(name, h));  // TypeError if not real
         if (!a || a.ndim() > 1)
             throw InvalidArgument(std::string(name) +
                                   " must be a number or a 1-d array of numbers");
@@ -230,7 +237,9 @@ void bind_estimation(py::module_& m) {
         "theta2 (degrees), viewer on the normal. Vectorised.");
     m.def(
         "ratio_range_gaussian",
-        [](double t1, double t2, const std::string& factor) {
+        [](py::handle t1_in, py::handle t2_in, const std::string& factor) {
+            const double t1 = real_scalar("theta1_deg", t1_in);
+            const double t2 = real_scalar("theta2_deg", t2_in);
             return range_tuple(ratio_range_gaussian(rad(t1), rad(t2), factor_of(factor)));
         },
         arg("theta1_deg"), arg("theta2_deg"), arg("factor") = "vh",
@@ -238,14 +247,21 @@ void bind_estimation(py::module_& m) {
         "inf).");
     m.def(
         "ratio_range_exponential",
-        [](double t1, double t2, const std::string& factor) {
+        [](py::handle t1_in, py::handle t2_in, const std::string& factor) {
+            const double t1 = real_scalar("theta1_deg", t1_in);
+            const double t2 = real_scalar("theta2_deg", t2_in);
             return range_tuple(ratio_range_exponential(rad(t1), rad(t2), factor_of(factor)));
         },
         arg("theta1_deg"), arg("theta2_deg"), arg("factor") = "vh",
         "Open interval (lower, upper) of E1/E2 for which Eq. 19 has a solution.");
     m.def(
         "ratio_range_correlation_length",
-        [](double sigma_um, double t1, double t2, double wavelength_um, const std::string& factor) {
+        [](py::handle sigma_um_in, py::handle t1_in, py::handle t2_in, py::handle wavelength_um_in,
+           const std::string& factor) {
+            const double sigma_um = real_scalar("sigma_um", sigma_um_in);
+            const double t1 = real_scalar("theta1_deg", t1_in);
+            const double t2 = real_scalar("theta2_deg", t2_in);
+            const double wavelength_um = real_scalar("wavelength_um", wavelength_um_in);
             return range_tuple(ratio_range_correlation_length(sigma_um, rad(t1), rad(t2),
                                                               wavelength_um, factor_of(factor)));
         },
@@ -324,7 +340,8 @@ void bind_estimation(py::module_& m) {
         [](py::handle ratio, py::handle sigma_um, py::handle ti1, py::handle ts1, py::handle ps1,
            py::handle ti2, py::handle ts2, py::handle ps2, const std::string& correlation,
            const std::string& factor, const std::string& radiometry, const std::string& regime,
-           double wavelength_um) {
+           py::handle wavelength_um_in) {
+            const double wavelength_um = real_scalar("wavelength_um", wavelength_um_in);
             TwoGeometryOptions o;
             o.factor = factor_of(factor);
             o.radiometry = radiometry_of(radiometry);
@@ -354,10 +371,20 @@ void bind_estimation(py::module_& m) {
     // given, as with the CLI's --noise / --sigma-stderr.
     m.def(
         "estimate_slope",
-        [](double ratio, double theta1_deg, double theta2_deg, const std::string& correlation,
-           const std::string& factor, const std::string& radiometry, py::handle noise,
-           std::optional<double> sigma_um, double wavelength_um, double theta_s1_deg,
-           double phi_s1_deg, double theta_s2_deg, double phi_s2_deg) {
+        [](py::handle ratio_in, py::handle theta1_deg_in, py::handle theta2_deg_in,
+           const std::string& correlation, const std::string& factor, const std::string& radiometry,
+           py::handle noise, py::handle sigma_um_in, py::handle wavelength_um_in,
+           py::handle theta_s1_deg_in, py::handle phi_s1_deg_in, py::handle theta_s2_deg_in,
+           py::handle phi_s2_deg_in) {
+            const double ratio = real_scalar("ratio", ratio_in);
+            const double theta1_deg = real_scalar("theta1_deg", theta1_deg_in);
+            const double theta2_deg = real_scalar("theta2_deg", theta2_deg_in);
+            const std::optional<double> sigma_um = optional_real("sigma_um", sigma_um_in);
+            const double wavelength_um = real_scalar("wavelength_um", wavelength_um_in);
+            const double theta_s1_deg = real_scalar("theta_s1_deg", theta_s1_deg_in);
+            const double phi_s1_deg = real_scalar("phi_s1_deg", phi_s1_deg_in);
+            const double theta_s2_deg = real_scalar("theta_s2_deg", theta_s2_deg_in);
+            const double phi_s2_deg = real_scalar("phi_s2_deg", phi_s2_deg_in);
             SlopeInput in;
             in.E1_over_E2 = ratio;
             in.geom1 = geometry_deg(theta1_deg, theta_s1_deg, phi_s1_deg);
@@ -391,9 +418,15 @@ void bind_estimation(py::module_& m) {
         "Returns the dict of `roughscope estimate slope --json` (docs/estimation.md).");
     m.def(
         "estimate_sigma_specular",
-        [](std::optional<double> R_spec, double theta_deg, std::optional<double> E_tot,
-           std::optional<double> E_dif, double wavelength_um, double R0,
-           std::optional<double> noise) {
+        [](py::handle R_spec_in, py::handle theta_deg_in, py::handle E_tot_in, py::handle E_dif_in,
+           py::handle wavelength_um_in, py::handle R0_in, py::handle noise_in) {
+            const std::optional<double> R_spec = optional_real("R_spec", R_spec_in);
+            const double theta_deg = real_scalar("theta_deg", theta_deg_in);
+            const std::optional<double> E_tot = optional_real("E_tot", E_tot_in);
+            const std::optional<double> E_dif = optional_real("E_dif", E_dif_in);
+            const double wavelength_um = real_scalar("wavelength_um", wavelength_um_in);
+            const double R0 = real_scalar("R0", R0_in);
+            const std::optional<double> noise = optional_real("noise", noise_in);
             SpecularInput in;
             if (R_spec && (E_tot || E_dif))
                 throw InvalidArgument("give R_spec or (E_tot, E_dif), not both");
@@ -417,11 +450,22 @@ void bind_estimation(py::module_& m) {
         "`roughscope estimate specular --json`.");
     m.def(
         "estimate_correlation_length",
-        [](double ratio, double sigma_um, double theta1_deg, double theta2_deg,
-           std::optional<double> sigma_um_stderr, const std::string& correlation,
+        [](py::handle ratio_in, py::handle sigma_um_in, py::handle theta1_deg_in,
+           py::handle theta2_deg_in, py::handle sigma_um_stderr_in, const std::string& correlation,
            const std::string& factor, const std::string& radiometry, const std::string& regime,
-           double wavelength_um, py::handle noise, double theta_s1_deg, double phi_s1_deg,
-           double theta_s2_deg, double phi_s2_deg) {
+           py::handle wavelength_um_in, py::handle noise, py::handle theta_s1_deg_in,
+           py::handle phi_s1_deg_in, py::handle theta_s2_deg_in, py::handle phi_s2_deg_in) {
+            const double ratio = real_scalar("ratio", ratio_in);
+            const double sigma_um = real_scalar("sigma_um", sigma_um_in);
+            const double theta1_deg = real_scalar("theta1_deg", theta1_deg_in);
+            const double theta2_deg = real_scalar("theta2_deg", theta2_deg_in);
+            const std::optional<double> sigma_um_stderr =
+                optional_real("sigma_um_stderr", sigma_um_stderr_in);
+            const double wavelength_um = real_scalar("wavelength_um", wavelength_um_in);
+            const double theta_s1_deg = real_scalar("theta_s1_deg", theta_s1_deg_in);
+            const double phi_s1_deg = real_scalar("phi_s1_deg", phi_s1_deg_in);
+            const double theta_s2_deg = real_scalar("theta_s2_deg", theta_s2_deg_in);
+            const double phi_s2_deg = real_scalar("phi_s2_deg", phi_s2_deg_in);
             CorrelationLengthInput in;
             in.E1_over_E2 = ratio;
             in.sigma_um = sigma_um;
@@ -490,11 +534,17 @@ void bind_estimation(py::module_& m) {
                  py::object scale_covariance, bool residuals) {
             const py::dict o(
                 "model"_a = model, "correlation"_a = correlation, "factor"_a = factor,
-                "radiometry"_a = radiometry, "regime"_a = regime, "wavelength_um"_a = wavelength_um,
-                "residual"_a = residual, "loss"_a = loss, "loss_scale"_a = loss_scale,
-                "initial_sigma_over_T"_a = i_s, "initial_sigma_um"_a = i_sigma,
-                "initial_T_um"_a = i_T, "sigma_over_T_bounds"_a = sb, "sigma_bounds_um"_a = sigb,
-                "T_bounds_um"_a = tb, "max_iterations"_a = max_iterations,
+                "radiometry"_a = radiometry, "regime"_a = regime,
+                "wavelength_um"_a = real_option("wavelength_um", wavelength_um, false, false),
+                "residual"_a = residual, "loss"_a = loss,
+                "loss_scale"_a = real_option("loss_scale", loss_scale, false, false),
+                "initial_sigma_over_T"_a = real_option("initial_sigma_over_T", i_s),
+                "initial_sigma_um"_a = real_option("initial_sigma_um", i_sigma),
+                "initial_T_um"_a = real_option("initial_T_um", i_T),
+                "sigma_over_T_bounds"_a = real_option("sigma_over_T_bounds", sb, true),
+                "sigma_bounds_um"_a = real_option("sigma_bounds_um", sigb, true),
+                "T_bounds_um"_a = real_option("T_bounds_um", tb, true),
+                "max_iterations"_a = py::int_(integer_scalar("max_iterations", max_iterations)),
                 "scale_covariance"_a = scale_covariance);
             return fit_fn(ti, ts, ps, b, w, o, residuals, false);
         },
@@ -513,9 +563,12 @@ void bind_estimation(py::module_& m) {
                  py::object model, py::object factor, py::object radiometry, py::object regime,
                  py::object wavelength_um, py::object residual, py::object loss,
                  py::object loss_scale, bool residuals) {
-            const py::dict o("model"_a = model, "factor"_a = factor, "radiometry"_a = radiometry,
-                             "regime"_a = regime, "wavelength_um"_a = wavelength_um,
-                             "residual"_a = residual, "loss"_a = loss, "loss_scale"_a = loss_scale);
+            const py::dict o(
+                "model"_a = model, "factor"_a = factor, "radiometry"_a = radiometry,
+                "regime"_a = regime,
+                "wavelength_um"_a = real_option("wavelength_um", wavelength_um, false, false),
+                "residual"_a = residual, "loss"_a = loss,
+                "loss_scale"_a = real_option("loss_scale", loss_scale, false, false));
             return fit_fn(ti, ts, ps, b, w, o, residuals, true);
         },
         arg("theta_i_deg"), arg("theta_s_deg"), arg("phi_s_deg"), arg("brightness"),

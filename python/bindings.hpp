@@ -1,6 +1,10 @@
 // Pieces of the pybind11 module roughscope._core; module.cpp calls every bind_* function.
 #pragma once
 
+#include <optional>
+#include <string>
+
+#include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 
 #include "roughscope/serialize/json.hpp"
@@ -16,9 +20,35 @@ void bind_curet(pybind11::module_& m);       // python/bind_curet.cpp: CUReT / B
 // null → None. Defined in module.cpp.
 pybind11::object to_python(const serialize::Json& value);
 
+// ---- Strict numeric input (docs/python.md, "Types") ---------------------------------------
+// A numeric argument accepts a Python int or float, a NumPy integer or floating scalar, an
+// ndarray of integer or floating dtype, or a (nested) sequence of such numbers. Anything else —
+// bool and NumPy bool, str, bytes, complex (whose imaginary part would be dropped), datetime64,
+// timedelta64, object arrays, None where a number is required — raises TypeError naming the
+// argument and saying what is accepted. A float64 ndarray passes through without a copy.
+
+// `value` checked: itself (an ndarray of integer or floating dtype, an int, a float) or its NumPy
+// array (NumPy scalars, sequences), ready for py::array_t<double>::ensure; TypeError otherwise.
+pybind11::object real_array(const char* name, pybind11::handle value);
+// `value` as a double: a real number or a 0-d/size-1 real array; TypeError for a non-real type,
+// InvalidArgument for an array of another size.
+double real_scalar(const char* name, pybind11::handle value);
+// None → std::nullopt, else real_scalar.
+std::optional<double> optional_real(const char* name, pybind11::handle value);
+// A Python or NumPy integer (not bool, not float); TypeError otherwise.
+long long integer_scalar(const char* name, pybind11::handle value);
+// Checks an option value that must be a real number (or, with `pair`, a pair of real numbers) —
+// or None when `none_allowed` (None: "not given") — before it becomes JSON: TypeError otherwise.
+// Returns the value as float (list of floats).
+pybind11::object real_option(const char* name, pybind11::object value, bool pair = false,
+                             bool none_allowed = true);
+// Throws MemoryError (checked before allocating) when `elements` float64 values, `arrays` times,
+// exceed what this machine can hold; `what` describes the shape.
+void check_allocation(double elements, int arrays, const std::string& what);
+
 // Named options from Python (a dict or keyword arguments, values None/bool/int/float/str or
 // sequences of them) → JSON for the library's *_options_from functions. numpy scalars and
-// arrays are accepted (via float()/tolist()). InvalidArgument for anything else.
+// arrays are accepted (via tolist()). TypeError for anything else (complex, bytes, objects).
 serialize::Json from_python(pybind11::handle value, const std::string& where = "option");
 
 }  // namespace roughscope::python

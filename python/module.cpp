@@ -7,12 +7,15 @@
 //     ├── roughscope.NoSolution        (an inversion with no solution for valid inputs)
 //     └── roughscope.DataError         (a malformed or missing file or table)
 #include <cstdint>
+#include <optional>
 #include <string>
 
 #include <pybind11/pybind11.h>
+#include <unistd.h>
 
 #include "bindings.hpp"
 #include "roughscope/core/errors.hpp"
+#include "roughscope/core/numbers.hpp"
 #include "roughscope/version.hpp"
 
 namespace py = pybind11;
@@ -57,6 +60,10 @@ serialize::Json from_python(py::handle value, const std::string& where) {
     if (py::isinstance<py::bool_>(value)) return value.cast<bool>();
     if (py::isinstance<py::int_>(value)) return value.cast<std::int64_t>();
     if (py::isinstance<py::float_>(value)) return value.cast<double>();
+    if (PyComplex_Check(value.ptr()) || py::isinstance<py::bytes>(value))
+        throw py::type_error(where + " has an unsupported type " +
+                             py::str(py::type::of(value).attr("__name__")).cast<std::string>() +
+                             " (expected None, bool, an int or float, a string or a sequence)");
     if (py::isinstance<py::str>(value)) return value.cast<std::string>();
     if (py::isinstance<py::dict>(value)) {
         Json out = Json::object();
@@ -72,9 +79,128 @@ serialize::Json from_python(py::handle value, const std::string& where) {
         for (py::handle item : value.cast<py::sequence>()) out.push_back(from_python(item, where));
         return out;
     }
-    throw InvalidArgument(where + " has an unsupported type " +
-                          py::str(py::type::of(value).attr("__name__")).cast<std::string>() +
-                          " (expected None, bool, a number, a string or a sequence)");
+    throw py::type_error(where + " has an unsupported type " +
+                         py::str(py::type::of(value).attr("__name__")).cast<std::string>() +
+                         " (expected None, bool, an int or float, a string or a sequence)");
+}
+
+namespace {
+
+// The accepted dtype kinds: signed and unsigned integers, floating point.
+bool real_kind(char kind) { return kind == 'i' || kind == 'u' || kind == 'f'; }
+
+std::string type_name(py::handle value) {
+    return py::str(py::type::of(value).attr("__name__")).cast<std::string>();
+}
+
+[[noreturn]] void not_real(const char* name, const std::string& what) {
+    throw py::type_error(std::string(name) +
+                         " must be a real number or an array-like of real numbers (int or "
+                         "float, or a NumPy array of integer or floating dtype), not " +
+                         what);
+}
+
+}  // namespace
+
+py::object real_array(const char* name, py::handle value) {
+    // Fast paths: an ndarray is checked by its dtype only; a Python float or int is taken as is.
+    if (py::isinstance<py::array>(value)) {
+        const py::dtype dt = py::reinterpret_borrow<py::array>(value).dtype();
+        if (!real_kind(dt.kind()))
+            not_real(name, "an array of dtype " +
+                               py::str(static_cast<py::handle>(dt)).cast<std::string>());
+        return py::reinterpret_borrow<py::object>(value);
+    }
+    if (value.is_none()) not_real(name, "None");
+    if (PyBool_Check(value.ptr())) not_real(name, "bool");
+    if (PyFloat_Check(value.ptr()) || PyLong_Check(value.ptr()))
+        return py::reinterpret_borrow<py::object>(value);
+    if (py::isinstance<py::str>(value) || py::isinstance<py::bytes>(value) ||
+        PyComplex_Check(value.ptr()))
+        not_real(name, type_name(value));
+    // NumPy scalars and sequences: by the dtype NumPy gives them.
+    py::object array;
+    try {
+        array = py::module_::import("numpy").attr("asarray")(value);
+    } catch (py::error_already_set& e) {
+        if (e.matches(PyExc_MemoryError)) throw;
+        // A ragged sequence: the values may be real, the shape is wrong.
+        if (e.matches(PyExc_ValueError))
+            throw InvalidArgument(std::string(name) +
+                                  " is not a rectangular array of numbers: " + e.what());
+        not_real(name, type_name(value) + " (" + e.what() + ")");
+    }
+    const py::dtype dt = py::reinterpret_borrow<py::array>(array).dtype();
+    if (!real_kind(dt.kind())) {
+        if (py::isinstance<py::list>(value) || py::isinstance<py::tuple>(value))
+            not_real(name, "a sequence of " +
+                               py::str(static_cast<py::handle>(dt)).cast<std::string>() +
+                               " values");
+        not_real(name, type_name(value));
+    }
+    return array;
+}
+
+double real_scalar(const char* name, py::handle value) {
+    if (PyFloat_Check(value.ptr())) return PyFloat_AS_DOUBLE(value.ptr());
+    const py::object checked = real_array(name, value);
+    const auto a = py::array_t<double, py::array::forcecast>::ensure(checked);
+    if (!a) throw py::error_already_set();
+    if (a.size() != 1)
+        throw InvalidArgument(std::string(name) + " must be a single number, got an array of " +
+                              std::to_string(a.size()) + " values");
+    return a.data()[0];
+}
+
+std::optional<double> optional_real(const char* name, py::handle value) {
+    if (value.is_none()) return std::nullopt;
+    return real_scalar(name, value);
+}
+
+long long integer_scalar(const char* name, py::handle value) {
+    // (NumPy's timedelta64 derives from its signedinteger: not an integer here.)
+    const py::module_ np = py::module_::import("numpy");
+    const bool integer =
+        !PyBool_Check(value.ptr()) &&
+        (PyLong_Check(value.ptr()) || (py::isinstance(value, np.attr("integer")) &&
+                                       !py::isinstance(value, np.attr("timedelta64"))));
+    if (!integer)
+        throw py::type_error(std::string(name) +
+                             " must be an integer (int or a NumPy integer), not " +
+                             (value.is_none() ? std::string("None") : type_name(value)));
+    return py::int_(py::reinterpret_borrow<py::object>(value)).cast<long long>();
+}
+
+py::object real_option(const char* name, py::object value, bool pair, bool none_allowed) {
+    if (value.is_none()) {
+        if (!none_allowed) not_real(name, "None");
+        return value;
+    }
+    if (pair && py::isinstance<py::array>(value)) real_array(name, value);  // dtype check
+    if (pair && (py::isinstance<py::list>(value) || py::isinstance<py::tuple>(value) ||
+                 py::isinstance<py::array>(value))) {
+        py::list out;
+        for (py::handle item : py::iter(value)) out.append(real_scalar(name, item));
+        return out;
+    }
+    return py::float_(real_scalar(name, value));
+}
+
+void check_allocation(double elements, int arrays, const std::string& what) {
+    const double bytes = elements * 8.0 * arrays;
+    if (bytes < 1e8) return;  // the common case, without a system call
+    static const double memory = [] {
+        const long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGE_SIZE);
+        return pages > 0 && page > 0 ? double(pages) * double(page) : 0.0;
+    }();
+    if (!(bytes <= 1e18) || (memory > 0.0 && bytes > memory)) {
+        const std::string msg = what + " needs " + format_significant(bytes / 1073741824.0, 3) +
+                                " GiB of float64 values, more than this machine's memory (" +
+                                format_significant(memory / 1073741824.0, 3) +
+                                " GiB): give smaller arrays";
+        PyErr_SetString(PyExc_MemoryError, msg.c_str());
+        throw py::error_already_set();
+    }
 }
 
 }  // namespace roughscope::python

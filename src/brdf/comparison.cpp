@@ -123,6 +123,18 @@ void oren_nayar_prediction(const Prepared& p, const OrenNayarParams& on, std::ve
     p.oren_nayar.radiance(on, out);
 }
 
+// "N measurements at K distinct geometries": why a fit or search cannot determine its parameters.
+std::string distinct_geometries_text(const std::vector<Geometry>& geom) {
+    std::vector<std::array<double, 3>> distinct;
+    for (const Geometry& g : geom) {
+        const std::array<double, 3> a{g.theta_i_rad, g.theta_s_rad, g.phi_s_rad};
+        if (std::find(distinct.begin(), distinct.end(), a) == distinct.end()) distinct.push_back(a);
+    }
+    return std::to_string(geom.size()) + " measurement" + (geom.size() == 1 ? "" : "s") + " at " +
+           std::to_string(distinct.size()) + " distinct geometr" +
+           (distinct.size() == 1 ? "y" : "ies");
+}
+
 // min over K of Σ w (K M − d)²; K returned through `gain`. A model that is zero everywhere
 // explains nothing: SSE = Σ w d².
 double gain_sse(const Prepared& p, const std::vector<double>& M, double* gain = nullptr) {
@@ -210,6 +222,10 @@ void run_fit(const Prepared& p, ModelResult& r, const LeastSquaresProblem& probl
     r.evaluations = lsq.evaluations;
     r.fit_status = lsq.status;
     r.fit_message = lsq.message;
+    if (lsq.status == SolverStatus::NotIdentifiable)
+        r.fit_message = "not identifiable (" + distinct_geometries_text(p.geom) + " for " +
+                        std::to_string(lsq.num_parameters) + " parameters including the gain); " +
+                        r.fit_message;
     if (lsq.model.empty()) {
         r.reason = "the fit failed: " + lsq.message;
         return;
@@ -218,9 +234,10 @@ void run_fit(const Prepared& p, ModelResult& r, const LeastSquaresProblem& probl
     r.parameters.clear();
     for (const FitParameter& fp : lsq.parameters)
         r.parameters.push_back({fp.name, fp.value,
-                                lsq.covariance_available && !fp.at_bound
+                                lsq.covariance_available && !fp.at_bound && fp.identified
                                     ? std::optional<double>(fp.std_error)
-                                    : std::nullopt});
+                                    : std::nullopt,
+                                fp.identified});
     if (lsq.covariance_available) {
         const auto k = lsq.covariance.rows();
         r.covariance.assign(static_cast<std::size_t>(k * k), 0.0);
@@ -289,9 +306,9 @@ void finish_at_lambert(const Prepared& p, ModelResult& r, double rho, double sig
     r.available = true;
     r.fit_status = SolverStatus::NotIdentifiable;
     r.errors = measures(p, r.prediction);
-    r.parameters = {{"sigma_rad", 0.0, std::nullopt},
-                    {"albedo", rho, std::nullopt},
-                    {"gain", r.errors.gain, std::nullopt}};
+    r.parameters = {{"sigma_rad", 0.0, std::nullopt, true},
+                    {"albedo", rho, std::nullopt, false},
+                    {"gain", r.errors.gain, std::nullopt, false}};
     r.covariance.clear();
     r.fit_message =
         "Lambert limit: the grid start has sigma_rad = 0 and the slope of the profiled SSE in "
@@ -494,7 +511,7 @@ TwoPointEstimate two_point_estimate(const BrdfTable& table, const std::vector<bo
 void pick_winners(Comparison& c) {
     double best = kInf, best_paper = kInf;
     for (const ModelResult& r : c.models) {
-        if (!r.available) continue;
+        if (!r.identified()) continue;
         if (r.errors.gain_sse < best) {
             best = r.errors.gain_sse;
             c.winner = r.model;
@@ -536,9 +553,16 @@ bool is_fit(ComparisonModel model) {
     }
 }
 
+bool ModelResult::identified() const {
+    if (!available) return false;
+    if (fit_status != SolverStatus::NotIdentifiable) return true;
+    return std::any_of(parameters.begin(), parameters.end(),
+                       [](const ModelParameter& q) { return q.identified && q.name != "gain"; });
+}
+
 std::optional<double> ModelResult::parameter(std::string_view name) const {
     for (const ModelParameter& p : parameters)
-        if (p.name == name) return p.value;
+        if (p.name == name) return p.identified ? std::optional<double>(p.value) : std::nullopt;
     return std::nullopt;
 }
 
@@ -725,8 +749,8 @@ Comparison compare_brdf(const BrdfTable& table, const ComparisonOptions& o) {
         if (o.oren_nayar) {
             r.available = true;
             r.method = "given parameters (" + o.oren_nayar_source + ")";
-            r.parameters = {{"sigma_rad", o.oren_nayar->sigma_rad, std::nullopt},
-                            {"albedo", o.oren_nayar->albedo, std::nullopt}};
+            r.parameters = {{"sigma_rad", o.oren_nayar->sigma_rad, std::nullopt, true},
+                            {"albedo", o.oren_nayar->albedo, std::nullopt, true}};
             oren_nayar_prediction(p, *o.oren_nayar, r.prediction);
             r.evaluations = 1;
             r.errors = measures(p, r.prediction);
@@ -743,18 +767,24 @@ Comparison compare_brdf(const BrdfTable& table, const ComparisonOptions& o) {
         const auto steps = static_cast<long>(
             std::floor((o.lafortune_n_max - o.lafortune_n_min) / o.lafortune_n_step + 1e-9));
         std::vector<double> M(p.size());
-        double best_err = kInf, best_n = o.lafortune_n_min;
+        double best_err = kInf, worst_err = -kInf, best_n = o.lafortune_n_min;
         long best_k = 0;
         for (long k = 0; k <= steps; ++k) {
             const double n = o.lafortune_n_min + static_cast<double>(k) * o.lafortune_n_step;
             lafortune_prediction(p, n, M);
             const double e = paper_sse(p, M);
+            worst_err = std::max(worst_err, e);
             if (e < best_err) {
                 best_err = e;
                 best_n = n;
                 best_k = k;
             }
         }
+        // The data do not determine n_d when every n of the search gives the same error (to
+        // rounding): one geometry (the normalised model is 1 there whatever n), or several with
+        // the same cos θi cos θs.
+        const bool flat =
+            std::isfinite(worst_err) && worst_err - best_err <= 1e-12 * std::max(1.0, worst_err);
         r.available = true;
         r.method = "exhaustive search of n_d in [" + format_significant(o.lafortune_n_min, 6) +
                    ", " + format_significant(o.lafortune_n_max, 6) + "] in steps of " +
@@ -762,11 +792,16 @@ Comparison compare_brdf(const BrdfTable& table, const ComparisonOptions& o) {
                    std::to_string(steps + 1) + " values)";
         r.evaluations = static_cast<int>(steps + 1);
         const bool at_bound = best_k == 0 || best_k == steps;
-        r.fit_status = at_bound ? SolverStatus::AtBound : SolverStatus::Converged;
-        r.fit_message = at_bound ? "n_d = " + format_significant(best_n, 6) +
-                                       " is an end of the search interval"
-                                 : "interior minimum of the search";
-        r.parameters = {{"n", best_n, std::nullopt}};
+        r.fit_status = flat       ? SolverStatus::NotIdentifiable
+                       : at_bound ? SolverStatus::AtBound
+                                  : SolverStatus::Converged;
+        r.fit_message = flat ? "not identifiable: every n_d of the search gives the same Table-4 "
+                               "error (" +
+                                   distinct_geometries_text(p.geom) + ")"
+                        : at_bound ? "n_d = " + format_significant(best_n, 6) +
+                                         " is an end of the search interval"
+                                   : "interior minimum of the search";
+        r.parameters = {{"n", best_n, std::nullopt, !flat}};
         r.prediction.resize(p.size());
         lafortune_prediction(p, best_n, r.prediction);
         r.errors = measures(p, r.prediction);
@@ -806,7 +841,7 @@ Comparison compare_brdf(const BrdfTable& table, const ComparisonOptions& o) {
                    "); " + (gaussian ? "Eq. 4" : "Eq. 5") + " with " +
                    (v.factor == GeometricFactor::Beckmann ? "F_Beck" : "F_VH") + ", " +
                    std::string(to_string(o.radiometry));
-        r.parameters = {{"sigma_over_T", *sigma_over_T, std::nullopt}};
+        r.parameters = {{"sigma_over_T", *sigma_over_T, std::nullopt, true}};
         r.evaluations = 1;
         very_rough_prediction(p, v.factor, v.correlation, *sigma_over_T, r.prediction);
         r.errors = measures(p, r.prediction);

@@ -666,6 +666,10 @@ std::string brief_report_tail(const std::vector<FitParameter>& parameters,
                               const std::string& message) {
     std::string s;
     for (const auto& p : parameters) {
+        if (!p.identified) {
+            s += " " + p.name + " not identifiable" + (p.at_bound ? " (at bound);" : ";");
+            continue;
+        }
         s += " " + p.name + " = " + format_message(p.value, 6);
         if (covariance_available && !p.at_bound) s += " +/- " + format_message(p.std_error, 3);
         if (p.at_bound) s += " (at bound)";
@@ -699,8 +703,8 @@ LeastSquaresResult solve_least_squares(const LeastSquaresProblem& P, const Least
     res.num_data = N;
     res.num_parameters = p;
     for (const ParameterSpec& s : P.parameters)
-        res.parameters.push_back({s.name, kNaN, 0.0, s.lower, s.upper, false});
-    if (has_gain) res.parameters.push_back({"gain", kNaN, 0.0, -kInf, kInf, false});
+        res.parameters.push_back({s.name, kNaN, 0.0, s.lower, s.upper, false, true});
+    if (has_gain) res.parameters.push_back({"gain", kNaN, 0.0, -kInf, kInf, false, true});
 
     // Starts, then one Ceres run per start; the lowest final cost wins.
     const std::vector<std::vector<double>> starts = grid_starts(e, P, O, O.num_starts);
@@ -790,7 +794,7 @@ LeastSquaresResult solve_least_squares(const LeastSquaresProblem& P, const Least
     std::vector<int> all(static_cast<std::size_t>(p)), free_cols;
     std::iota(all.begin(), all.end(), 0);
     std::vector<int> bad;
-    Eigen::MatrixXd J;
+    Eigen::MatrixXd J, J_rank;
     bool have_J = false;
     if (N < p) {
         bad = all;
@@ -815,7 +819,12 @@ LeastSquaresResult solve_least_squares(const LeastSquaresProblem& P, const Least
                 }
                 if (!held) free_cols.push_back(j);
             }
-            bad = unidentified(J, free_cols, O.rank_tolerance);
+            // The rank test compares relative effects: the gain's column as ∂r/∂ln K = K ∂r/∂K,
+            // like a Log parameter's (∂r/∂ln θ); in natural units a large K would make its column
+            // look like one "without effect" and hide the parameter it trades off with.
+            J_rank = J;
+            if (has_gain) J_rank.col(n) *= std::abs(K);
+            bad = unidentified(J_rank, free_cols, O.rank_tolerance);
         }
         if (!bad.empty())
             res.message += "; the Jacobian is rank deficient: the data do not determine " +
@@ -823,8 +832,10 @@ LeastSquaresResult solve_least_squares(const LeastSquaresProblem& P, const Least
                            " (a parameter without effect, repeated geometries or constant "
                            "data, or parameters that trade off exactly)";
     }
-    for (int j : bad)
+    for (int j : bad) {
         res.not_identifiable.push_back(res.parameters[static_cast<std::size_t>(j)].name);
+        res.parameters[static_cast<std::size_t>(j)].identified = false;
+    }
     if (!bad.empty() && res.status != SolverStatus::Failed)
         res.status = SolverStatus::NotIdentifiable;
     res.evaluations = e.evaluations();
@@ -833,7 +844,7 @@ LeastSquaresResult solve_least_squares(const LeastSquaresProblem& P, const Least
     if (have_J && bad.empty()) {
         Eigen::MatrixXd C;
         const bool full =
-            unidentified(J, all, O.rank_tolerance).empty() && inverse_normal_matrix(J, all, C);
+            unidentified(J_rank, all, O.rank_tolerance).empty() && inverse_normal_matrix(J, all, C);
         const bool ok = full || inverse_normal_matrix(J, free_cols, C);
         if (ok && (N > p || !O.scale_covariance)) {
             const double scale = O.scale_covariance ? sse / (N - p) : 1.0;

@@ -77,12 +77,8 @@ void check_options(const FitOptions& o) {
     check::positive("parameter tolerance", o.parameter_tolerance);
 }
 
-void check_measurements(const std::vector<Measurement>& ms, int p) {
-    if (static_cast<int>(ms.size()) < p + 1)
-        throw InvalidArgument("measurements: " + std::to_string(ms.size()) +
-                              " given, but this fit has " + std::to_string(p) +
-                              " parameters (including the gain K) and needs at least " +
-                              std::to_string(p + 1));
+void check_measurements(const std::vector<Measurement>& ms) {
+    if (ms.empty()) throw InvalidArgument("measurements: none given; at least 1 is needed");
     for (std::size_t i = 0; i < ms.size(); ++i) {
         const std::string at = "measurement " + std::to_string(i + 1) + " ";
         check::polar_angle(at + "theta_i", ms[i].geometry.theta_i_rad);
@@ -226,6 +222,31 @@ LeastSquaresProblem make_problem(const std::vector<Measurement>& ms, const FitOp
     return P;
 }
 
+// Why a fit is not identifiable, in the user's terms: how many measurements at how many distinct
+// geometries for how many parameters (each parameter needs a geometry of its own: at one geometry
+// the model is a single number, which the gain alone matches).
+std::string identifiability_diagnosis(const std::vector<Measurement>& ms,
+                                      const std::vector<FitParameter>& parameters) {
+    std::vector<std::array<double, 3>> distinct;
+    for (const Measurement& m : ms) {
+        const std::array<double, 3> g{m.geometry.theta_i_rad, m.geometry.theta_s_rad,
+                                      m.geometry.phi_s_rad};
+        if (std::find(distinct.begin(), distinct.end(), g) == distinct.end()) distinct.push_back(g);
+    }
+    std::string unidentified;
+    for (const FitParameter& fp : parameters)
+        if (!fp.identified) unidentified += (unidentified.empty() ? "" : ", ") + fp.name;
+    const std::size_t p = parameters.size();
+    std::string s = "not identifiable: the data do not determine " + unidentified + " (" +
+                    std::to_string(ms.size()) + " measurement" + (ms.size() == 1 ? "" : "s") +
+                    " at " + std::to_string(distinct.size()) + " distinct geometr" +
+                    (distinct.size() == 1 ? "y" : "ies") + " for " + std::to_string(p) +
+                    " parameters including the gain";
+    if (distinct.size() < p)
+        s += "; at least " + std::to_string(p) + " distinct geometries are needed";
+    return s + ")";
+}
+
 LeastSquaresOptions engine_options(const FitOptions& o) {
     LeastSquaresOptions e;
     e.max_iterations = o.max_iterations;
@@ -282,7 +303,7 @@ FitResult fit_roughness(const std::vector<Measurement>& measurements, const FitO
     check_options(options);
     const int n = model_parameter_count(options);
     const int p = n + 1;
-    check_measurements(measurements, p);
+    check_measurements(measurements);
 
     const LeastSquaresResult lsq =
         solve_least_squares(make_problem(measurements, options), engine_options(options));
@@ -307,6 +328,9 @@ FitResult fit_roughness(const std::vector<Measurement>& measurements, const FitO
     result.evaluations = lsq.evaluations;
     result.initial_cost = lsq.initial_cost;
     result.final_cost = lsq.final_cost;
+    if (result.status == SolverStatus::NotIdentifiable)
+        result.message =
+            identifiability_diagnosis(measurements, result.parameters) + "; " + result.message;
     std::vector<double> natural(static_cast<std::size_t>(p));
     for (int j = 0; j < p; ++j)
         natural[static_cast<std::size_t>(j)] = lsq.parameters[static_cast<std::size_t>(j)].value;
@@ -320,9 +344,19 @@ FitResult fit_roughness(const std::vector<Measurement>& measurements, const FitO
     auto se = [&](int j) {
         return result.covariance_available ? result.parameters[j].std_error : 0.0;
     };
+    // A parameter the data do not determine gives no estimate (std::nullopt), nor do the
+    // quantities derived from it.
+    auto identified = [&](int j) {
+        return result.parameters[static_cast<std::size_t>(j)].identified;
+    };
     if (options.model == FitModel::VeryRough) {
-        est.sigma_over_T = Estimate{natural[0], se(0)};
+        if (identified(0)) est.sigma_over_T = Estimate{natural[0], se(0)};
         est.roughness_class = RoughnessClass::VeryRough;
+        est.roughness_class_assumed = true;
+    } else if (!identified(0) || !identified(1)) {
+        if (identified(0)) est.sigma_um = Estimate{natural[0], se(0)};
+        if (identified(1)) est.T_um = Estimate{natural[1], se(1)};
+        est.roughness_class = RoughnessClass::SlightlyRough;  // the model's assumption (Eq. 3)
         est.roughness_class_assumed = true;
     } else {
         const double s = natural[0] / natural[1];
@@ -345,15 +379,14 @@ FitResult fit_roughness(const std::vector<Measurement>& measurements, const FitO
     }
     fill_derived_quantities(est, geoms);
     for (const auto& fp : result.parameters)
-        if (fp.at_bound)
+        if (fp.at_bound && fp.identified)
             est.warnings.push_back(fp.name + " = " + format_message(fp.value, 6) +
                                    " is at a bound of its range [" + format_message(fp.lower, 6) +
                                    ", " + format_message(fp.upper, 6) +
                                    "]: the data do not constrain it there; its standard error "
                                    "is not meaningful");
     if (result.status == SolverStatus::NotIdentifiable)
-        est.warnings.push_back("the measurements do not determine the parameters: " +
-                               result.message);
+        est.warnings.push_back(result.message);
     else if (result.status == SolverStatus::NoConvergence || result.status == SolverStatus::Failed)
         est.warnings.push_back("the fit did not converge: " + result.message);
     return result;
@@ -367,9 +400,19 @@ CorrelationComparison compare_correlations(const std::vector<Measurement>& measu
     c.gaussian = fit_roughness(measurements, o);
     o.correlation = Correlation::Exponential;
     c.exponential = fit_roughness(measurements, o);
+    // AIC ranks fits that determine their parameters; an unidentifiable fit never wins, and the
+    // difference is unknown (NaN) unless both are identifiable.
+    const bool g_ok = c.gaussian.status != SolverStatus::NotIdentifiable;
+    const bool e_ok = c.exponential.status != SolverStatus::NotIdentifiable;
+    if (g_ok != e_ok) {
+        c.preferred = g_ok ? Correlation::Gaussian : Correlation::Exponential;
+        c.delta_aic = std::numeric_limits<double>::quiet_NaN();
+        return c;
+    }
     c.preferred =
         c.gaussian.aic <= c.exponential.aic ? Correlation::Gaussian : Correlation::Exponential;
-    c.delta_aic = std::abs(c.gaussian.aic - c.exponential.aic);
+    c.delta_aic = g_ok ? std::abs(c.gaussian.aic - c.exponential.aic)
+                       : std::numeric_limits<double>::quiet_NaN();
     return c;
 }
 

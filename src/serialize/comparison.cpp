@@ -88,7 +88,7 @@ Json comparison_json(const Comparison& c, bool series) {
         m["method"] = text_or_null(r.method);
         Json params = Json::object(), errs = Json::object();
         for (const ModelParameter& p : r.parameters) {
-            params[p.name] = number(p.value);
+            params[p.name] = p.identified ? number(p.value) : Json(nullptr);
             if (p.standard_error) errs[p.name] = number(*p.standard_error);
         }
         m["parameters"] = params;

@@ -194,8 +194,9 @@ Json to_json(const FitResult& r, bool with_residuals) {
     const FitParameter* gain = nullptr;
     for (const auto& p : r.parameters)
         if (p.name == "gain") gain = &p;
-    out["gain"] = gain ? number(gain->value) : Json(nullptr);
-    out["gain_stderr"] = gain && err ? number(gain->std_error) : Json(nullptr);
+    const bool gain_known = gain && gain->identified;
+    out["gain"] = gain_known ? number(gain->value) : Json(nullptr);
+    out["gain_stderr"] = gain_known && err ? number(gain->std_error) : Json(nullptr);
     put_derived(out, e, true);
     if (!err)
         for (const char* k : {"theta_K_deg_stderr", "xi_K_stderr", "rms_slope_stderr"})
@@ -209,12 +210,14 @@ Json to_json(const FitResult& r, bool with_residuals) {
     Json table = Json::array();
     for (const auto& p : r.parameters)
         table.push_back({{"name", p.name},
-                         {"value", number(p.value)},
+                         {"value", p.identified ? number(p.value) : Json(nullptr)},
+                         {"identified", p.identified},
                          {"stderr", err ? number(p.std_error) : Json(nullptr)},
                          {"lower", number(p.lower)},
                          {"upper", number(p.upper)},
                          {"at_bound", p.at_bound}});
     out["parameter_table"] = table;
+    out["not_identifiable"] = strings(r.not_identifiable);
     if (err) {
         Json cov = Json::array();
         for (Eigen::Index a = 0; a < r.covariance.rows(); ++a) {

@@ -222,8 +222,9 @@ def test_fit_errors(tmp_path):
     assert_error(run("estimate", "fit", "--measurements", f, check=False), EXIT_DATA, ":3:", "theta_i")
     f.write_text("theta_i,theta_s,phi_s,brightness\n10,0,0,1\n")
     assert_error(run("estimate", "fit", "--measurements", f, check=False), EXIT_DATA, "phi_i")
-    f.write_text("theta_i,phi_i,theta_s,phi_s,brightness\n10,180,0,0,1\n20,180,0,0,2\n")
-    assert_error(run("estimate", "fit", "--measurements", f, check=False), EXIT_USAGE, "at least 3")
+    f.write_text("theta_i,phi_i,theta_s,phi_s,brightness\n10,180,0,0,1\n")
+    assert_error(run("estimate", "fit", "--measurements", f, check=False), EXIT_NO_SOLUTION,
+                 "1 measurement at 1 distinct geometry")
     assert_error(run("estimate", "fit", "--measurements", tmp_path / "missing.csv", check=False), EXIT_DATA)
     assert_error(run("estimate", "fit", check=False), EXIT_USAGE, "--measurements")
 

@@ -474,9 +474,11 @@ def test_mean_scattered_power_rejects_bad_input():
 def test_shapes_that_cannot_broadcast_are_rejected():
     with pytest.raises(rs.InvalidArgument, match=r"cannot be broadcast.*\(3,\).*\(4,\)"):
         rs.very_rough_brightness(np.zeros(3), np.zeros(4), 0.0, 0.5)
-    with pytest.raises(rs.InvalidArgument, match="real number"):
+    # A wrong type is a TypeError naming the argument (test_python_inputs.py covers every
+    # function and every kind of non-real input).
+    with pytest.raises(TypeError, match="theta_i_deg must be a real number"):
         rs.lambert_brightness("thirty")
-    with pytest.raises(rs.InvalidArgument):  # None converts to NaN
+    with pytest.raises(TypeError, match="theta_i_deg .* not None"):
         rs.lambert_brightness(None)
 
 

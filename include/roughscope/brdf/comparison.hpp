@@ -113,6 +113,9 @@ struct ModelParameter {
     // Fits only: from the covariance at the optimum; none for a parameter on a bound of its
     // range, or when the parameters are not identifiable.
     std::optional<double> standard_error;
+    // False when the data do not determine it (a NotIdentifiable fit or search): `value` is then
+    // an arbitrary point of a flat direction, not a result; reports show no number for it.
+    bool identified = true;
 };
 
 struct ModelResult {
@@ -131,7 +134,13 @@ struct ModelResult {
     ErrorMeasures errors;
     std::vector<double> prediction;  // model brightness at each used measurement
 
+    // The value of parameter `name`; none when there is no such parameter or the data do not
+    // determine it (ModelParameter::identified false).
     std::optional<double> parameter(std::string_view name) const;
+    // Available, and its parameters are determined by the data: not a NotIdentifiable fit or
+    // search none of whose shape parameters (the gain aside) is identified. Only such models
+    // enter the winners.
+    bool identified() const;
 };
 
 // The two-point estimate of Table 3 (paper §4.2, Eq. 16–19, F_VH, viewer on the normal).
@@ -199,9 +208,10 @@ struct Comparison {
     TwoPointEstimate two_point;
     std::vector<ModelResult> models;  // one per kComparisonModels entry, same order
     std::vector<DataIssue> data_issues;
-    // Lowest gain_sse among every available model (fits included): the scale-free verdict.
+    // Lowest gain_sse among every identified model (ModelResult::identified; fits included): the
+    // scale-free verdict. None when no model is identified (e.g. a one-row table).
     std::optional<ComparisonModel> winner;
-    // Lowest paper_sse among the paper's six methods (the Table 4 verdict).
+    // Lowest paper_sse among the paper's six methods that are identified (the Table 4 verdict).
     std::optional<ComparisonModel> winner_paper_metric;
 
     const ModelResult& result(ComparisonModel model) const;

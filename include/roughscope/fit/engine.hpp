@@ -131,10 +131,15 @@ struct FitParameter {
     double lower = 0.0;      // bounds (gain: −inf, inf)
     double upper = 0.0;
     bool at_bound = false;  // the solution sits on a bound: its std_error is not meaningful
+    // False when the data do not determine it (listed in the result's not_identifiable): `value`
+    // is then only where the solver stopped, an arbitrary point of a flat direction, and is not
+    // a result (reports show "not identifiable" instead of the number).
+    bool identified = true;
 };
 
 // The end of a brief report: " name = value +/- std_error; ...; SSE = ..., AIC = .... message"
-// (std_error only when the covariance is available and the parameter is not on a bound).
+// (std_error only when the covariance is available and the parameter is not on a bound; a
+// parameter that is not identified shows " name not identifiable;" and no number).
 std::string brief_report_tail(const std::vector<FitParameter>& parameters,
                               bool covariance_available, double sse, double aic,
                               const std::string& message);

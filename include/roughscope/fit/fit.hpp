@@ -109,13 +109,21 @@ struct FitResult {
 };
 
 // Fits the model of `options` to the measurements. Throws InvalidArgument for bad input
-// (fewer than p + 1 measurements, brightness or weight not > 0, a geometry outside [0°, 90°),
-// bad options); a solver failure is reported in the result's status, not thrown.
+// (no measurement, brightness or weight not > 0, a geometry outside [0°, 90°), bad options); a
+// solver failure is reported in the result's status, not thrown. Data that cannot determine the
+// parameters — fewer distinct geometries than parameters (gain included), e.g. one measurement
+// or repeated geometries, or a rank-deficient Jacobian — give SolverStatus::NotIdentifiable:
+// the message says why (measurements, distinct geometries, parameters), the parameters the data
+// do not determine have FitParameter::identified = false, and the estimate leaves them (and
+// what derives from them) empty. N = p measurements at distinct geometries determine the
+// parameters exactly but give no standard errors (N − p = 0 degrees of freedom).
 FitResult fit_roughness(const std::vector<Measurement>& measurements,
                         const FitOptions& options = {});
 
 // Fits the same data with both correlation functions (Gaussian, exponential), all other options
 // as given. preferred is the one with the lower AIC; delta_aic = AIC(other) − AIC(preferred).
+// A NotIdentifiable fit is never preferred over an identifiable one; delta_aic is NaN unless
+// both are identifiable.
 struct CorrelationComparison {
     FitResult gaussian;
     FitResult exponential;

@@ -453,6 +453,52 @@ TEST(Comparison, NoPositiveDataLeavesEveryModelUnavailable) {
     EXPECT_FALSE(c.winner.has_value());
 }
 
+// A table that cannot determine any model parameter — one row, or every row at one geometry
+// (the normalised data and every normalised model are 1 there) — gives no fit and no search
+// result: every fit and the Lafortune search are NotIdentifiable with the reason, no parameter
+// value is identified, and there is no winner (never "converged" with an arbitrary value).
+TEST(Comparison, OneGeometryIdentifiesNoModel) {
+    for (const int rows : {1, 3}) {
+        BrdfTable t;
+        t.name = "one geometry";
+        for (int k = 1; k <= rows; ++k)
+            t.measurements.push_back(make_brdf_measurement(k, 0.5, 0.0, 0.2, kPi, 0.1));
+        ComparisonOptions o;
+        o.measurement1 = 1;
+        o.measurement2 = 2;
+        const Comparison c = compare_brdf(t, o);
+        const std::string where = std::to_string(rows) + " rows";
+        for (const ModelResult& r : c.models) {
+            EXPECT_FALSE(r.identified()) << display_name(r.model) << ", " << where;
+            if (!r.available) continue;
+            ASSERT_TRUE(r.fit_status.has_value()) << display_name(r.model);
+            EXPECT_EQ(*r.fit_status, SolverStatus::NotIdentifiable)
+                << display_name(r.model) << ", " << where << ": " << r.fit_message;
+            EXPECT_NE(r.fit_message.find("1 distinct geometry"), std::string::npos)
+                << r.fit_message;
+            for (const ModelParameter& p : r.parameters)
+                if (p.name != "gain" || is_fit(r.model)) {
+                    EXPECT_FALSE(p.identified) << display_name(r.model) << " " << p.name;
+                    EXPECT_FALSE(p.standard_error.has_value());
+                }
+        }
+        EXPECT_FALSE(c.result(ComparisonModel::Lafortune).parameter("n").has_value()) << where;
+        EXPECT_FALSE(c.winner.has_value()) << where;
+        EXPECT_FALSE(c.winner_paper_metric.has_value()) << where;
+    }
+    // Two distinct geometries identify the one-parameter models again.
+    BrdfTable t;
+    t.name = "two geometries";
+    t.measurements.push_back(make_brdf_measurement(1, 0.5, 0.0, 0.2, kPi, 0.1));
+    t.measurements.push_back(make_brdf_measurement(2, 0.9, 0.0, 0.2, kPi, 0.07));
+    ComparisonOptions o;
+    o.measurement1 = 1;
+    o.measurement2 = 2;
+    const Comparison c = compare_brdf(t, o);
+    EXPECT_TRUE(c.result(ComparisonModel::Lafortune).identified());
+    EXPECT_TRUE(c.winner.has_value());
+}
+
 TEST(Comparison, BadOptionsAndEmptyTablesThrow) {
     const BrdfTable t = synthetic_table([](const Geometry& g) { return std::cos(g.theta_i_rad); });
     ComparisonOptions o;

@@ -280,6 +280,29 @@ TEST(FitEngineIdentifiability, RepeatedGeometryIsNotEnough) {
     EXPECT_NE(r.message.find("k"), std::string::npos);
 }
 
+TEST(FitEngineIdentifiability, RepeatedGeometryNamesTheParameterWhateverTheGainsScale) {
+    // A model of order 1e-20 against data of order 1 (gain ≈ 1e20, e.g. a very rough brightness
+    // far outside its lobe), all at one x: k and the gain trade off exactly, and both are named
+    // — the gain's size must not make it look like a parameter without effect.
+    const std::vector<double> x(3, 0.7);
+    rs::LeastSquaresProblem P;
+    P.parameters = {param("k", 0.01, 10.0, rs::Transform::Log, 0.5)};
+    P.model = [x](std::span<const double> t, std::span<double> out) {
+        for (std::size_t i = 0; i < x.size(); ++i) out[i] = 1e-20 * std::exp(-t[0] * x[i]);
+        return true;
+    };
+    P.data = {1.0, 1.1, 0.9};
+    P.residual = rs::ResidualType::Relative;
+    P.gain = rs::GainMode::Profiled;
+    const auto r = rs::solve_least_squares(P);
+    EXPECT_EQ(r.status, rs::SolverStatus::NotIdentifiable) << r.brief_report();
+    EXPECT_EQ(r.not_identifiable, (std::vector<std::string>{"k", "gain"})) << r.brief_report();
+    for (const auto& p : r.parameters) EXPECT_FALSE(p.identified) << p.name;
+    // No number for what the data do not determine.
+    EXPECT_NE(r.brief_report().find("k not identifiable"), std::string::npos) << r.brief_report();
+    EXPECT_EQ(r.brief_report().find("k = "), std::string::npos) << r.brief_report();
+}
+
 TEST(FitEngineIdentifiability, ConstantDataDoNotDetermineTheShape) {
     // A lobe exp(−(x/w)²) times a gain against constant data: the width runs off to where the
     // lobe is flat and has no effect any more.
