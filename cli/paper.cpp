@@ -7,12 +7,12 @@
 // where the agreement marks are defined); this file only prints the document as text or JSON.
 #include <cmath>
 #include <filesystem>
-#include <fstream>
 #include <functional>
 #include <memory>
 #include <optional>
 #include <sstream>
 #include <string>
+#include <system_error>
 #include <vector>
 
 #include "commands.hpp"
@@ -54,18 +54,15 @@ void add_cells(std::vector<std::string>& cells, const json& c, int printed_decim
     cells.push_back(mark(c));
 }
 
+// The reference document (serialize/paper_tables.hpp; DataError naming the file and the place).
 json load_reference(const fs::path& path) {
-    std::ifstream in(path);
-    if (!in)
+    std::error_code ec;
+    if (!fs::exists(path, ec))
         throw roughscope::DataError(
             "paper tables not found at " + path.string() +
             " (the printed values live beside the project in ../shared/reference/; run from the "
             "project root or give --reference FILE)");
-    try {
-        return json::parse(in);
-    } catch (const json::exception& e) {
-        throw roughscope::DataError(path.string() + ": not valid JSON (" + e.what() + ")");
-    }
+    return serialize::read_paper_tables_reference(path);
 }
 
 void run_tables(const Args& a) {

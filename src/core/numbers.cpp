@@ -8,6 +8,7 @@
 #include <system_error>
 
 #include "roughscope/core/errors.hpp"
+#include "roughscope/core/text.hpp"
 
 namespace roughscope {
 namespace {
@@ -39,7 +40,7 @@ std::optional<double> try_parse_number(std::string_view text, std::string& reaso
         reason = "empty (a number is required)";
         return std::nullopt;
     }
-    if (s.front() == '+') s.remove_prefix(1);
+    if (s.front() == '+' && s.size() > 1 && s[1] != '-') s.remove_prefix(1);
     double value = 0.0;
     const auto [ptr, ec] = std::from_chars(s.data(), s.data() + s.size(), value);
     if (ec == std::errc::result_out_of_range) {
@@ -65,7 +66,37 @@ double parse_number(std::string_view text, std::string_view what) {
     std::string reason;
     const auto value = try_parse_number(text, reason);
     if (!value)
-        throw InvalidArgument(std::string(what) + ": '" + std::string(trim_space(text)) + "' is " +
+        throw InvalidArgument(std::string(what) + ": " + quote_input(trim_space(text)) + " is " +
+                              reason);
+    return *value;
+}
+
+std::optional<long long> try_parse_integer(std::string_view text, long long lo, long long hi,
+                                           std::string& reason) {
+    std::string_view s = trim_space(text);
+    if (s.empty()) {
+        reason = "empty (an integer is required)";
+        return std::nullopt;
+    }
+    if (s.front() == '+' && s.size() > 1 && s[1] != '-') s.remove_prefix(1);
+    long long value = 0;
+    const auto [ptr, ec] = std::from_chars(s.data(), s.data() + s.size(), value, 10);
+    if (ec == std::errc::invalid_argument || ptr != s.data() + s.size()) {
+        reason = "not an integer (decimal digits only)";
+        return std::nullopt;
+    }
+    if (ec == std::errc::result_out_of_range || value < lo || value > hi) {
+        reason = "out of the range [" + std::to_string(lo) + ", " + std::to_string(hi) + "]";
+        return std::nullopt;
+    }
+    return value;
+}
+
+long long parse_integer(std::string_view text, long long lo, long long hi, std::string_view what) {
+    std::string reason;
+    const auto value = try_parse_integer(text, lo, hi, reason);
+    if (!value)
+        throw InvalidArgument(std::string(what) + ": " + quote_input(trim_space(text)) + " is " +
                               reason);
     return *value;
 }
@@ -82,8 +113,7 @@ std::vector<double> parse_number_list(std::string_view text, std::size_t count,
     }
     if (parts.size() != count)
         throw InvalidArgument(std::string(what) + ": expected " + std::to_string(count) +
-                              " comma-separated numbers, got '" + std::string(trim_space(text)) +
-                              "'");
+                              " comma-separated numbers, got " + quote_input(trim_space(text)));
     std::vector<double> out;
     out.reserve(count);
     for (std::size_t i = 0; i < parts.size(); ++i)
@@ -110,7 +140,11 @@ std::string format_significant(double value, int digits, std::string_view name) 
 std::string format_message(double value, int digits) {
     if (std::isnan(value)) return "nan";
     if (std::isinf(value)) return value > 0 ? "inf" : "-inf";
-    if (digits > 0) return printf_g(value, digits < 17 ? digits : 17);
+    if (digits > 0) {
+        // Rounded only when nothing is lost: a value just past a limit must not print as the limit.
+        std::string rounded = printf_g(value, digits < 17 ? digits : 17);
+        if (std::strtod(rounded.c_str(), nullptr) == value) return rounded;
+    }
     char buf[64];
     const auto res = std::to_chars(buf, buf + sizeof buf, value);
     return std::string(buf, res.ptr);
