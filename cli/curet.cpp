@@ -306,7 +306,8 @@ void register_curet(CLI::App& app) {
         "FILE.csv). See docs/curet.md.");
     const std::string what = "What to compare";
     cmd->add_option("--sample", a.sample, "CUReT sample number (1..61)")
-        ->transform(integer_validator(std::numeric_limits<int>::min(), std::numeric_limits<int>::max()))
+        ->transform(
+            integer_validator(std::numeric_limits<int>::min(), std::numeric_limits<int>::max()))
         ->group(what);
     cmd->add_flag("--all", a.all, "Every sample of the database")->group(what);
     cmd->add_option("--table", a.table_path,

@@ -217,11 +217,10 @@ fs::path find_curet_directory(const std::optional<fs::path>& explicit_dir) {
     if (explicit_dir) {
         std::error_code ec;
         if (!fs::is_directory(*explicit_dir, ec))
-            throw DataError("CUReT directory " + explicit_dir->string() +
-                            (fs::exists(*explicit_dir, ec) ? " is not a directory"
-                                                           : " does not exist") +
-                            "; it must be a directory holding " + kNeededFiles + ", from " +
-                            kWhereFrom);
+            throw DataError(
+                "CUReT directory " + explicit_dir->string() +
+                (fs::exists(*explicit_dir, ec) ? " is not a directory" : " does not exist") +
+                "; it must be a directory holding " + kNeededFiles + ", from " + kWhereFrom);
         if (!has_curet_files(*explicit_dir))
             throw DataError("CUReT directory " + explicit_dir->string() + " lacks " +
                             (fs::exists(*explicit_dir / "table.txt") ? "abrdf.dat" : "table.txt") +

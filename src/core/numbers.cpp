@@ -24,6 +24,20 @@ std::string printf_g(double value, int digits) {
     return buf;
 }
 
+// Significant digits of a "%g" text (trailing zeros are already dropped by %g).
+int significant_digits(std::string_view text) {
+    int count = 0;
+    bool leading = true;
+    for (const char c : text) {
+        if (c == 'e' || c == 'E') break;
+        if (c < '0' || c > '9') continue;
+        if (leading && c == '0') continue;
+        leading = false;
+        ++count;
+    }
+    return count;
+}
+
 }  // namespace
 
 std::string_view trim_space(std::string_view s) {
@@ -141,9 +155,11 @@ std::string format_message(double value, int digits) {
     if (std::isnan(value)) return "nan";
     if (std::isinf(value)) return value > 0 ? "inf" : "-inf";
     if (digits > 0) {
-        // Rounded only when nothing is lost: a value just past a limit must not print as the limit.
+        // Rounding that ends in a shorter, rounder number than asked for ("1" for 1.00000001 at
+        // 7 digits) would show the value equal to a limit it breaks: then every digit is shown.
         std::string rounded = printf_g(value, digits < 17 ? digits : 17);
-        if (std::strtod(rounded.c_str(), nullptr) == value) return rounded;
+        if (significant_digits(rounded) >= digits || std::strtod(rounded.c_str(), nullptr) == value)
+            return rounded;
     }
     char buf[64];
     const auto res = std::to_chars(buf, buf + sizeof buf, value);

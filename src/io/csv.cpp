@@ -178,8 +178,8 @@ bool CsvReader::next(CsvRow& row) {
             std::string reason;
             const auto value = try_parse_number(cell, reason);
             if (!value)
-                throw DataError(lines_.where() + "column " + header_[c] + ": " +
-                                quote_input(cell) + " is " + reason);
+                throw DataError(lines_.where() + "column " + header_[c] + ": " + quote_input(cell) +
+                                " is " + reason);
             row.values.emplace(header_[c], *value);
         }
         ++rows_;

@@ -1,17 +1,17 @@
 #include "roughscope/serialize/paper_tables.hpp"
 
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
 #include <cstddef>
-#include <functional>
-#include <string>
-#include <vector>
-#include <cerrno>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <iterator>
+#include <string>
 #include <string_view>
+#include <vector>
 
 #include "roughscope/core/errors.hpp"
 #include "roughscope/estimation/estimation.hpp"
@@ -209,7 +209,8 @@ Json one_table(Json (*compute)(const Json&, const std::string&), const char* key
 std::string line_and_column(std::string_view text, std::size_t offset) {
     offset = std::min(offset, text.size());
     const std::string_view before = text.substr(0, offset);
-    const std::size_t line = 1 + static_cast<std::size_t>(std::count(before.begin(), before.end(), '\n'));
+    const std::size_t line =
+        1 + static_cast<std::size_t>(std::count(before.begin(), before.end(), '\n'));
     const std::size_t last_newline = before.rfind('\n');
     const std::size_t column =
         last_newline == std::string_view::npos ? offset + 1 : offset - last_newline;
@@ -251,6 +252,5 @@ Json read_paper_tables_reference(const std::filesystem::path& path) {
         throw DataError(name + ": " + line_and_column(text, offset) + ": not valid JSON: " + what);
     }
 }
-
 
 }  // namespace roughscope::serialize

@@ -4,8 +4,8 @@
 // front end can show it to the user verbatim. The message is made printable and bounded on the
 // way in (core/text.hpp: control characters and invalid UTF-8 escaped, at most kMessageMaxBytes
 // kept), so a value read from a file can never reach a terminal raw, cut a C string at a NUL
-// byte, or make a Python exception without a message. The CLI turns any roughscope::Error into a one-line
-// message and a non-zero exit status; the Python module raises ValueError subclasses.
+// byte, or make a Python exception without a message. The CLI turns any roughscope::Error into a
+// one-line message and a non-zero exit status; the Python module raises ValueError subclasses.
 #pragma once
 
 #include <stdexcept>

@@ -10,11 +10,11 @@
 //                         output); refuses NaN/infinity (results are never printed as NaN);
 //  * format_significant — fixed number of significant digits ("%.*g") for human-readable text;
 //                         refuses NaN/infinity too;
-//  * format_message     — error messages: at least the shortest round-trip form, so that a
-//                         value is never printed equal to the limit it breaks ("kappa =
-//                         1.0000001 must exceed 1", not "kappa = 1 must exceed 1"); "nan",
-//                         "inf" and "-inf" spelled out (the value being reported may be the bad
-//                         one).
+//  * format_message     — error messages: shortest round-trip form, or fixed significant
+//                         digits when asked, but never rounded to a shorter, rounder number
+//                         that is not the value ("kappa = 1.00000001 must exceed 1", not
+//                         "kappa = 1 must exceed 1"); "nan", "inf" and "-inf" spelled out (the
+//                         value being reported may be the bad one).
 //
 // Integers (counts, sample and measurement numbers given as text): try_parse_integer, the same
 // rules as numbers (decimal digits only, optional sign, surrounding spaces allowed; no "0x19",
@@ -64,9 +64,10 @@ std::string format_roundtrip(double value, std::string_view name = "value");
 // roughscope::Error naming `name` for NaN or infinity.
 std::string format_significant(double value, int digits, std::string_view name = "value");
 
-// For error messages only: `digits` significant digits when that text reads back as the same
-// double, else (and for digits <= 0) the shortest round-trip form; "nan", "inf", "-inf" spelled
-// out.
+// For error messages only: the shortest round-trip form, or `digits` significant digits when
+// digits > 0 — unless the rounded text has fewer significant digits than `digits` and does not
+// read back as the value (1.00000001 at 7 digits is "1.00000001", not "1"); "nan", "inf", "-inf"
+// spelled out.
 std::string format_message(double value, int digits = 0);
 
 // `value` rounded to `digits` significant digits (the value format_significant prints). NaN,

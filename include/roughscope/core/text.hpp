@@ -43,7 +43,6 @@ std::string printable_text(std::string_view text);
 std::string quote_input(std::string_view text, std::size_t max_bytes = kQuoteMaxBytes);
 
 // printable_text of the first max_bytes bytes of `message`, then "… (N bytes in all)" when cut.
-std::string printable_message(std::string_view message,
-                              std::size_t max_bytes = kMessageMaxBytes);
+std::string printable_message(std::string_view message, std::size_t max_bytes = kMessageMaxBytes);
 
 }  // namespace roughscope
