@@ -221,10 +221,17 @@ fs::path find_curet_directory(const std::optional<fs::path>& explicit_dir) {
                 "CUReT directory " + explicit_dir->string() +
                 (fs::exists(*explicit_dir, ec) ? " is not a directory" : " does not exist") +
                 "; it must be a directory holding " + kNeededFiles + ", from " + kWhereFrom);
-        if (!has_curet_files(*explicit_dir))
-            throw DataError("CUReT directory " + explicit_dir->string() + " lacks " +
-                            (fs::exists(*explicit_dir / "table.txt") ? "abrdf.dat" : "table.txt") +
-                            "; it must hold " + kNeededFiles + ", from " + kWhereFrom);
+        for (const char* name : {"table.txt", "abrdf.dat"}) {
+            const fs::path file = *explicit_dir / name;
+            if (!fs::exists(file, ec))
+                throw DataError("CUReT directory " + explicit_dir->string() + " lacks " + name +
+                                "; it must hold " + kNeededFiles + ", from " + kWhereFrom);
+            if (!fs::is_regular_file(file, ec))
+                throw DataError(file.string() + ": " +
+                                (fs::is_directory(file, ec) ? "is a directory, not a file"
+                                                            : "is not a regular file") +
+                                "; the CUReT directory must hold " + kNeededFiles);
+        }
         return *explicit_dir;
     }
     // The reference-data locator (io/data_locator.hpp): $ROUGHSCOPE_SHARED_DIR/data/curet, else

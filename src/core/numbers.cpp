@@ -24,6 +24,9 @@ std::string printf_g(double value, int digits) {
     return buf;
 }
 
+// Relative differences this small are floating-point noise, not information, in a message.
+constexpr double kConversionNoise = 1e-14;
+
 // Significant digits of a "%g" text (trailing zeros are already dropped by %g).
 int significant_digits(std::string_view text) {
     int count = 0;
@@ -156,9 +159,13 @@ std::string format_message(double value, int digits) {
     if (std::isinf(value)) return value > 0 ? "inf" : "-inf";
     if (digits > 0) {
         // Rounding that ends in a shorter, rounder number than asked for ("1" for 1.00000001 at
-        // 7 digits) would show the value equal to a limit it breaks: then every digit is shown.
+        // 7 digits) would show the value equal to a limit it breaks: then every digit is shown,
+        // unless the difference is rounding noise of a unit conversion (29.999999999999996 deg
+        // from 30 deg in radians stays "30").
         std::string rounded = printf_g(value, digits < 17 ? digits : 17);
-        if (significant_digits(rounded) >= digits || std::strtod(rounded.c_str(), nullptr) == value)
+        const double shown = std::strtod(rounded.c_str(), nullptr);
+        if (significant_digits(rounded) >= digits ||
+            std::abs(shown - value) <= kConversionNoise * std::abs(value))
             return rounded;
     }
     char buf[64];

