@@ -660,3 +660,19 @@ TEST(BrdfCsvPolicy, SameVariantsAsEveryReader) {
     EXPECT_EQ(ansi.find('\x1b'), std::string::npos) << ansi;
     EXPECT_NE(ansi.find("\\x1b[31mphi_i"), std::string::npos) << ansi;
 }
+
+TEST(BrdfCsvPolicy, MeasurementNumbersAreDecimalDigitsOnly) {
+    const std::string header = "theta_i,phi_i,theta_s,phi_s,value,measurement\n";
+    EXPECT_EQ(parse_brdf_csv(header + "30,180,20,0,0.5, 7 \n", "t.csv").measurements[0].index, 7);
+    for (const char* bad : {"7.0", "0x7", "7e0"}) {
+        try {
+            parse_brdf_csv(header + "30,180,20,0,0.5," + bad + "\n", "t.csv");
+            FAIL() << bad;
+        } catch (const DataError& e) {
+            EXPECT_NE(std::string(e.what()).find("t.csv:2: column measurement: '" +
+                                                 std::string(bad) + "' is not a"),
+                      std::string::npos)
+                << e.what();
+        }
+    }
+}
