@@ -588,7 +588,7 @@ void register_estimate(CLI::App& app) {
         a.o_initial_T = add_positive_option(*cmd, "--initial-T", a.initial_T_um,
                                             "Starting T (um; default automatic)", "um");
         cmd->add_option("--max-iterations", a.max_iterations, "Solver iterations (default 200)")
-            ->check(CLI::Range(1, 100000));
+            ->transform(integer_validator(1, 100000));
         cmd->add_flag("--residuals", a.residuals, "Include the residuals in the JSON output");
         add_output_options(*cmd, a.out);
         cmd->callback([args]() { run_fit(*args); });
