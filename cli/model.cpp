@@ -298,7 +298,8 @@ double evaluate_bk(const Args& a, const Point& p, const Roughness& r, json& out)
         if (p.geom) {
             const json power = serialize::to_json(mean_scattered_power(*p.geom, surface, options));
             brightness = power["brightness"].get<double>();
-            for (const char* k : {"coherent", "diffuse", "total", "g", "regime", "roughness_class"})
+            for (const char* k : {"coherent", "diffuse", "total", "g", "regime", "roughness_class",
+                                  "method", "relative_error_bound"})
                 out[k] = power[k];
         } else {
             coherent = diffuse = total = 0.0;  // light or viewer below the horizon
@@ -334,6 +335,8 @@ double evaluate_bk(const Args& a, const Point& p, const Roughness& r, json& out)
         out["g"] = to_json_number(g);
         out["regime"] = regime ? json(*regime) : json(nullptr);
         out["roughness_class"] = roughness_class ? json(*roughness_class) : json(nullptr);
+        out["method"] = std::string(to_string(DiffuseMethod::ClosedForm));
+        out["relative_error_bound"] = 0.0;
     }
     out["scale"] = absolute ? "absolute" : "relative";
     out["correlation"] = std::string(to_string(a.correlation));

@@ -286,6 +286,8 @@ constexpr std::array<GeometricFactor, 4> kFactors = {
 constexpr std::array<Radiometry, 2> kRadiometries = {Radiometry::Radiance, Radiometry::Intensity};
 constexpr std::array<Regime, 5> kRegimes = {Regime::Auto, Regime::Series, Regime::SlightlyRough,
                                             Regime::VeryRough, Regime::VeryRoughSeriesLimit};
+constexpr std::array<DiffuseMethod, 3> kMethods = {
+    DiffuseMethod::ClosedForm, DiffuseMethod::Summation, DiffuseMethod::LargeGExpansion};
 constexpr std::array<RoughnessClass, 3> kRoughnessClasses = {
     RoughnessClass::SlightlyRough, RoughnessClass::ModeratelyRough, RoughnessClass::VeryRough};
 
@@ -641,11 +643,12 @@ F_Beck(0, 0, ·) = 1; retro (θ, θ, 180): 1/cos²θ. Angles in degrees.)doc");
             auto& ops = operands.first;  // not a structured binding (the lambdas below name it)
             auto& b = operands.second;
             py::array_t<double> coh = make_output(b), dif = make_output(b), tot = make_output(b),
-                                bri = make_output(b), gg = make_output(b);
-            py::array_t<std::uint8_t> reg(b.shape), cls(b.shape);
+                                bri = make_output(b), gg = make_output(b), bnd = make_output(b);
+            py::array_t<std::uint8_t> reg(b.shape), cls(b.shape), met(b.shape);
             double *oc = coh.mutable_data(), *od = dif.mutable_data(), *ot = tot.mutable_data(),
-                   *ob = bri.mutable_data(), *og = gg.mutable_data();
-            std::uint8_t *orr = reg.mutable_data(), *ocl = cls.mutable_data();
+                   *ob = bri.mutable_data(), *og = gg.mutable_data(), *obd = bnd.mutable_data();
+            std::uint8_t *orr = reg.mutable_data(), *ocl = cls.mutable_data(),
+                         *om = met.mutable_data();
             for_each_element(b, true, [&](ssize_t i) {
                 const auto x = values_at(ops, i);
                 ModelOptions o = opt;
@@ -659,6 +662,9 @@ F_Beck(0, 0, ·) = 1; retro (θ, θ, 180): 1/cos²θ. Angles in degrees.)doc");
                 ot[i] = p.total;
                 ob[i] = p.brightness;
                 og[i] = p.g;
+                obd[i] = p.relative_error_bound;
+                om[i] = static_cast<std::uint8_t>(
+                    std::find(kMethods.begin(), kMethods.end(), p.method) - kMethods.begin());
                 orr[i] = static_cast<std::uint8_t>(
                     std::find(kRegimes.begin(), kRegimes.end(), p.regime) - kRegimes.begin());
                 ocl[i] = static_cast<std::uint8_t>(std::find(kRoughnessClasses.begin(),
@@ -674,6 +680,8 @@ F_Beck(0, 0, ·) = 1; retro (θ, θ, 180): 1/cos²θ. Angles in degrees.)doc");
             d["g"] = finish(b, gg);
             d["regime"] = names_from_codes(b, reg, enum_names(kRegimes));
             d["roughness_class"] = names_from_codes(b, cls, enum_names(kRoughnessClasses));
+            d["method"] = names_from_codes(b, met, enum_names(kMethods));
+            d["relative_error_bound"] = finish(b, bnd);
             return d;
         },
         arg("theta_i_deg"), arg("theta_s_deg"), arg("phi_s_deg"), arg("sigma_um"), arg("T_um"),
@@ -694,9 +702,12 @@ Angles in degrees (θ in [0, 90)); sigma_um, T_um, wavelength_um, patch_x_um, pa
 All numeric arguments broadcast together.
 
 Returns a dict: 'coherent', 'diffuse', 'total' (= P), 'brightness', 'g' (floats or arrays),
-'regime' (the regime actually used, never 'auto') and 'roughness_class' ('slightly_rough',
-'moderately_rough', 'very_rough' by g): a str for scalar input, else a NumPy str array of the
-broadcast shape.)doc");
+'regime' (the regime actually used, never 'auto'), 'roughness_class' ('slightly_rough',
+'moderately_rough', 'very_rough' by g) and 'method' ('closed_form', 'summation' or
+'large_g_expansion': how D was evaluated; the series switches to its large-g expansion where the
+sum underflows or loses accuracy): a str for scalar input, else a NumPy str array of the
+broadcast shape; 'relative_error_bound' (float or array): bound on the relative error of D against
+the exact series (0 for a closed form asked for by name). Lengths must be in [1e-30, 1e30] µm.)doc");
 
     m.def("very_rough_brightness", &very_rough_brightness_py, arg("theta_i_deg"),
           arg("theta_s_deg"), arg("phi_s_deg"), arg("sigma_over_T"), py::kw_only(),
