@@ -291,6 +291,16 @@ constexpr std::array<DiffuseMethod, 3> kMethods = {
 constexpr std::array<RoughnessClass, 3> kRoughnessClasses = {
     RoughnessClass::SlightlyRough, RoughnessClass::ModeratelyRough, RoughnessClass::VeryRough};
 
+// The unchecked pure terms (diffuse_power_*) overflow for extreme combinations of their inputs:
+// an InvalidArgument (ValueError) instead of inf or NaN.
+double representable(double value) {
+    if (!std::isfinite(value))
+        throw InvalidArgument(
+            "the result is not representable as a double for these inputs (it overflows or is "
+            "0/0); keep the lengths in [1e-30, 1e30] um as mean_scattered_power does");
+    return value;
+}
+
 // =============================================================================================
 // very_rough_brightness over arrays: the library's batch kernel (scattering/brightness_batch.hpp)
 // =============================================================================================
@@ -534,7 +544,7 @@ phi_s_deg) with phi_s_deg in [0, 360).)doc");
             for_each_element(b, true, [&](ssize_t i) {
                 const auto x = values_at(ops, i);
                 const Geometry g = geometry_deg(x[0], x[1], x[2]);
-                check::positive("wavelength_um", x[3], "um");
+                check_length_um("wavelength_um", x[3]);
                 const ScatteringVector v = scattering_vector(g, x[3]);
                 ox[i] = v.vx;
                 oy[i] = v.vy;
@@ -556,7 +566,8 @@ k = 2π/λ. Angles in degrees, wavelength_um > 0 (default 0.555, the paper's). R
                                  [](double ti, double ts, double sigma, double wl) {
                                      const Geometry g = geometry_deg(ti, ts, 0.0);
                                      check::non_negative("sigma_um", sigma, "um");
-                                     check::positive("wavelength_um", wl, "um");
+                                     if (sigma != 0.0) check_length_um("sigma_um", sigma);
+                                     check_length_um("wavelength_um", wl);
                                      return roughness_g(g, sigma, wl);
                                  });
         },
@@ -602,8 +613,8 @@ F_Beck(0, 0, ·) = 1; retro (θ, θ, 180): 1/cos²θ. Angles in degrees.)doc");
                                  [](double x, double y, double X, double Y) {
                                      check::finite("vx", x);
                                      check::finite("vy", y);
-                                     check::positive("patch_x_um", X, "um");
-                                     check::positive("patch_y_um", Y, "um");
+                                     check_length_um("patch_x_um", X);
+                                     check_length_um("patch_y_um", Y);
                                      return specular_amplitude_rho0(x, y, X, Y);
                                  });
         },
@@ -615,7 +626,9 @@ F_Beck(0, 0, ·) = 1; retro (θ, θ, 180): 1/cos²θ. Angles in degrees.)doc");
         "coherent_power",
         [](py::handle rho0, py::handle g) {
             return map_double<2>({"rho0", "g"}, {rho0, g}, [](double r, double gg) {
-                check::finite("rho0", r);
+                if (!(r >= -1.0 && r <= 1.0))  // ρ0 is a product of two sincs (§3.1)
+                    throw InvalidArgument("rho0 = " + check::format_number(r) +
+                                          " is outside the valid range [-1, 1]");
                 check::non_negative("g", gg);
                 return coherent_power(r, gg);
             });
@@ -763,7 +776,7 @@ exponential-correlation series without its prefactor. g >= 0, T2_vxy2 >= 0.)doc"
                                          check::positive("area_um2", A, "um^2");
                                          check::non_negative("g", gg);
                                          check::non_negative("vxy2", v, "1/um^2");
-                                         return fn(f2, T, A, gg, v);
+                                         return representable(fn(f2, T, A, gg, v));
                                      });
             },
             py::arg("F2"), py::arg("T_um"), py::arg("area_um2"), py::arg("g"), py::arg("vxy2"),
@@ -818,7 +831,7 @@ exponential-correlation series without its prefactor. g >= 0, T2_vxy2 >= 0.)doc"
                         check::positive("area_um2", A, "um^2");
                         check::positive("vz2", vz, "1/um^2");
                         check::non_negative("vxy2", v, "1/um^2");
-                        return fn(f2, s, T, A, vz, v);
+                        return representable(fn(f2, s, T, A, vz, v));
                     });
             },
             py::arg("F2"), py::arg("sigma_um"), py::arg("T_um"), py::arg("area_um2"),

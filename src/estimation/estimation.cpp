@@ -178,7 +178,9 @@ double sigma_from_specular(double R_spec, double theta_rad, double wavelength_um
         throw InvalidArgument("R_spec = " + check::format_number(R_spec) +
                               " is invalid: it must be below R0 = " + check::format_number(R0) +
                               " (Eq. 13 needs 0 < R_spec < R0)");
-    return wavelength_um / (4.0 * kPi * std::cos(theta_rad)) * std::sqrt(std::log(R0 / R_spec));
+    // ln(R0/R_spec) as a difference: R0/R_spec overflows for a subnormal R_spec.
+    return wavelength_um / (4.0 * kPi * std::cos(theta_rad)) *
+           std::sqrt(std::log(R0) - std::log(R_spec));
 }
 
 namespace {
@@ -302,7 +304,7 @@ double d_correlation_length_d_sigma(double E1_over_E2, double sigma_um, double t
 double d_sigma_d_specular_reflectance(double R_spec, double theta_rad, double wavelength_um,
                                       double R0) {
     const double sigma = sigma_from_specular(R_spec, theta_rad, wavelength_um, R0);
-    return -sigma / (2.0 * R_spec * std::log(R0 / R_spec));
+    return -sigma / (2.0 * R_spec * (std::log(R0) - std::log(R_spec)));
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -706,7 +708,14 @@ RoughnessEstimate estimate_sigma_specular(const SpecularInput& in) {
                                               in.relative_noise_dif * in.relative_noise_dif);
     const double dsdR = d_sigma_d_specular_reflectance(R, in.theta_rad, in.wavelength_um, in.R0);
     RoughnessEstimate est;
-    est.sigma_um = Estimate{sigma, std::abs(dsdR) * sd_R};
+    const double sd_sigma = sd_R == 0.0 ? 0.0 : std::abs(dsdR) * sd_R;
+    est.sigma_um = Estimate{sigma, sd_sigma};
+    if (!std::isfinite(sd_sigma))
+        est.warnings.push_back(
+            "the standard error of sigma is unavailable: at R_spec = " +
+            check::format_number(R) +
+            " dsigma/dR_spec times the noise exceeds the double range (R_spec is too close to 0 "
+            "for the noise to bound sigma)");
     // Eq. 12 (the coherent term) holds in every regime: no class is assumed.
     const Geometry geom = specular_geometry(in.theta_rad);
     fill_roughness_class(est, {geom}, sigma, in.wavelength_um, std::nullopt);

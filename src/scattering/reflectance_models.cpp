@@ -76,6 +76,13 @@ double lafortune_brdf(const Geometry& geom, const std::vector<LafortuneLobe>& lo
         const double dot =
             lobe.Cx * L.x() * V.x() + lobe.Cy * L.y() * V.y() + lobe.Cz * L.z() * V.z();
         if (dot > 0.0) f += lobe.albedo * std::pow(dot, lobe.n);  // else: a physical zero
+        if (!std::isfinite(f))
+            throw InvalidArgument(name + ": albedo (Cx Lx Vx + Cy Ly Vy + Cz Lz Vz)^n = " +
+                                  check::format_number(lobe.albedo) + " * " +
+                                  check::format_number(dot) + "^" +
+                                  check::format_number(lobe.n) +
+                                  " exceeds the double range; use coefficients with a bracket "
+                                  "<= 1 (a physical lobe) or a smaller n");
     }
     return f;
 }

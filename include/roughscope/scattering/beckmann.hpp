@@ -93,7 +93,10 @@ double exponential_series_sum_naive(double g, double T2_vxy2, int max_terms);
 
 // ρ0 = sinc(vx X) sinc(vy Y) for a 2X × 2Y patch (§3.1); ρ0 = 1 in the specular direction.
 inline double specular_amplitude_rho0(double vx, double vy, double X_um, double Y_um) {
-    auto sinc = [](double x) { return std::abs(x) < 1e-8 ? 1.0 - x * x / 6.0 : std::sin(x) / x; };
+    auto sinc = [](double x) {  // → 0 as |x| → ∞ (also where vx·X overflows)
+        if (!(std::abs(x) <= 1.7976931348623157e308)) return 0.0;
+        return std::abs(x) < 1e-8 ? 1.0 - x * x / 6.0 : std::sin(x) / x;
+    };
     return sinc(vx * X_um) * sinc(vy * Y_um);
 }
 
