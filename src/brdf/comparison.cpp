@@ -732,10 +732,9 @@ Comparison compare_brdf(const BrdfTable& table, const ComparisonOptions& o) {
             r.errors = measures(p, r.prediction);
             if (!std::isfinite(r.errors.paper_sse)) {  // albedo 0: the model is 0 everywhere
                 r.available = false;
-                r.reason =
-                    "the Oren-Nayar model with albedo = " +
-                    check::format_number(o.oren_nayar->albedo) +
-                    " is 0 at every measurement: it cannot be normalised to the data";
+                r.reason = "the Oren-Nayar model with albedo = " +
+                           check::format_number(o.oren_nayar->albedo) +
+                           " is 0 at every measurement: it cannot be normalised to the data";
             }
         } else {
             r.reason =

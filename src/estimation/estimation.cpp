@@ -128,11 +128,11 @@ double sigma_over_T_gaussian_from_ratio(double E1_over_E2, double theta1_rad, do
     const double radicand = (p.a2 - p.a1) / log_kappa;
     const double kappa = std::exp(log_kappa);
     if (!(radicand > 0.0) || !std::isfinite(radicand))
-        throw_no_solution("Gaussian correlation (Eq. 17)", E1_over_E2, theta1_rad, theta2_rad,
-                          factor, ratio_range_gaussian(theta1_rad, theta2_rad, factor),
-                          " (kappa = " +
-                              (std::isfinite(kappa) ? fmt(kappa) : std::string("above 1e308")) +
-                              (p.a2 > p.a1 ? " must exceed 1)" : " must be below 1)"));
+        throw_no_solution(
+            "Gaussian correlation (Eq. 17)", E1_over_E2, theta1_rad, theta2_rad, factor,
+            ratio_range_gaussian(theta1_rad, theta2_rad, factor),
+            " (kappa = " + (std::isfinite(kappa) ? fmt(kappa) : std::string("above 1e308")) +
+                (p.a2 > p.a1 ? " must exceed 1)" : " must be below 1)"));
     return 0.5 * std::sqrt(radicand);
 }
 
@@ -695,13 +695,12 @@ RoughnessEstimate estimate_sigma_specular(const SpecularInput& in) {
         R = specular_reflectance_from_brightness(*in.E_tot, *in.E_dif);
         check::positive("R0", in.R0);
         if (!(R < in.R0))  // name the inputs, not only the derived R_spec
-            throw InvalidArgument("R_spec = 1 - E_dif/E_tot = " + check::format_number(R) +
-                                  " (E_tot = " + check::format_number(*in.E_tot) +
-                                  ", E_dif = " + check::format_number(*in.E_dif) +
-                                  ") is invalid: it must be below R0 = " +
-                                  check::format_number(in.R0) +
-                                  " (Eq. 13 needs 0 < R_spec < R0; E_dif/E_tot must exceed " +
-                                  check::format_number(1.0 - in.R0) + ")");
+            throw InvalidArgument(
+                "R_spec = 1 - E_dif/E_tot = " + check::format_number(R) + " (E_tot = " +
+                check::format_number(*in.E_tot) + ", E_dif = " + check::format_number(*in.E_dif) +
+                ") is invalid: it must be below R0 = " + check::format_number(in.R0) +
+                " (Eq. 13 needs 0 < R_spec < R0; E_dif/E_tot must exceed " +
+                check::format_number(1.0 - in.R0) + ")");
     }
     const double sigma = sigma_from_specular(R, in.theta_rad, in.wavelength_um, in.R0);
     const double sd_R = (1.0 - R) * std::sqrt(in.relative_noise_tot * in.relative_noise_tot +
@@ -712,8 +711,7 @@ RoughnessEstimate estimate_sigma_specular(const SpecularInput& in) {
     est.sigma_um = Estimate{sigma, sd_sigma};
     if (!std::isfinite(sd_sigma))
         est.warnings.push_back(
-            "the standard error of sigma is unavailable: at R_spec = " +
-            check::format_number(R) +
+            "the standard error of sigma is unavailable: at R_spec = " + check::format_number(R) +
             " dsigma/dR_spec times the noise exceeds the double range (R_spec is too close to 0 "
             "for the noise to bound sigma)");
     // Eq. 12 (the coherent term) holds in every regime: no class is assumed.

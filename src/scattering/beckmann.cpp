@@ -187,9 +187,8 @@ double diffuse_power_quadrature(Correlation correlation, double F2, double T_um,
                               check::format_number(kQuadratureMaxTvxy) + "]");
     const double scale = 2.0 * kPi / area_um2 * F2 * T_um * T_um;  // D = scale ∫ ... du
     if (!std::isfinite(scale))
-        throw InvalidArgument("(2 pi/A) F2 T^2 = " + check::format_number(scale) +
-                              " (F2 = " + check::format_number(F2) +
-                              ", T = " + check::format_number(T_um) +
+        throw InvalidArgument("(2 pi/A) F2 T^2 = " + check::format_number(scale) + " (F2 = " +
+                              check::format_number(F2) + ", T = " + check::format_number(T_um) +
                               " um, area = " + check::format_number(area_um2) +
                               " um^2) is outside the domain of diffuse_power_quadrature: it "
                               "must be a finite number");

@@ -32,10 +32,10 @@ double oren_nayar_radiance(const Geometry& geom, const OrenNayarParams& p) {
     const double cos_dphi = -std::cos(geom.phi_s_rad);  // cos(φr − φi) with φi = π
     const double C1 = 1.0 - 0.5 * oren_nayar_saturation(s2, 0.33);
     const double two_beta_pi = 2.0 * beta / kPi;
-    const double C2 =
-        cos_dphi >= 0.0
-            ? 0.45 * oren_nayar_saturation(s2, 0.09) * std::sin(alpha)
-            : 0.45 * oren_nayar_saturation(s2, 0.09) * (std::sin(alpha) - two_beta_pi * two_beta_pi * two_beta_pi);
+    const double C2 = cos_dphi >= 0.0
+                          ? 0.45 * oren_nayar_saturation(s2, 0.09) * std::sin(alpha)
+                          : 0.45 * oren_nayar_saturation(s2, 0.09) *
+                                (std::sin(alpha) - two_beta_pi * two_beta_pi * two_beta_pi);
     const double ab = 4.0 * alpha * beta / (kPi * kPi);
     const double C3 = 0.125 * oren_nayar_saturation(s2, 0.09) * ab * ab;
     const double E0cos = std::cos(ti);  // irradiance for unit E0 along L
@@ -79,8 +79,7 @@ double lafortune_brdf(const Geometry& geom, const std::vector<LafortuneLobe>& lo
         if (!std::isfinite(f))
             throw InvalidArgument(name + ": albedo (Cx Lx Vx + Cy Ly Vy + Cz Lz Vz)^n = " +
                                   check::format_number(lobe.albedo) + " * " +
-                                  check::format_number(dot) + "^" +
-                                  check::format_number(lobe.n) +
+                                  check::format_number(dot) + "^" + check::format_number(lobe.n) +
                                   " exceeds the double range; use coefficients with a bracket "
                                   "<= 1 (a physical lobe) or a smaller n");
     }

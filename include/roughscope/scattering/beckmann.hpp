@@ -61,7 +61,7 @@ std::string_view to_string(DiffuseMethod m);  // "closed_form", "summation", "la
 //    fixed and nothing overflows; for wide peaks (g ≳ 200) by the exponentially convergent
 //    trapezoid rule on the analytic continuation of the summand (Poisson summation), so the cost
 //    stays bounded (~1 µs) however large g is. Relative error ≲ 1e−13 up to g = 1e7 (checked
-//    against 40-digit references), bound stated as 1e−13 + 1e−21·g.
+//    against 40-digit references), bound stated as 2e−13 + 1e−21·g.
 //  * Large-g expansion (g ≥ 1e4 where its bound is the smaller, always for g > 1e13): the
 //    very-rough limit (Eq. 4; for the exponential case the series limit) times 1 + R1/g, with
 //    the bound 2(|R2|/g² + |R3|/g³) + rounding from the next terms (series.cpp,

@@ -591,7 +591,7 @@ TEST(Errors, NoSolutionForKappaAtMostOneInEq17) {
         const std::string m = e.what();
         EXPECT_NE(m.find("E1/E2 = 1"), std::string::npos) << m;
         EXPECT_NE(m.find("must be > 1.025"), std::string::npos) << m;  // C = 1.02502, no upper
-        EXPECT_EQ(m.find("inf"), std::string::npos) << m;               // bound: never "inf"
+        EXPECT_EQ(m.find("inf"), std::string::npos) << m;              // bound: never "inf"
     }
 }
 
