@@ -866,7 +866,9 @@ exponential-correlation series without its prefactor. g >= 0, T2_vxy2 >= 0.)doc"
         arg("correlation"), arg("F2"), arg("T_um"), arg("area_um2"), arg("g"), arg("vxy2"),
         R"doc(The diffuse Kirchhoff integral by direct numerical quadrature, independent of the series:
 D = (2π/A) F² exp(−g) ∫₀^∞ [exp(g C(τ)) − 1] J0(v_xy τ) τ dτ, C the 'gaussian' or 'exponential'
-correlation. Slow (milliseconds per value); for g ≲ 50 and T v_xy ≲ 50.)doc");
+correlation. Slow (up to ~0.3 s per value). Domain: 0 <= g <= 1e4 and 0 <= T v_xy <= 100 (else
+InvalidArgument naming the value); absolute error <= 1e-12 of the integral's size at the lobe
+centre; never negative.)doc");
 
     // ---- Retro-scattering closed forms (Eq. 7–11) -----------------------------------------
     auto retro_vr = [&m](const char* name, double (*fn)(double, double), const char* doc) {

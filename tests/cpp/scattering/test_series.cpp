@@ -418,7 +418,7 @@ TEST(SeriesEveryG, MethodAndBoundAreReported) {
     }
 }
 
-// The B–K model at the scale of the example (σ = 2 m, g = 1.67e15): the default Auto
+// The B–K model at metre scale (σ = 2 m, T = 4 m, g = 1.67e15): the default Auto
 // regime equals the very-rough form (Eq. 4) and says it used the expansion.
 TEST(SeriesEveryG, ModelAtMetreScaleUsesTheExpansion) {
     using namespace roughscope;
