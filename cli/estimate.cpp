@@ -129,7 +129,7 @@ CLI::Option* add_wavelength_option(
     CLI::App& cmd, double& wavelength_um,
     const std::string& description = "Mean wavelength lambda (um; default 0.555)") {
     // The library's length range (scattering/beckmann.hpp): no product of lengths overflows.
-    return add_range_option(cmd, "--wavelength", wavelength_um, kMinLength_um, kMaxLength_um,
+    return add_range_option(cmd, "--wavelength", wavelength_um, kMinLengthUm, kMaxLengthUm,
                             description);
 }
 

@@ -49,14 +49,14 @@ std::string_view to_string(DiffuseMethod m) {
 }
 
 void check_length_um(std::string_view name, double value_um) {
-    if (!(value_um >= kMinLength_um && value_um <= kMaxLength_um)) {
+    if (!(value_um >= kMinLengthUm && value_um <= kMaxLengthUm)) {
         std::string message(name);
         message.append(" = ")
             .append(check::format_number(value_um))
             .append(" um is outside the valid range [")
-            .append(check::format_number(kMinLength_um))
+            .append(check::format_number(kMinLengthUm))
             .append(", ")
-            .append(check::format_number(kMaxLength_um))
+            .append(check::format_number(kMaxLengthUm))
             .append("] um");
         throw InvalidArgument(message);
     }

@@ -184,10 +184,10 @@ inline double very_rough_shape_exponential(double F2, const ScatteringDirection&
 // Lengths (σ, T, λ, X, Y) accepted by the validated functions, in µm: from below the Planck
 // length to beyond the observable universe, so that no product of lengths and wavenumbers in
 // Eq. 1–5 overflows or underflows to a meaningless 0/0.
-inline constexpr double kMinLength_um = 1e-30;
-inline constexpr double kMaxLength_um = 1e30;
+inline constexpr double kMinLengthUm = 1e-30;
+inline constexpr double kMaxLengthUm = 1e30;
 // Throws InvalidArgument "<name> = <value> um is outside the valid range [1e-30, 1e+30] um"
-// unless kMinLength_um <= value_um <= kMaxLength_um.
+// unless kMinLengthUm <= value_um <= kMaxLengthUm.
 void check_length_um(std::string_view name, double value_um);
 
 struct Surface {
@@ -225,7 +225,7 @@ struct ScatteredPower {
 };
 
 // Eq. 1 at one geometry. Validates: θi, θs in [0°, 90°), φs finite, σ, T, λ, X, Y in
-// [kMinLength_um, kMaxLength_um], auto_tolerance in (0, 1); throws InvalidArgument naming the
+// [kMinLengthUm, kMaxLengthUm], auto_tolerance in (0, 1); throws InvalidArgument naming the
 // input otherwise. Every result field is finite: where the power itself exceeds the double range
 // (grazing geometries with a patch far below the wavelength) it throws InvalidArgument saying so.
 ScatteredPower mean_scattered_power(const Geometry& geom, const Surface& surface,
