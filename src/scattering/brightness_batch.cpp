@@ -14,7 +14,7 @@
 #include "roughscope/core/names.hpp"
 #include "roughscope/scattering/geometry.hpp"
 
-#if defined(__x86_64__) && defined(__GLIBC__) && (defined(__GNUC__) || defined(__clang__))
+#if defined(__x86_64__) && defined(__GLIBC__) && defined(__GNUC__) && !defined(__clang__)
 #define ROUGHSCOPE_HAVE_LIBMVEC 1
 #include <immintrin.h>
 #else
