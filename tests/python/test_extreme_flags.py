@@ -22,6 +22,9 @@ import pytest
 
 from conftest import cli_path
 
+# Drives the CLI: also run against the sanitizer build (`make sanitize`, DEVELOPERS.md).
+pytestmark = pytest.mark.cli
+
 NAN_RE = re.compile(r"\b(nan|inf|infinity)\b", re.IGNORECASE)
 # "  --sigma FLOAT:> 0   ..." / "  --max-iterations INT:INT in [1 - 100000]" / "--pair INT x 2"
 FLAG_RE = re.compile(r"^\s+(?:-\w,)?(--[\w-]+) (FLOAT|INT)\b( x (\d+))?", re.MULTILINE)

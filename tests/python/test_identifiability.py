@@ -17,6 +17,9 @@ import roughscope as rs
 
 from conftest import cli_path
 
+# Drives the CLI: also run against the sanitizer build (`make sanitize`, DEVELOPERS.md).
+pytestmark = pytest.mark.cli
+
 EXIT_NO_SOLUTION = 3
 HEADER = "theta_i,phi_i,theta_s,phi_s,brightness\n"
 TABLE_HEADER = "theta_i,phi_i,theta_s,phi_s,value\n"

@@ -20,6 +20,9 @@ import pytest
 
 from conftest import cli_path
 
+# Drives the CLI: also run against the sanitizer build (`make sanitize`, DEVELOPERS.md).
+pytestmark = pytest.mark.cli
+
 # One geometry, printed as CSV when --output is given.
 ONE_POINT = ["model", "--theta-i", "30", "--theta-s", "20", "--phi-s", "0", "--sigma", "1",
              "--T", "2"]

@@ -15,6 +15,9 @@ import pytest
 
 from conftest import cli_path
 
+# Drives the CLI: also run against the sanitizer build (`make sanitize`, DEVELOPERS.md).
+pytestmark = pytest.mark.cli
+
 BINARY = b"\x7fELF\x02\x01\x01\x00\x00\x00\x1b[2J" + bytes(range(256))
 
 
