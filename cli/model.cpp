@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <array>
+#include <charconv>
 #include <cmath>
 #include <filesystem>
 #include <iostream>
@@ -277,8 +278,34 @@ std::vector<LafortuneLobe> lafortune_lobes(const Args& a) {
 
 json to_json_number(const std::optional<double>& v) { return serialize::number(v); }
 
+// A result record: its keys (string literals) in output order and their JSON values. Unlike a JSON
+// object it allocates no key and looks keys up without hashing; to_json() gives the object, and
+// RecordWriter formats the record directly with the bytes the object's dump would give.
+class Record {
+  public:
+    Record() { items_.reserve(32); }  // every key of a record without regrowing
+    json& operator[](std::string_view key) {
+        for (auto& [k, v] : items_)
+            if (k == key) return v;
+        return items_.emplace_back(key, json()).second;
+    }
+    bool contains(std::string_view key) const {
+        return std::any_of(items_.begin(), items_.end(),
+                           [key](const auto& item) { return item.first == key; });
+    }
+    const std::vector<std::pair<std::string_view, json>>& items() const { return items_; }
+    json to_json() const {
+        json out = json::object();
+        for (const auto& [k, v] : items_) out[std::string(k)] = v;
+        return out;
+    }
+
+  private:
+    std::vector<std::pair<std::string_view, json>> items_;
+};
+
 // B–K model (Eq. 1–5, §3.2–3.3) at one point: adds its keys to `out`, returns the brightness.
-double evaluate_bk(const Args& a, const Point& p, const Roughness& r, json& out) {
+double evaluate_bk(const Args& a, const Point& p, const Roughness& r, Record& out) {
     const bool absolute = r.sigma_um.has_value();
     std::optional<double> coherent, diffuse, total, g;
     std::optional<std::string> regime, roughness_class;
@@ -360,9 +387,8 @@ double evaluate_bk(const Args& a, const Point& p, const Roughness& r, json& out)
 }
 
 // Evaluates the chosen model at one point; returns the result record (keys in output order).
-json evaluate(const Args& a, const Point& p, const Roughness& r) {
-    json out = json::object();
-    out.get_ref<json::object_t&>().reserve(32);  // every key of a record without regrowing
+Record evaluate(const Args& a, const Point& p, const Roughness& r) {
+    Record out;
     out["model"] = model_name(a.model);
     // Angles of a geometry echoed as the shortest degrees that map to the same radians.
     const auto angle = [&](double deg, const std::optional<double> rad) {
@@ -477,24 +503,110 @@ std::string csv_text(const json& record) {
     return out;
 }
 
+// A string that JSON and CSV output write as its bytes: printable ASCII without quote, backslash
+// or CSV separator (every key and word of a record).
+bool plain_text(std::string_view text) {
+    return std::all_of(text.begin(), text.end(), [](char c) {
+        return c >= 0x20 && c < 0x7f && c != '"' && c != '\\' && c != ',';
+    });
+}
+
+// Appends a scalar JSON value as dump() writes it; false (nothing appended) for an array or
+// object or a string that needs escaping.
+bool append_json_scalar(std::string& out, const json& v) {
+    switch (v.type()) {
+        case json::value_t::null:
+            out += "null";
+            return true;
+        case json::value_t::boolean:
+            out += v.get<bool>() ? "true" : "false";
+            return true;
+        case json::value_t::number_float: {
+            // nlohmann's own shortest round-trip formatter, as its serializer calls it.
+            std::array<char, 64> buf{};
+            const double x = v.get<double>();
+            if (!std::isfinite(x)) {
+                out += "null";
+                return true;
+            }
+            const char* end = nlohmann::detail::to_chars(buf.data(), buf.data() + buf.size(), x);
+            out.append(buf.data(), static_cast<std::size_t>(end - buf.data()));
+            return true;
+        }
+        case json::value_t::string: {
+            const auto& text = v.get_ref<const std::string&>();
+            if (!plain_text(text)) return false;
+            out += '"';
+            out += text;
+            out += '"';
+            return true;
+        }
+        case json::value_t::number_integer:
+        case json::value_t::number_unsigned:
+            out += v.dump();
+            return true;
+        default:
+            return false;
+    }
+}
+
+// Appends the CSV cell of a scalar value (cell_text, quoted by csv_field when needed).
+void append_csv_cell(std::string& out, const json& v) {
+    if (v.is_number_float()) {
+        // format_result's "%.10g" (no "-0"), without a temporary string.
+        const double x = v.get<double>();
+        std::array<char, 64> buf{};
+        const auto [end, ec] =
+            std::to_chars(buf.data(), buf.data() + buf.size(), x == 0.0 ? 0.0 : x,
+                          std::chars_format::general, kPrintDigits);
+        if (ec == std::errc() && std::isfinite(x)) {
+            out.append(buf.data(), static_cast<std::size_t>(end - buf.data()));
+            return;
+        }
+    }
+    const std::string cell = cell_text(v);
+    if (cell.find_first_of(",\"\n\r") == std::string::npos)
+        out += cell;  // csv_field would return it unchanged
+    else
+        out += csv_field(cell);
+}
+
 // Writes the records of `model --csv` one at a time: CSV (header from the first record) or a JSON
-// array byte-identical to serialize::dump of the whole array, without holding the records.
+// array byte-identical to serialize::dump of the whole array, without holding the records. Each
+// record is formatted straight into the output buffer.
 class RecordWriter {
   public:
     RecordWriter(io::OutputFile& out, bool json_output) : out_(out), json_(json_output) {}
 
-    void add(json record) {
+    void add(const Record& record) {
         chunk_.clear();
         if (json_) {
-            // The element as the whole array's dump indents it: "[\n" + element + "\n]\n".
-            json one = json::array();
-            one.push_back(std::move(record));
-            const std::string text = serialize::dump(one);
             chunk_.append(count_ == 0 ? "[\n" : ",\n");
-            chunk_.append(text, 2, text.size() - 5);
+            if (!append_json_element(record)) {
+                // Nested values (Lafortune lobes): the element as the whole array's dump indents
+                // it: "[\n" + element + "\n]\n".
+                json one = json::array();
+                one.push_back(record.to_json());
+                const std::string text = serialize::dump(one);
+                chunk_.append(text, 2, text.size() - 5);
+            }
         } else {
-            if (count_ == 0) chunk_ = csv_header(record);
-            append_csv_line(chunk_, record);
+            if (count_ == 0) {
+                bool first = true;
+                for (const auto& item : record.items()) {
+                    if (!first) chunk_ += ',';
+                    chunk_ += csv_field(std::string(item.first));
+                    first = false;
+                }
+                chunk_ += '\n';
+            }
+            bool first = true;
+            for (const auto& item : record.items()) {
+                if (!first) chunk_ += ',';
+                append_csv_cell(chunk_, item.second);
+                first = false;
+            }
+            chunk_ += '\n';
         }
         out_.write(chunk_);
         ++count_;
@@ -508,6 +620,31 @@ class RecordWriter {
     std::size_t count() const { return count_; }
 
   private:
+    // The element "  {\n    \"key\": value,\n ...\n  }" as dump(2) indents it inside the array;
+    // false (chunk_ unchanged) when a value is nested or needs escaping.
+    bool append_json_element(const Record& record) {
+        const std::size_t mark = chunk_.size();
+        if (record.items().empty()) {
+            chunk_ += "  {}";
+            return true;
+        }
+        chunk_ += "  {\n";
+        bool first = true;
+        for (const auto& [key, value] : record.items()) {
+            if (!first) chunk_ += ",\n";
+            first = false;
+            chunk_ += "    \"";
+            chunk_ += key;
+            chunk_ += "\": ";
+            if (!plain_text(key) || !append_json_scalar(chunk_, value)) {
+                chunk_.resize(mark);
+                return false;
+            }
+        }
+        chunk_ += "\n  }";
+        return true;
+    }
+
     io::OutputFile& out_;
     bool json_;
     std::size_t count_ = 0;
@@ -576,7 +713,7 @@ void run_model(const Args& a) {
 
     if (!given(a.o_csv)) {
         const Point p = point_from_flags(a);
-        const json record = evaluate(a, p, roughness_from_flags(a));
+        const json record = evaluate(a, p, roughness_from_flags(a)).to_json();
         std::string text;
         if (a.json_output) {
             text = serialize::dump(record);

@@ -537,6 +537,14 @@ bool jacobian(const Evaluator& e, const LeastSquaresProblem& P, std::vector<doub
     return J.allFinite();
 }
 
+// The upper-triangular factor R (p×p) of the thin QR decomposition J = QR of a tall J (rows ≥
+// columns), computed in place: J is overwritten (and released by the caller's reassignment).
+Eigen::MatrixXd triangular_factor(Eigen::MatrixXd& J) {
+    const Eigen::Index p = J.cols();
+    const Eigen::HouseholderQR<Eigen::Ref<Eigen::MatrixXd>> qr(J);
+    return qr.matrixQR().topRows(p).triangularView<Eigen::Upper>();
+}
+
 // Identifiability of the columns `cols` of J: the names of the parameters that the data do not
 // determine (empty when J restricted to cols has full column rank).
 std::vector<int> unidentified(const Eigen::MatrixXd& J, const std::vector<int>& cols, double tol) {
@@ -819,6 +827,10 @@ LeastSquaresResult solve_least_squares(const LeastSquaresProblem& P, const Least
                 }
                 if (!held) free_cols.push_back(j);
             }
+            // Everything below depends on J only through JᵀJ: J = QR (thin, Householder, in
+            // place) gives the p×p factor R with RᵀR = JᵀJ, the same column norms and singular
+            // values, so that no further copy of the N×p Jacobian is needed (N can be 1e6).
+            J = triangular_factor(J);
             // The rank test compares relative effects: the gain's column as ∂r/∂ln K = K ∂r/∂K,
             // like a Log parameter's (∂r/∂ln θ); in natural units a large K would make its column
             // look like one "without effect" and hide the parameter it trades off with.
