@@ -14,6 +14,7 @@
 #include <iostream>
 #include <memory>
 #include <optional>
+#include <span>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -278,30 +279,96 @@ std::vector<LafortuneLobe> lafortune_lobes(const Args& a) {
 
 json to_json_number(const std::optional<double>& v) { return serialize::number(v); }
 
-// A result record: its keys (string literals) in output order and their JSON values. Unlike a JSON
-// object it allocates no key and looks keys up without hashing; to_json() gives the object, and
-// RecordWriter formats the record directly with the bytes the object's dump would give.
+// A result record: its keys (string literals) in output order and their values. Unlike a JSON
+// object it allocates no key, and one record is reused row after row (clear() keeps the slots and
+// their strings' storage); to_json() gives the object, and RecordWriter formats the record
+// directly with the bytes the object's dump would give.
 class Record {
   public:
+    // A JSON value: null, a boolean, a number, a string, or (Nested) any other JSON value.
+    struct Value {
+        enum class Kind { Null, Boolean, Number, Text, Nested };
+        Kind kind = Kind::Null;
+        bool boolean = false;
+        double number = 0.0;
+        std::string text;
+        json nested;
+
+        Value& operator=(std::nullptr_t) {
+            kind = Kind::Null;
+            return *this;
+        }
+        Value& operator=(bool b) {
+            kind = Kind::Boolean;
+            boolean = b;
+            return *this;
+        }
+        Value& operator=(std::string_view t) {
+            kind = Kind::Text;
+            text.assign(t);
+            return *this;
+        }
+        Value& operator=(const char* t) { return *this = std::string_view(t); }
+        Value& operator=(const std::string& t) { return *this = std::string_view(t); }
+        Value& operator=(const json& j) {
+            if (j.is_null()) return *this = nullptr;
+            if (j.is_boolean()) return *this = j.get<bool>();
+            if (j.is_string()) return *this = std::string_view(j.get_ref<const std::string&>());
+            if (j.is_number_float()) {
+                kind = Kind::Number;
+                number = j.get<double>();
+                return *this;
+            }
+            kind = Kind::Nested;
+            nested = j;
+            return *this;
+        }
+        json to_json() const {
+            switch (kind) {
+                case Kind::Null:
+                    return nullptr;
+                case Kind::Boolean:
+                    return boolean;
+                case Kind::Number:
+                    return number;
+                case Kind::Text:
+                    return text;
+                case Kind::Nested:
+                    break;
+            }
+            return nested;
+        }
+    };
+    struct Item {
+        std::string_view key;
+        Value value;
+    };
+
     Record() { items_.reserve(32); }  // every key of a record without regrowing
-    json& operator[](std::string_view key) {
-        for (auto& [k, v] : items_)
-            if (k == key) return v;
-        return items_.emplace_back(key, json()).second;
+    void clear() { size_ = 0; }
+    Value& operator[](std::string_view key) {
+        for (std::size_t k = 0; k < size_; ++k)
+            if (items_[k].key == key) return items_[k].value;
+        if (size_ == items_.size()) items_.emplace_back();
+        Item& item = items_[size_++];
+        item.key = key;
+        item.value = nullptr;
+        return item.value;
     }
     bool contains(std::string_view key) const {
-        return std::any_of(items_.begin(), items_.end(),
-                           [key](const auto& item) { return item.first == key; });
+        return std::any_of(items_.begin(), items_.begin() + static_cast<std::ptrdiff_t>(size_),
+                           [key](const Item& item) { return item.key == key; });
     }
-    const std::vector<std::pair<std::string_view, json>>& items() const { return items_; }
+    std::span<const Item> items() const { return {items_.data(), size_}; }
     json to_json() const {
         json out = json::object();
-        for (const auto& [k, v] : items_) out[std::string(k)] = v;
+        for (const Item& item : items()) out[std::string(item.key)] = item.value.to_json();
         return out;
     }
 
   private:
-    std::vector<std::pair<std::string_view, json>> items_;
+    std::vector<Item> items_;
+    std::size_t size_ = 0;
 };
 
 // B–K model (Eq. 1–5, §3.2–3.3) at one point: adds its keys to `out`, returns the brightness.
@@ -386,9 +453,9 @@ double evaluate_bk(const Args& a, const Point& p, const Roughness& r, Record& ou
     return brightness;
 }
 
-// Evaluates the chosen model at one point; returns the result record (keys in output order).
-Record evaluate(const Args& a, const Point& p, const Roughness& r) {
-    Record out;
+// Evaluates the chosen model at one point into `out` (keys in output order).
+void evaluate(const Args& a, const Point& p, const Roughness& r, Record& out) {
+    out.clear();
     out["model"] = model_name(a.model);
     // Angles of a geometry echoed as the shortest degrees that map to the same radians.
     const auto angle = [&](double deg, const std::optional<double> rad) {
@@ -445,7 +512,6 @@ Record evaluate(const Args& a, const Point& p, const Roughness& r) {
         }
     }
     out["brightness"] = serialize::number(brightness);
-    return out;
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -511,60 +577,61 @@ bool plain_text(std::string_view text) {
     });
 }
 
-// Appends a scalar JSON value as dump() writes it; false (nothing appended) for an array or
-// object or a string that needs escaping.
-bool append_json_scalar(std::string& out, const json& v) {
-    switch (v.type()) {
-        case json::value_t::null:
+// Appends a value as dump() writes it (outside an array or object); false (nothing appended) for
+// a nested value or a string that needs escaping.
+bool append_json_scalar(std::string& out, const Record::Value& v) {
+    using Kind = Record::Value::Kind;
+    switch (v.kind) {
+        case Kind::Null:
             out += "null";
             return true;
-        case json::value_t::boolean:
-            out += v.get<bool>() ? "true" : "false";
+        case Kind::Boolean:
+            out += v.boolean ? "true" : "false";
             return true;
-        case json::value_t::number_float: {
-            // nlohmann's own shortest round-trip formatter, as its serializer calls it.
-            std::array<char, 64> buf{};
-            const double x = v.get<double>();
-            if (!std::isfinite(x)) {
+        case Kind::Number: {
+            if (!std::isfinite(v.number)) {
                 out += "null";
                 return true;
             }
-            const char* end = nlohmann::detail::to_chars(buf.data(), buf.data() + buf.size(), x);
+            // nlohmann's own shortest round-trip formatter, as its serializer calls it.
+            std::array<char, 64> buf{};
+            const char* end =
+                nlohmann::detail::to_chars(buf.data(), buf.data() + buf.size(), v.number);
             out.append(buf.data(), static_cast<std::size_t>(end - buf.data()));
             return true;
         }
-        case json::value_t::string: {
-            const auto& text = v.get_ref<const std::string&>();
-            if (!plain_text(text)) return false;
+        case Kind::Text:
+            if (!plain_text(v.text)) return false;
             out += '"';
-            out += text;
+            out += v.text;
             out += '"';
             return true;
-        }
-        case json::value_t::number_integer:
-        case json::value_t::number_unsigned:
-            out += v.dump();
-            return true;
-        default:
-            return false;
+        case Kind::Nested:
+            break;
     }
+    return false;
 }
 
-// Appends the CSV cell of a scalar value (cell_text, quoted by csv_field when needed).
-void append_csv_cell(std::string& out, const json& v) {
-    if (v.is_number_float()) {
+// Appends the CSV cell of a value (cell_text, quoted by csv_field when needed).
+void append_csv_cell(std::string& out, const Record::Value& v) {
+    using Kind = Record::Value::Kind;
+    if (v.kind == Kind::Number && std::isfinite(v.number)) {
         // format_result's "%.10g" (no "-0"), without a temporary string.
-        const double x = v.get<double>();
         std::array<char, 64> buf{};
         const auto [end, ec] =
-            std::to_chars(buf.data(), buf.data() + buf.size(), x == 0.0 ? 0.0 : x,
+            std::to_chars(buf.data(), buf.data() + buf.size(), v.number == 0.0 ? 0.0 : v.number,
                           std::chars_format::general, kPrintDigits);
-        if (ec == std::errc() && std::isfinite(x)) {
+        if (ec == std::errc()) {
             out.append(buf.data(), static_cast<std::size_t>(end - buf.data()));
             return;
         }
     }
-    const std::string cell = cell_text(v);
+    if (v.kind == Kind::Null) return;  // cell_text: ""
+    if (v.kind == Kind::Text && plain_text(v.text)) {
+        out += v.text;
+        return;
+    }
+    const std::string cell = cell_text(v.to_json());
     if (cell.find_first_of(",\"\n\r") == std::string::npos)
         out += cell;  // csv_field would return it unchanged
     else
@@ -595,7 +662,7 @@ class RecordWriter {
                 bool first = true;
                 for (const auto& item : record.items()) {
                     if (!first) chunk_ += ',';
-                    chunk_ += csv_field(std::string(item.first));
+                    chunk_ += csv_field(std::string(item.key));
                     first = false;
                 }
                 chunk_ += '\n';
@@ -603,7 +670,7 @@ class RecordWriter {
             bool first = true;
             for (const auto& item : record.items()) {
                 if (!first) chunk_ += ',';
-                append_csv_cell(chunk_, item.second);
+                append_csv_cell(chunk_, item.value);
                 first = false;
             }
             chunk_ += '\n';
@@ -630,13 +697,13 @@ class RecordWriter {
         }
         chunk_ += "  {\n";
         bool first = true;
-        for (const auto& [key, value] : record.items()) {
+        for (const Record::Item& item : record.items()) {
             if (!first) chunk_ += ",\n";
             first = false;
             chunk_ += "    \"";
-            chunk_ += key;
+            chunk_ += item.key;
             chunk_ += "\": ";
-            if (!plain_text(key) || !append_json_scalar(chunk_, value)) {
+            if (!plain_text(item.key) || !append_json_scalar(chunk_, item.value)) {
                 chunk_.resize(mark);
                 return false;
             }
@@ -713,7 +780,9 @@ void run_model(const Args& a) {
 
     if (!given(a.o_csv)) {
         const Point p = point_from_flags(a);
-        const json record = evaluate(a, p, roughness_from_flags(a)).to_json();
+        Record result;
+        evaluate(a, p, roughness_from_flags(a), result);
+        const json record = result.to_json();
         std::string text;
         if (a.json_output) {
             text = serialize::dump(record);
@@ -736,6 +805,7 @@ void run_model(const Args& a) {
     const std::size_t c_ps = *reader.column_index("phi_s");
     io::OutputFile out = io::open_output(output);
     RecordWriter writer(out, a.json_output);
+    Record record;  // reused row after row
     CsvRow row;
     while (reader.next(row)) {
         const double ti = *row.value(c_ti), ts = *row.value(c_ts), ps = *row.value(c_ps);
@@ -751,7 +821,8 @@ void run_model(const Args& a) {
                 a.model == ModelKind::BK ? roughness_for_row(a, row, where) : Roughness{};
             const Point p =
                 point_from(make_geometry(deg_to_rad(ti), deg_to_rad(ts), deg_to_rad(ps)));
-            writer.add(evaluate(a, p, r));
+            evaluate(a, p, r, record);
+            writer.add(record);
         } catch (const UsageError&) {
             throw;  // about the flags, not the row
         } catch (const roughscope::DataError&) {
