@@ -4,6 +4,8 @@
 
 BUILD      ?= build
 ASAN_BUILD ?= build-asan
+FUZZ_BUILD ?= build-fuzz
+FUZZ_SECONDS ?= 30
 JOBS       ?= 2
 PYTHON     ?= /usr/bin/python3
 CMAKE      ?= cmake
@@ -27,10 +29,37 @@ ASAN_CONFIGURE_FLAGS = -G Ninja \
 	-DROUGHSCOPE_BUILD_TESTS=ON \
 	-DROUGHSCOPE_BUILD_PYTHON=OFF \
 	-DROUGHSCOPE_BUILD_BENCH=OFF \
+	-DROUGHSCOPE_BUILD_CLI=ON \
 	-DROUGHSCOPE_SANITIZE=ON \
 	-DROUGHSCOPE_WERROR=OFF
 
-.PHONY: all deps configure build test demo sanitize bench lint format clean
+# libFuzzer build (clang): every object instrumented for coverage + ASan + UBSan, asserts on.
+# Warnings are not errors here (clang-only warnings in code built with GCC elsewhere).
+FUZZ_CONFIGURE_FLAGS = -G Ninja \
+	-DCMAKE_CXX_COMPILER=clang++ \
+	-DCMAKE_BUILD_TYPE=RelWithDebInfo \
+	"-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -gline-tables-only" \
+	-DROUGHSCOPE_BUILD_FUZZERS=ON \
+	-DROUGHSCOPE_BUILD_TESTS=OFF \
+	-DROUGHSCOPE_BUILD_PYTHON=OFF \
+	-DROUGHSCOPE_BUILD_BENCH=OFF \
+	-DROUGHSCOPE_BUILD_CLI=OFF \
+	-DROUGHSCOPE_WERROR=OFF
+
+# Any sanitizer report ends the process with exit code 86, which no roughscope command uses.
+# For the CLI tests, ASan and LeakSanitizer reports also go to files, and tests/python/conftest.py
+# fails the test during which one appeared, whatever exit code it expected (UBSan combined with
+# ASan ignores log_path: its reports stay on stderr, with exit code 86).
+SANITIZER_OPTIONS = halt_on_error=1:exitcode=86
+SANITIZER_ENV = ASAN_OPTIONS=detect_leaks=1:$(SANITIZER_OPTIONS) \
+	UBSAN_OPTIONS=print_stacktrace=1:$(SANITIZER_OPTIONS)
+SANITIZER_LOG_DIR = $(CURDIR)/$(ASAN_BUILD)/sanitizer-reports
+SANITIZER_CLI_ENV = \
+	ASAN_OPTIONS=detect_leaks=1:$(SANITIZER_OPTIONS):log_path=$(SANITIZER_LOG_DIR)/report \
+	UBSAN_OPTIONS=print_stacktrace=1:$(SANITIZER_OPTIONS):log_path=$(SANITIZER_LOG_DIR)/report \
+	ROUGHSCOPE_SANITIZER_LOG_DIR=$(SANITIZER_LOG_DIR)
+
+.PHONY: all deps configure build test demo sanitize fuzz bench lint format clean
 
 all: build
 
@@ -51,13 +80,29 @@ demo: build
 		$(PYTHON) -m roughscope.report --out $(REPORT_DIR)
 	@echo "Report: $(REPORT_DIR)/index.html"
 
-# C++ tests only (ctest label "cpp"), under AddressSanitizer + UBSan. Warnings are not errors
-# here: GCC's flow warnings give false positives under -fsanitize (the Release build has -Werror).
-sanitize: deps
+# Under AddressSanitizer + UBSan: the C++ tests (ctest labels "cpp" and "fuzz": the fuzz
+# targets' corpus and regressions), then the CLI tests (pytest marker "cli", see DEVELOPERS.md)
+# against the instrumented executable, with the Python module of the release build $(BUILD)
+# (built here if missing) and ROUGHSCOPE_SANITIZED=1 (memory-measuring tests skip). Warnings are
+# not errors here: GCC's flow warnings give false positives under -fsanitize (the Release build
+# has -Werror).
+sanitize: configure
+	$(CMAKE) --build $(BUILD) -j $(JOBS) --target _core roughscope_python_package
 	$(CMAKE) -S . -B $(ASAN_BUILD) $(ASAN_CONFIGURE_FLAGS)
 	$(CMAKE) --build $(ASAN_BUILD) -j $(JOBS)
-	ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
-		$(CTEST) --test-dir $(ASAN_BUILD) --output-on-failure -j $(JOBS) -L '^cpp$$' --no-tests=error
+	rm -rf $(SANITIZER_LOG_DIR) && mkdir -p $(SANITIZER_LOG_DIR)
+	$(SANITIZER_ENV) \
+		$(CTEST) --test-dir $(ASAN_BUILD) --output-on-failure -j $(JOBS) -L '^(cpp|fuzz)$$' --no-tests=error
+	$(SANITIZER_CLI_ENV) ROUGHSCOPE_SANITIZED=1 PYTHONPATH=$(CURDIR)/$(BUILD)/python \
+		ROUGHSCOPE_CLI=$(CURDIR)/$(ASAN_BUILD)/bin/roughscope PYTHONDONTWRITEBYTECODE=1 MPLBACKEND=Agg \
+		$(PYTHON) -m pytest -q -m cli -o cache_dir=$(CURDIR)/$(ASAN_BUILD)/.pytest_cache tests/python
+
+# libFuzzer: builds $(FUZZ_BUILD) with clang and runs every target of fuzz/ for FUZZ_SECONDS
+# each (fuzz/run: fixed seed, a copy of the seed corpus, fails on any crash or report).
+fuzz: deps
+	$(CMAKE) -S . -B $(FUZZ_BUILD) $(FUZZ_CONFIGURE_FLAGS)
+	$(CMAKE) --build $(FUZZ_BUILD) -j $(JOBS)
+	FUZZ_SECONDS=$(FUZZ_SECONDS) fuzz/run $(FUZZ_BUILD)
 
 # clang-format check + clang-tidy (.clang-format, .clang-tidy) on the project's sources.
 lint: configure
@@ -76,4 +121,4 @@ bench: build
 	fi
 
 clean:
-	rm -rf $(BUILD) $(ASAN_BUILD) out
+	rm -rf $(BUILD) $(ASAN_BUILD) $(FUZZ_BUILD) out

@@ -15,12 +15,17 @@ namespace {
 
 using roughscope::io::trim;
 
+// The message on one line, printable and bounded (core/text.hpp): line breaks become spaces,
+// other control characters and invalid UTF-8 are escaped, a very long message is cut. Library
+// messages are already escaped; this is the last defence for text from elsewhere (CLI11, the
+// standard library, the operating system).
 std::string one_line(std::string_view message) {
     std::string s(trim(message));
     for (char& c : s) {
         if (c == '\n' || c == '\r') c = ' ';
     }
-    return s;
+    s = roughscope::printable_message(s);
+    return s.empty() ? std::string("unknown error (no message)") : s;
 }
 
 // Shortest form of a limit for messages ("90", "0.5").
@@ -143,9 +148,10 @@ CLI::Validator number_validator(std::function<bool(double)> ok, std::string rang
         [ok = std::move(ok), range = std::move(range)](std::string& text) -> std::string {
             std::string reason;
             const auto value = parse_double(text, reason);
-            if (!value) return "'" + std::string(trim(text)) + "' is " + reason + "; " + range;
+            if (!value) return roughscope::quote_input(trim(text)) + " is " + reason + "; " + range;
             if (!ok(*value))
-                return "value " + std::string(trim(text)) + " is out of range; " + range;
+                return "value " + roughscope::format_message(*value) + " is out of range; " + range;
+            text = std::string(trim(text));  // CLI11 converts the text: no surrounding spaces
             return {};
         },
         std::move(tag));
@@ -172,6 +178,19 @@ CLI::Validator non_negative_validator(const std::string& unit) {
                             "must be >= 0" + (unit.empty() ? "" : " " + unit), ">= 0");
 }
 
+CLI::Validator integer_validator(long long lo, long long hi) {
+    const std::string range = "in [" + std::to_string(lo) + "," + std::to_string(hi) + "]";
+    return CLI::Validator(
+        [lo, hi](std::string& text) -> std::string {
+            std::string reason;
+            const auto value = roughscope::try_parse_integer(text, lo, hi, reason);
+            if (!value) return roughscope::quote_input(trim(text)) + " is " + reason;
+            text = std::to_string(*value);  // the decimal form CLI11 converts
+            return {};
+        },
+        "INT " + range);
+}
+
 CLI::Validator range_validator(double lo, double hi) {
     return number_validator([lo, hi](double v) { return v >= lo && v <= hi; },
                             "must be in [" + fmt_limit(lo) + ", " + fmt_limit(hi) + "]",
@@ -180,27 +199,27 @@ CLI::Validator range_validator(double lo, double hi) {
 
 CLI::Option* add_angle_option(CLI::App& app, const std::string& flag, double& deg,
                               const std::string& description) {
-    return app.add_option(flag, deg, description)->check(polar_angle_validator());
+    return app.add_option(flag, deg, description)->transform(polar_angle_validator());
 }
 
 CLI::Option* add_azimuth_option(CLI::App& app, const std::string& flag, double& deg,
                                 const std::string& description) {
-    return app.add_option(flag, deg, description)->check(finite_validator());
+    return app.add_option(flag, deg, description)->transform(finite_validator());
 }
 
 CLI::Option* add_positive_option(CLI::App& app, const std::string& flag, double& value,
                                  const std::string& description, const std::string& unit) {
-    return app.add_option(flag, value, description)->check(positive_validator(unit));
+    return app.add_option(flag, value, description)->transform(positive_validator(unit));
 }
 
 CLI::Option* add_non_negative_option(CLI::App& app, const std::string& flag, double& value,
                                      const std::string& description, const std::string& unit) {
-    return app.add_option(flag, value, description)->check(non_negative_validator(unit));
+    return app.add_option(flag, value, description)->transform(non_negative_validator(unit));
 }
 
 CLI::Option* add_range_option(CLI::App& app, const std::string& flag, double& value, double lo,
                               double hi, const std::string& description) {
-    return app.add_option(flag, value, description)->check(range_validator(lo, hi));
+    return app.add_option(flag, value, description)->transform(range_validator(lo, hi));
 }
 
 bool given(const CLI::Option* option) { return option != nullptr && option->count() > 0; }

@@ -164,12 +164,16 @@ CLI::Option* add_range_option(CLI::App& app, const std::string& flag, double& va
 // True if the option exists and was given on the command line.
 bool given(const CLI::Option* option);
 
-// Validators usable with Option::check (they parse the string strictly).
+// Validators for Option::transform (not check, which keeps the text unchanged): they parse the
+// string strictly and hand CLI11 the text without surrounding spaces.
 CLI::Validator polar_angle_validator();
 CLI::Validator finite_validator();
 CLI::Validator positive_validator(const std::string& unit = "");
 CLI::Validator non_negative_validator(const std::string& unit = "");
 CLI::Validator range_validator(double lo, double hi);
+// An integer in [lo, hi] by the library's strict parser (decimal digits only: "0x19", "25.0",
+// "1e3" are refused; surrounding spaces allowed). Use it for every integer option.
+CLI::Validator integer_validator(long long lo, long long hi);
 
 // Lower-cases `name` and replaces '-' by '_' (so "very-rough" == "very_rough"): the library's
 // enum-name scheme (roughscope/core/names.hpp).

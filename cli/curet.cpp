@@ -11,6 +11,7 @@
 #include <array>
 #include <cmath>
 #include <filesystem>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <sstream>
@@ -331,7 +332,10 @@ void register_curet(CLI::App& app) {
         "CUReT sample (--sample N), the whole database (--all), or any BRDF table (--table "
         "FILE.csv). See docs/curet.md.");
     const std::string what = "What to compare";
-    cmd->add_option("--sample", a.sample, "CUReT sample number (1..61)")->group(what);
+    cmd->add_option("--sample", a.sample, "CUReT sample number (1..61)")
+        ->transform(
+            integer_validator(std::numeric_limits<int>::min(), std::numeric_limits<int>::max()))
+        ->group(what);
     cmd->add_flag("--all", a.all, "Every sample of the database")->group(what);
     cmd->add_option("--table", a.table_path,
                     "A BRDF table in CSV: theta_i,phi_i,theta_s,phi_s,value (degrees, 1/sr; "
@@ -370,6 +374,7 @@ void register_curet(CLI::App& app) {
                     "on the normal)")
         ->delimiter(',')
         ->expected(2)
+        ->transform(integer_validator(1, std::numeric_limits<int>::max()))
         ->group(models);
     add_non_negative_option(*cmd, "--on-sigma", a.on_sigma_rad,
                             "Given Oren-Nayar facet slope sigma (rad; default for samples 25, "
@@ -385,7 +390,7 @@ void register_curet(CLI::App& app) {
     cmd->add_flag("--no-fits", a.no_fits, "Only the paper's methods (no least-squares fits)")
         ->group(models);
     cmd->add_option("--threads", a.threads, "Threads for --all (default: all cores)")
-        ->check(CLI::Range(1, 1024))
+        ->transform(integer_validator(1, 1024))
         ->group(models);
 
     const std::string outg = "Output";

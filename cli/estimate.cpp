@@ -13,6 +13,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <sstream>
@@ -58,7 +59,15 @@ double ratio_from(const RatioArgs& r) {
     if (given(r.o_ratio) && (given(r.o_e1) || given(r.o_e2)))
         throw UsageError("--ratio excludes --e1/--e2: give either --ratio R or --e1 E1 --e2 E2");
     if (given(r.o_ratio)) return r.ratio;
-    if (given(r.o_e1) && given(r.o_e2)) return r.e1 / r.e2;
+    if (given(r.o_e1) && given(r.o_e2)) {
+        const double ratio = r.e1 / r.e2;
+        if (!(ratio > 0.0 && ratio <= std::numeric_limits<double>::max()))
+            throw UsageError("--e1/--e2: E1/E2 = " + format_message(r.e1, 17) + "/" +
+                             format_message(r.e2, 17) +
+                             " underflows or overflows the double range; give values with a "
+                             "representable ratio (or --ratio)");
+        return ratio;
+    }
     if (given(r.o_e1) || given(r.o_e2))
         throw UsageError(std::string("missing ") + (given(r.o_e1) ? "--e2" : "--e1") +
                          ": give both brightness values --e1 E1 --e2 E2 (or --ratio R)");
@@ -120,9 +129,12 @@ void add_output_options(CLI::App& cmd, OutputArgs& o) {
 }
 
 // Options that read the same in several subcommands.
-CLI::Option* add_wavelength_option(CLI::App& cmd, double& wavelength_um) {
-    return add_positive_option(cmd, "--wavelength", wavelength_um,
-                               "Mean wavelength lambda (um; default 0.555)", "um");
+CLI::Option* add_wavelength_option(
+    CLI::App& cmd, double& wavelength_um,
+    const std::string& description = "Mean wavelength lambda (um; default 0.555)") {
+    // The library's length range (scattering/beckmann.hpp): no product of lengths overflows.
+    return add_range_option(cmd, "--wavelength", wavelength_um, kMinLengthUm, kMaxLengthUm,
+                            description);
 }
 
 CLI::Option* add_noise_option(CLI::App& cmd, double& noise) {
@@ -543,8 +555,8 @@ void register_estimate(CLI::App& app) {
         a.o_noise = add_noise_option(*cmd, a.noise);
         a.o_sigma = add_positive_option(*cmd, "--sigma", a.sigma_um,
                                         "RMS height if known (um): adds T, g and the class", "um");
-        add_positive_option(*cmd, "--wavelength", a.wavelength_um,
-                            "Wavelength for g with --sigma (um; default 0.555)", "um");
+        add_wavelength_option(*cmd, a.wavelength_um,
+                              "Wavelength for g with --sigma (um; default 0.555)");
         add_output_options(*cmd, a.out);
         cmd->callback([args]() { run_slope(*args); });
     }
@@ -572,8 +584,8 @@ void register_estimate(CLI::App& app) {
         a.o_regime = add_enum_option(*cmd, "--regime", a.regime, parse_regime,
                                      "slightly-rough model: slightly_rough (default, Eq. 3), "
                                      "series or auto");
-        a.o_wavelength = add_positive_option(*cmd, "--wavelength", a.wavelength_um,
-                                             "slightly-rough model: wavelength (um; 0.555)", "um");
+        a.o_wavelength = add_wavelength_option(*cmd, a.wavelength_um,
+                                               "slightly-rough model: wavelength (um; 0.555)");
         add_enum_option(*cmd, "--residual", a.residual, parse_residual_type,
                         "relative (default), absolute or log");
         add_enum_option(*cmd, "--loss", a.loss, parse_loss_type,
@@ -588,7 +600,7 @@ void register_estimate(CLI::App& app) {
         a.o_initial_T = add_positive_option(*cmd, "--initial-T", a.initial_T_um,
                                             "Starting T (um; default automatic)", "um");
         cmd->add_option("--max-iterations", a.max_iterations, "Solver iterations (default 200)")
-            ->check(CLI::Range(1, 100000));
+            ->transform(integer_validator(1, 100000));
         cmd->add_flag("--residuals", a.residuals, "Include the residuals in the JSON output");
         add_output_options(*cmd, a.out);
         cmd->callback([args]() { run_fit(*args); });

@@ -399,6 +399,8 @@ double evaluate_bk(const Args& a, const Point& p, const Roughness& r, Record& ou
             out["g"] = serialize::number(power.g);
             out["regime"] = std::string(to_string(power.regime));
             out["roughness_class"] = std::string(to_string(power.roughness_class));
+            out["method"] = std::string(to_string(power.method));
+            out["relative_error_bound"] = serialize::number(power.relative_error_bound);
         } else {
             coherent = diffuse = total = 0.0;  // light or viewer below the horizon
         }
@@ -433,6 +435,8 @@ double evaluate_bk(const Args& a, const Point& p, const Roughness& r, Record& ou
         out["g"] = to_json_number(g);
         out["regime"] = regime ? json(*regime) : json(nullptr);
         out["roughness_class"] = roughness_class ? json(*roughness_class) : json(nullptr);
+        out["method"] = std::string(to_string(DiffuseMethod::ClosedForm));
+        out["relative_error_bound"] = 0.0;
     }
     out["scale"] = absolute ? "absolute" : "relative";
     out["correlation"] = std::string(to_string(a.correlation));

@@ -7,12 +7,12 @@
 // where the agreement marks are defined); this file only prints the document as text or JSON.
 #include <cmath>
 #include <filesystem>
-#include <fstream>
 #include <functional>
 #include <memory>
 #include <optional>
 #include <sstream>
 #include <string>
+#include <system_error>
 #include <vector>
 
 #include "commands.hpp"
@@ -54,25 +54,25 @@ void add_cells(std::vector<std::string>& cells, const json& c, int printed_decim
     cells.push_back(mark(c));
 }
 
-json load_reference(const fs::path& path) {
-    std::ifstream in(path);
-    if (!in)
+// The reference document (serialize/paper_tables.hpp; DataError naming the file and the place).
+json load_reference(const fs::path& path, bool given) {
+    std::error_code ec;
+    if (!fs::exists(path, ec))
         throw roughscope::DataError(
-            "paper tables not found at " + path.string() +
+            "paper tables not found at " +
+            (given ? path.string()
+                   : roughscope::io::shared_search_description(
+                         roughscope::io::kPaperTablesRelative)) +
             " (the printed values live beside the project in ../shared/reference/; run from the "
             "project root or give --reference FILE)");
-    try {
-        return json::parse(in);
-    } catch (const json::exception& e) {
-        throw roughscope::DataError(path.string() + ": not valid JSON (" + e.what() + ")");
-    }
+    return serialize::read_paper_tables_reference(path);
 }
 
 void run_tables(const Args& a) {
     const fs::path path = a.reference.empty()
                               ? roughscope::io::paper_tables_path().value_or(kDefaultReference)
                               : fs::path(a.reference);
-    const json ref = load_reference(path);
+    const json ref = load_reference(path, !a.reference.empty());
     json out;
     out["reference"] = path.string();
     const json tables = serialize::recompute_paper_tables(ref, path.string());

@@ -298,8 +298,20 @@ constexpr std::array<GeometricFactor, 4> kFactors = {
 constexpr std::array<Radiometry, 2> kRadiometries = {Radiometry::Radiance, Radiometry::Intensity};
 constexpr std::array<Regime, 5> kRegimes = {Regime::Auto, Regime::Series, Regime::SlightlyRough,
                                             Regime::VeryRough, Regime::VeryRoughSeriesLimit};
+constexpr std::array<DiffuseMethod, 3> kMethods = {
+    DiffuseMethod::ClosedForm, DiffuseMethod::Summation, DiffuseMethod::LargeGExpansion};
 constexpr std::array<RoughnessClass, 3> kRoughnessClasses = {
     RoughnessClass::SlightlyRough, RoughnessClass::ModeratelyRough, RoughnessClass::VeryRough};
+
+// The unchecked pure terms (diffuse_power_*) overflow for extreme combinations of their inputs:
+// an InvalidArgument (ValueError) instead of inf or NaN.
+double representable(double value) {
+    if (!std::isfinite(value))
+        throw InvalidArgument(
+            "the result is not representable as a double for these inputs (it overflows or is "
+            "0/0); keep the lengths in [1e-30, 1e30] um as mean_scattered_power does");
+    return value;
+}
 
 // =============================================================================================
 // very_rough_brightness over arrays: the library's batch kernel (scattering/brightness_batch.hpp)
@@ -552,7 +564,7 @@ phi_s_deg) with phi_s_deg in [0, 360).)doc");
             for_each_element(b, true, [&](ssize_t i) {
                 const auto x = values_at(ops, i);
                 const Geometry g = geometry_deg(x[0], x[1], x[2]);
-                check::positive("wavelength_um", x[3], "um");
+                check_length_um("wavelength_um", x[3]);
                 const ScatteringVector v = scattering_vector(g, x[3]);
                 ox[i] = v.vx;
                 oy[i] = v.vy;
@@ -574,7 +586,8 @@ k = 2π/λ. Angles in degrees, wavelength_um > 0 (default 0.555, the paper's). R
                                  [](double ti, double ts, double sigma, double wl) {
                                      const Geometry g = geometry_deg(ti, ts, 0.0);
                                      check::non_negative("sigma_um", sigma, "um");
-                                     check::positive("wavelength_um", wl, "um");
+                                     if (sigma != 0.0) check_length_um("sigma_um", sigma);
+                                     check_length_um("wavelength_um", wl);
                                      return roughness_g(g, sigma, wl);
                                  });
         },
@@ -620,8 +633,8 @@ F_Beck(0, 0, ·) = 1; retro (θ, θ, 180): 1/cos²θ. Angles in degrees.)doc");
                                  [](double x, double y, double X, double Y) {
                                      check::finite("vx", x);
                                      check::finite("vy", y);
-                                     check::positive("patch_x_um", X, "um");
-                                     check::positive("patch_y_um", Y, "um");
+                                     check_length_um("patch_x_um", X);
+                                     check_length_um("patch_y_um", Y);
                                      return specular_amplitude_rho0(x, y, X, Y);
                                  });
         },
@@ -633,7 +646,9 @@ F_Beck(0, 0, ·) = 1; retro (θ, θ, 180): 1/cos²θ. Angles in degrees.)doc");
         "coherent_power",
         [](py::handle rho0, py::handle g) {
             return map_double<2>({"rho0", "g"}, {rho0, g}, [](double r, double gg) {
-                check::finite("rho0", r);
+                if (!(r >= -1.0 && r <= 1.0))  // ρ0 is a product of two sincs (§3.1)
+                    throw InvalidArgument("rho0 = " + check::format_number(r) +
+                                          " is outside the valid range [-1, 1]");
                 check::non_negative("g", gg);
                 return coherent_power(r, gg);
             });
@@ -662,11 +677,12 @@ F_Beck(0, 0, ·) = 1; retro (θ, θ, 180): 1/cos²θ. Angles in degrees.)doc");
             auto& ops = operands.first;  // not a structured binding (the lambdas below name it)
             auto& b = operands.second;
             py::array_t<double> coh = make_output(b), dif = make_output(b), tot = make_output(b),
-                                bri = make_output(b), gg = make_output(b);
-            py::array_t<std::uint8_t> reg(b.shape), cls(b.shape);
+                                bri = make_output(b), gg = make_output(b), bnd = make_output(b);
+            py::array_t<std::uint8_t> reg(b.shape), cls(b.shape), met(b.shape);
             double *oc = coh.mutable_data(), *od = dif.mutable_data(), *ot = tot.mutable_data(),
-                   *ob = bri.mutable_data(), *og = gg.mutable_data();
-            std::uint8_t *orr = reg.mutable_data(), *ocl = cls.mutable_data();
+                   *ob = bri.mutable_data(), *og = gg.mutable_data(), *obd = bnd.mutable_data();
+            std::uint8_t *orr = reg.mutable_data(), *ocl = cls.mutable_data(),
+                         *om = met.mutable_data();
             for_each_element(b, true, [&](ssize_t i) {
                 const auto x = values_at(ops, i);
                 ModelOptions o = opt;
@@ -680,6 +696,9 @@ F_Beck(0, 0, ·) = 1; retro (θ, θ, 180): 1/cos²θ. Angles in degrees.)doc");
                 ot[i] = p.total;
                 ob[i] = p.brightness;
                 og[i] = p.g;
+                obd[i] = p.relative_error_bound;
+                om[i] = static_cast<std::uint8_t>(
+                    std::find(kMethods.begin(), kMethods.end(), p.method) - kMethods.begin());
                 orr[i] = static_cast<std::uint8_t>(
                     std::find(kRegimes.begin(), kRegimes.end(), p.regime) - kRegimes.begin());
                 ocl[i] = static_cast<std::uint8_t>(std::find(kRoughnessClasses.begin(),
@@ -695,6 +714,8 @@ F_Beck(0, 0, ·) = 1; retro (θ, θ, 180): 1/cos²θ. Angles in degrees.)doc");
             d["g"] = finish(b, gg);
             d["regime"] = names_from_codes(b, reg, enum_names(kRegimes));
             d["roughness_class"] = names_from_codes(b, cls, enum_names(kRoughnessClasses));
+            d["method"] = names_from_codes(b, met, enum_names(kMethods));
+            d["relative_error_bound"] = finish(b, bnd);
             return d;
         },
         arg("theta_i_deg"), arg("theta_s_deg"), arg("phi_s_deg"), arg("sigma_um"), arg("T_um"),
@@ -715,9 +736,12 @@ Angles in degrees (θ in [0, 90)); sigma_um, T_um, wavelength_um, patch_x_um, pa
 All numeric arguments broadcast together.
 
 Returns a dict: 'coherent', 'diffuse', 'total' (= P), 'brightness', 'g' (floats or arrays),
-'regime' (the regime actually used, never 'auto') and 'roughness_class' ('slightly_rough',
-'moderately_rough', 'very_rough' by g): a str for scalar input, else a NumPy str array of the
-broadcast shape.)doc");
+'regime' (the regime actually used, never 'auto'), 'roughness_class' ('slightly_rough',
+'moderately_rough', 'very_rough' by g) and 'method' ('closed_form', 'summation' or
+'large_g_expansion': how D was evaluated; the series switches to its large-g expansion where the
+sum underflows or loses accuracy): a str for scalar input, else a NumPy str array of the
+broadcast shape; 'relative_error_bound' (float or array): bound on the relative error of D against
+the exact series (0 for a closed form asked for by name). Lengths must be in [1e-30, 1e30] µm.)doc");
 
     m.def("very_rough_brightness", &very_rough_brightness_py, arg("theta_i_deg"),
           arg("theta_s_deg"), arg("phi_s_deg"), arg("sigma_over_T"), py::kw_only(),
@@ -773,7 +797,7 @@ exponential-correlation series without its prefactor. g >= 0, T2_vxy2 >= 0.)doc"
                                          check::positive("area_um2", A, "um^2");
                                          check::non_negative("g", gg);
                                          check::non_negative("vxy2", v, "1/um^2");
-                                         return fn(f2, T, A, gg, v);
+                                         return representable(fn(f2, T, A, gg, v));
                                      });
             },
             py::arg("F2"), py::arg("T_um"), py::arg("area_um2"), py::arg("g"), py::arg("vxy2"),
@@ -828,7 +852,7 @@ exponential-correlation series without its prefactor. g >= 0, T2_vxy2 >= 0.)doc"
                         check::positive("area_um2", A, "um^2");
                         check::positive("vz2", vz, "1/um^2");
                         check::non_negative("vxy2", v, "1/um^2");
-                        return fn(f2, s, T, A, vz, v);
+                        return representable(fn(f2, s, T, A, vz, v));
                     });
             },
             py::arg("F2"), py::arg("sigma_um"), py::arg("T_um"), py::arg("area_um2"),
@@ -863,7 +887,9 @@ exponential-correlation series without its prefactor. g >= 0, T2_vxy2 >= 0.)doc"
         arg("correlation"), arg("F2"), arg("T_um"), arg("area_um2"), arg("g"), arg("vxy2"),
         R"doc(The diffuse Kirchhoff integral by direct numerical quadrature, independent of the series:
 D = (2π/A) F² exp(−g) ∫₀^∞ [exp(g C(τ)) − 1] J0(v_xy τ) τ dτ, C the 'gaussian' or 'exponential'
-correlation. Slow (milliseconds per value); for g ≲ 50 and T v_xy ≲ 50.)doc");
+correlation. Slow (up to ~0.3 s per value). Domain: 0 <= g <= 1e4 and 0 <= T v_xy <= 100 (else
+InvalidArgument naming the value); absolute error <= 1e-12 of the integral's size at the lobe
+centre; never negative.)doc");
 
     // ---- Retro-scattering closed forms (Eq. 7–11) -----------------------------------------
     auto retro_vr = [&m](const char* name, double (*fn)(double, double), const char* doc) {

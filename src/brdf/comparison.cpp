@@ -825,6 +825,12 @@ Comparison compare(const BrdfTable& table, const ComparisonOptions& o, BrdfTable
             oren_nayar_prediction(p, *o.oren_nayar, r.prediction);
             r.evaluations = 1;
             set_errors(p, r);
+            if (!std::isfinite(r.errors.paper_sse)) {  // albedo 0: the model is 0 everywhere
+                r.available = false;
+                r.reason = "the Oren-Nayar model with albedo = " +
+                           check::format_number(o.oren_nayar->albedo) +
+                           " is 0 at every measurement: it cannot be normalised to the data";
+            }
         } else {
             r.reason =
                 "no given Oren-Nayar parameters (the paper's Table 3 lists them for CUReT "

@@ -11,6 +11,7 @@
 #include "roughscope/core/errors.hpp"
 #include "roughscope/core/names.hpp"
 #include "roughscope/core/numbers.hpp"
+#include "roughscope/core/text.hpp"
 #include "roughscope/io/csv.hpp"
 #include "roughscope/io/data_locator.hpp"
 
@@ -33,11 +34,11 @@ struct Line {
     std::vector<std::string_view> fields;
 };
 
-// Opens `path` for line-by-line reading (io/csv.hpp: UTF-8 BOM and CRLF accepted).
+// Opens `path` for line-by-line reading (io/csv.hpp: UTF-8 BOM and CRLF accepted, NUL bytes
+// refused). Throws DataError "<path>: does not exist" or "<path>: is a directory, not a file".
 io::LineReader open_lines(const fs::path& path) {
     std::error_code ec;
-    if (!fs::is_regular_file(path, ec))
-        throw DataError("cannot read " + path.string() + ": no such file or not readable");
+    if (!fs::exists(path, ec)) throw DataError(path.string() + ": does not exist");
     return io::LineReader(path);
 }
 
@@ -61,18 +62,20 @@ double field_number(const fs::path& file, const Line& line, std::size_t k, const
     const auto v = try_parse_number(line.fields[k], reason);
     if (!v)
         fail(file, line.number,
-             std::string("field ") + std::to_string(k + 1) + " (" + what + "): '" +
-                 std::string(line.fields[k]) + "' is " + reason);
+             std::string("field ") + std::to_string(k + 1) + " (" + what +
+                 "): " + quote_input(line.fields[k]) + " is " + reason);
     return *v;
 }
 
+// Measurement and sample numbers: decimal digits only (core/numbers.hpp), 1..1e6.
 int field_integer(const fs::path& file, const Line& line, std::size_t k, const char* what) {
-    const double v = field_number(file, line, k, what);
-    if (v != std::floor(v) || v < 1 || v > 1e6)
+    std::string reason;
+    const auto v = try_parse_integer(line.fields[k], 1, 1000000, reason);
+    if (!v)
         fail(file, line.number,
-             std::string("field ") + std::to_string(k + 1) + " (" + what + "): '" +
-                 std::string(line.fields[k]) + "' is not a positive integer");
-    return static_cast<int>(v);
+             std::string("field ") + std::to_string(k + 1) + " (" + what +
+                 "): " + quote_input(line.fields[k]) + " is " + reason);
+    return static_cast<int>(*v);
 }
 
 std::vector<CuretAngles> read_angle_table(const fs::path& file) {
@@ -214,13 +217,21 @@ fs::path find_curet_directory(const std::optional<fs::path>& explicit_dir) {
     if (explicit_dir) {
         std::error_code ec;
         if (!fs::is_directory(*explicit_dir, ec))
-            throw DataError("CUReT directory " + explicit_dir->string() +
-                            " does not exist; it must hold " + kNeededFiles + ", from " +
-                            kWhereFrom);
-        if (!has_curet_files(*explicit_dir))
-            throw DataError("CUReT directory " + explicit_dir->string() + " lacks " +
-                            (fs::exists(*explicit_dir / "table.txt") ? "abrdf.dat" : "table.txt") +
-                            "; it must hold " + kNeededFiles + ", from " + kWhereFrom);
+            throw DataError(
+                "CUReT directory " + explicit_dir->string() +
+                (fs::exists(*explicit_dir, ec) ? " is not a directory" : " does not exist") +
+                "; it must be a directory holding " + kNeededFiles + ", from " + kWhereFrom);
+        for (const char* name : {"table.txt", "abrdf.dat"}) {
+            const fs::path file = *explicit_dir / name;
+            if (!fs::exists(file, ec))
+                throw DataError("CUReT directory " + explicit_dir->string() + " lacks " + name +
+                                "; it must hold " + kNeededFiles + ", from " + kWhereFrom);
+            if (!fs::is_regular_file(file, ec))
+                throw DataError(file.string() + ": " +
+                                (fs::is_directory(file, ec) ? "is a directory, not a file"
+                                                            : "is not a regular file") +
+                                "; the CUReT directory must hold " + kNeededFiles);
+        }
         return *explicit_dir;
     }
     // The reference-data locator (io/data_locator.hpp): $ROUGHSCOPE_SHARED_DIR/data/curet, else

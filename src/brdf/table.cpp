@@ -9,6 +9,8 @@
 #include <system_error>
 
 #include "roughscope/core/errors.hpp"
+#include "roughscope/core/numbers.hpp"
+#include "roughscope/core/text.hpp"
 #include "roughscope/io/csv.hpp"
 
 namespace roughscope {
@@ -74,11 +76,13 @@ BrdfTable parse_brdf_csv(std::istream& in, std::string_view source_name,
         }
         const double weight = row.find("weight").value_or(1.0);
         int index = static_cast<int>(data_rows);
-        if (const auto idx = row.find("measurement")) {
-            if (*idx != std::floor(*idx) || *idx < 1 || *idx > 1e9)
+        if (row.find("measurement")) {  // an integer: decimal digits only (core/numbers.hpp)
+            std::string reason;
+            const auto idx = try_parse_integer(row.text("measurement"), 1, 1000000000, reason);
+            if (!idx)
                 fail(source_name, row.line,
-                     "column measurement: '" + row.text("measurement") +
-                         "' is not a positive integer");
+                     "column measurement: " + quote_input(row.text("measurement")) + " is " +
+                         reason);
             index = static_cast<int>(*idx);
         }
         if (has_index && !seen_index.insert(index).second)

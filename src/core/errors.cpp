@@ -4,6 +4,13 @@
 #include <numbers>
 
 #include "roughscope/core/numbers.hpp"
+#include "roughscope/core/text.hpp"
+
+namespace roughscope {
+
+Error::Error(std::string_view message) : std::runtime_error(printable_message(message)) {}
+
+}  // namespace roughscope
 
 namespace roughscope::check {
 

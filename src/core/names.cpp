@@ -4,6 +4,7 @@
 #include <cctype>
 
 #include "roughscope/core/numbers.hpp"
+#include "roughscope/core/text.hpp"
 
 namespace roughscope {
 
@@ -21,8 +22,8 @@ bool name_matches(std::string_view canonical, std::string_view input) {
 }
 
 void throw_unknown_name(std::string_view what, std::string_view name, std::string_view valid) {
-    throw InvalidArgument(std::string(what) + " '" + std::string(name) +
-                          "' is not recognised; valid values: " + std::string(valid));
+    throw InvalidArgument(std::string(what) + " " + quote_input(name) +
+                          " is not recognised; valid values: " + std::string(valid));
 }
 
 }  // namespace roughscope

@@ -8,6 +8,7 @@
 #include <system_error>
 
 #include "roughscope/core/errors.hpp"
+#include "roughscope/core/text.hpp"
 
 namespace roughscope {
 namespace {
@@ -30,6 +31,23 @@ std::string printf_g(double value, int digits) {
     return std::string(buf, end);
 }
 
+// Relative differences this small are floating-point noise, not information, in a message.
+constexpr double kConversionNoise = 1e-14;
+
+// Significant digits of a "%g" text (trailing zeros are already dropped by %g).
+int significant_digits(std::string_view text) {
+    int count = 0;
+    bool leading = true;
+    for (const char c : text) {
+        if (c == 'e' || c == 'E') break;
+        if (c < '0' || c > '9') continue;
+        if (leading && c == '0') continue;
+        leading = false;
+        ++count;
+    }
+    return count;
+}
+
 }  // namespace
 
 std::string_view trim_space(std::string_view s) {
@@ -46,7 +64,7 @@ std::optional<double> try_parse_number(std::string_view text, std::string& reaso
         reason = "empty (a number is required)";
         return std::nullopt;
     }
-    if (s.front() == '+') s.remove_prefix(1);
+    if (s.front() == '+' && s.size() > 1 && s[1] != '-') s.remove_prefix(1);
     double value = 0.0;
     const auto [ptr, ec] = std::from_chars(s.data(), s.data() + s.size(), value);
     if (ec == std::errc::result_out_of_range) {
@@ -72,7 +90,37 @@ double parse_number(std::string_view text, std::string_view what) {
     std::string reason;
     const auto value = try_parse_number(text, reason);
     if (!value)
-        throw InvalidArgument(std::string(what) + ": '" + std::string(trim_space(text)) + "' is " +
+        throw InvalidArgument(std::string(what) + ": " + quote_input(trim_space(text)) + " is " +
+                              reason);
+    return *value;
+}
+
+std::optional<long long> try_parse_integer(std::string_view text, long long lo, long long hi,
+                                           std::string& reason) {
+    std::string_view s = trim_space(text);
+    if (s.empty()) {
+        reason = "empty (an integer is required)";
+        return std::nullopt;
+    }
+    if (s.front() == '+' && s.size() > 1 && s[1] != '-') s.remove_prefix(1);
+    long long value = 0;
+    const auto [ptr, ec] = std::from_chars(s.data(), s.data() + s.size(), value, 10);
+    if (ec == std::errc::invalid_argument || ptr != s.data() + s.size()) {
+        reason = "not an integer (decimal digits only)";
+        return std::nullopt;
+    }
+    if (ec == std::errc::result_out_of_range || value < lo || value > hi) {
+        reason = "out of the range [" + std::to_string(lo) + ", " + std::to_string(hi) + "]";
+        return std::nullopt;
+    }
+    return value;
+}
+
+long long parse_integer(std::string_view text, long long lo, long long hi, std::string_view what) {
+    std::string reason;
+    const auto value = try_parse_integer(text, lo, hi, reason);
+    if (!value)
+        throw InvalidArgument(std::string(what) + ": " + quote_input(trim_space(text)) + " is " +
                               reason);
     return *value;
 }
@@ -89,8 +137,7 @@ std::vector<double> parse_number_list(std::string_view text, std::size_t count,
     }
     if (parts.size() != count)
         throw InvalidArgument(std::string(what) + ": expected " + std::to_string(count) +
-                              " comma-separated numbers, got '" + std::string(trim_space(text)) +
-                              "'");
+                              " comma-separated numbers, got " + quote_input(trim_space(text)));
     std::vector<double> out;
     out.reserve(count);
     for (std::size_t i = 0; i < parts.size(); ++i)
@@ -117,7 +164,17 @@ std::string format_significant(double value, int digits, std::string_view name) 
 std::string format_message(double value, int digits) {
     if (std::isnan(value)) return "nan";
     if (std::isinf(value)) return value > 0 ? "inf" : "-inf";
-    if (digits > 0) return printf_g(value, digits < 17 ? digits : 17);
+    if (digits > 0) {
+        // Rounding that ends in a shorter, rounder number than asked for ("1" for 1.00000001 at
+        // 7 digits) would show the value equal to a limit it breaks: then every digit is shown,
+        // unless the difference is rounding noise of a unit conversion (29.999999999999996 deg
+        // from 30 deg in radians stays "30").
+        std::string rounded = printf_g(value, digits < 17 ? digits : 17);
+        const double shown = std::strtod(rounded.c_str(), nullptr);
+        if (significant_digits(rounded) >= digits ||
+            std::abs(shown - value) <= kConversionNoise * std::abs(value))
+            return rounded;
+    }
     char buf[64];
     const auto res = std::to_chars(buf, buf + sizeof buf, value);
     return std::string(buf, res.ptr);

@@ -38,8 +38,14 @@ std::string factor_name(GeometricFactor f) {
     return "F";
 }
 
+// "in (a, b)", "> a", or why no range can be given (never prints NaN or inf).
 std::string range_text(const RatioRange& r) {
-    return "(" + fmt(r.lower) + ", " + fmt(r.upper) + ")";
+    if (std::isnan(r.lower) || std::isnan(r.upper))
+        return "unavailable: the model brightness underflows to 0 at one of the geometries";
+    if (r.lower > std::numeric_limits<double>::max())
+        return "above the largest double (no representable ratio)";
+    if (std::isinf(r.upper)) return "> " + fmt(r.lower);
+    return "in (" + fmt(r.lower) + ", " + fmt(r.upper) + ")";
 }
 
 void check_ratio(std::string_view name, double ratio) { check::positive(name, ratio); }
@@ -84,7 +90,7 @@ VeryRoughPair very_rough_pair(double theta1_rad, double theta2_rad, GeometricFac
                                     const RatioRange& range, const std::string& extra = "") {
     throw NoSolution("E1/E2 = " + check::format_number(ratio) + " has no solution for " + what +
                      " at theta1 = " + deg(theta1_rad) + ", theta2 = " + deg(theta2_rad) +
-                     " with " + factor_name(factor) + ": E1/E2 must be in " + range_text(range) +
+                     " with " + factor_name(factor) + ": E1/E2 must be " + range_text(range) +
                      extra);
 }
 
@@ -118,13 +124,15 @@ double sigma_over_T_gaussian_from_ratio(double E1_over_E2, double theta1_rad, do
                                         GeometricFactor factor) {
     check_ratio("E1/E2", E1_over_E2);
     const VeryRoughPair p = very_rough_pair(theta1_rad, theta2_rad, factor);
-    const double log_kappa = std::log(E1_over_E2 / p.C);
+    const double log_kappa = std::log(E1_over_E2) - std::log(p.C);  // no overflow of E1/E2/C
     const double radicand = (p.a2 - p.a1) / log_kappa;
+    const double kappa = std::exp(log_kappa);
     if (!(radicand > 0.0) || !std::isfinite(radicand))
-        throw_no_solution("Gaussian correlation (Eq. 17)", E1_over_E2, theta1_rad, theta2_rad,
-                          factor, ratio_range_gaussian(theta1_rad, theta2_rad, factor),
-                          " (kappa = " + fmt(E1_over_E2 / p.C) +
-                              (p.a2 > p.a1 ? " must exceed 1)" : " must be below 1)"));
+        throw_no_solution(
+            "Gaussian correlation (Eq. 17)", E1_over_E2, theta1_rad, theta2_rad, factor,
+            ratio_range_gaussian(theta1_rad, theta2_rad, factor),
+            " (kappa = " + (std::isfinite(kappa) ? fmt(kappa) : std::string("above 1e308")) +
+                (p.a2 > p.a1 ? " must exceed 1)" : " must be below 1)"));
     return 0.5 * std::sqrt(radicand);
 }
 
@@ -133,12 +141,15 @@ double sigma_over_T_exponential_from_ratio(double E1_over_E2, double theta1_rad,
                                            GeometricFactor factor) {
     check_ratio("E1/E2", E1_over_E2);
     const VeryRoughPair p = very_rough_pair(theta1_rad, theta2_rad, factor);
-    const double k23 = std::cbrt(E1_over_E2 / p.C) * std::cbrt(E1_over_E2 / p.C);
+    const double k13 = std::cbrt(E1_over_E2) / std::cbrt(p.C);  // no overflow of E1/E2/C
+    const double k23 = k13 * k13;
     const double radicand = (p.a2 - k23 * p.a1) / (k23 - 1.0);
     if (!(radicand > 0.0) || !std::isfinite(radicand))
         throw_no_solution("exponential correlation (Eq. 19)", E1_over_E2, theta1_rad, theta2_rad,
                           factor, ratio_range_exponential(theta1_rad, theta2_rad, factor),
-                          " (the radicand of Eq. 19 is " + fmt(radicand) + ")");
+                          std::isfinite(radicand)
+                              ? " (the radicand of Eq. 19 is " + fmt(radicand) + ")"
+                              : std::string());
     return std::sqrt(radicand);
 }
 
@@ -162,12 +173,14 @@ double sigma_from_specular(double R_spec, double theta_rad, double wavelength_um
     check::positive("R_spec", R_spec);
     check::positive("R0", R0);
     check::polar_angle("theta", theta_rad);
-    check::positive("wavelength", wavelength_um, "um");
+    check_length_um("wavelength", wavelength_um);
     if (!(R_spec < R0))
         throw InvalidArgument("R_spec = " + check::format_number(R_spec) +
                               " is invalid: it must be below R0 = " + check::format_number(R0) +
                               " (Eq. 13 needs 0 < R_spec < R0)");
-    return wavelength_um / (4.0 * kPi * std::cos(theta_rad)) * std::sqrt(std::log(R0 / R_spec));
+    // ln(R0/R_spec) as a difference: R0/R_spec overflows for a subnormal R_spec.
+    return wavelength_um / (4.0 * kPi * std::cos(theta_rad)) *
+           std::sqrt(std::log(R0) - std::log(R_spec));
 }
 
 namespace {
@@ -192,8 +205,8 @@ struct Eq15 {
 
 Eq15 eq15_terms(double sigma_um, double theta1_rad, double theta2_rad, double wavelength_um,
                 GeometricFactor factor) {
-    check::positive("sigma", sigma_um, "um");
-    check::positive("wavelength", wavelength_um, "um");
+    check_length_um("sigma", sigma_um);
+    check_length_um("wavelength", wavelength_um);
     check_two_angles(theta1_rad, theta2_rad);
     const auto t1 = slightly_rough_terms(theta1_rad, sigma_um, wavelength_um, factor);
     const auto t2 = slightly_rough_terms(theta2_rad, sigma_um, wavelength_um, factor);
@@ -224,7 +237,7 @@ double correlation_length_from_ratio(double E1_over_E2, double sigma_um, double 
                 " um, lambda = " + fmt(wavelength_um) + " um)",
             E1_over_E2, theta1_rad, theta2_rad, factor,
             ratio_range_correlation_length(sigma_um, theta1_rad, theta2_rad, wavelength_um, factor),
-            " (the radicand of Eq. 15 is " + fmt(radicand) + ")");
+            std::isfinite(radicand) ? " (the radicand of Eq. 15 is " + fmt(radicand) + ")" : "");
     return 2.0 * std::sqrt(radicand);
 }
 
@@ -236,7 +249,7 @@ double d_sigma_over_T_gaussian_d_log_ratio(double E1_over_E2, double theta1_rad,
                                            GeometricFactor factor) {
     const double s = sigma_over_T_gaussian_from_ratio(E1_over_E2, theta1_rad, theta2_rad, factor);
     const VeryRoughPair p = very_rough_pair(theta1_rad, theta2_rad, factor);
-    return -s / (2.0 * std::log(E1_over_E2 / p.C));
+    return -s / (2.0 * (std::log(E1_over_E2) - std::log(p.C)));
 }
 
 // Eq. 19: (σ/T)² = (a2 − K a1)/(K − 1), K = κ^{2/3} ⇒ d(σ/T)/d ln r = (a1 − a2)K/(3(σ/T)(K−1)²).
@@ -245,7 +258,8 @@ double d_sigma_over_T_exponential_d_log_ratio(double E1_over_E2, double theta1_r
     const double s =
         sigma_over_T_exponential_from_ratio(E1_over_E2, theta1_rad, theta2_rad, factor);
     const VeryRoughPair p = very_rough_pair(theta1_rad, theta2_rad, factor);
-    const double K = std::pow(E1_over_E2 / p.C, 2.0 / 3.0);
+    const double k13 = std::cbrt(E1_over_E2) / std::cbrt(p.C);
+    const double K = k13 * k13;
     return (p.a1 - p.a2) * K / (3.0 * s * (K - 1.0) * (K - 1.0));
 }
 
@@ -290,7 +304,7 @@ double d_correlation_length_d_sigma(double E1_over_E2, double sigma_um, double t
 double d_sigma_d_specular_reflectance(double R_spec, double theta_rad, double wavelength_um,
                                       double R0) {
     const double sigma = sigma_from_specular(R_spec, theta_rad, wavelength_um, R0);
-    return -sigma / (2.0 * R_spec * std::log(R0 / R_spec));
+    return -sigma / (2.0 * R_spec * (std::log(R0) - std::log(R_spec)));
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -533,7 +547,7 @@ double sigma_over_T_two_geometries(double E1_over_E2, const Geometry& geom1, con
                                       ", " + factor_name(options.factor) + ") at geom1 " +
                                       geometry_text(geom1) + ", geom2 " + geometry_text(geom2) +
                                       ": for sigma/T in [" + fmt(b.lo) + ", " + fmt(b.hi) +
-                                      "] E1/E2 must be in " + range_text(r);
+                                      "] E1/E2 must be " + range_text(r);
                            })
         .x;
 }
@@ -544,8 +558,8 @@ double correlation_length_two_geometries(double E1_over_E2, const Geometry& geom
                                          Correlation correlation,
                                          const TwoGeometryOptions& options) {
     check_ratio("E1/E2", E1_over_E2);
-    check::positive("sigma", sigma_um, "um");
-    check::positive("wavelength", options.wavelength_um, "um");
+    check_length_um("sigma", sigma_um);
+    check_length_um("wavelength", options.wavelength_um);
     check::geometry(geom1, "geom1");
     check::geometry(geom2, "geom2");
     check_options(options);
@@ -561,7 +575,7 @@ double correlation_length_two_geometries(double E1_over_E2, const Geometry& geom
                                       " um, lambda = " + fmt(options.wavelength_um) +
                                       " um) at geom1 " + geometry_text(geom1) + ", geom2 " +
                                       geometry_text(geom2) + ": for T in [" + fmt(b.lo) + ", " +
-                                      fmt(b.hi) + "] um E1/E2 must be in " + range_text(r);
+                                      fmt(b.hi) + "] um E1/E2 must be " + range_text(r);
                            })
         .x;
 }
@@ -679,13 +693,27 @@ RoughnessEstimate estimate_sigma_specular(const SpecularInput& in) {
             throw InvalidArgument(
                 "E_tot and E_dif must be given together (R_spec = 1 - E_dif/E_tot)");
         R = specular_reflectance_from_brightness(*in.E_tot, *in.E_dif);
+        check::positive("R0", in.R0);
+        if (!(R < in.R0))  // name the inputs, not only the derived R_spec
+            throw InvalidArgument(
+                "R_spec = 1 - E_dif/E_tot = " + check::format_number(R) + " (E_tot = " +
+                check::format_number(*in.E_tot) + ", E_dif = " + check::format_number(*in.E_dif) +
+                ") is invalid: it must be below R0 = " + check::format_number(in.R0) +
+                " (Eq. 13 needs 0 < R_spec < R0; E_dif/E_tot must exceed " +
+                check::format_number(1.0 - in.R0) + ")");
     }
     const double sigma = sigma_from_specular(R, in.theta_rad, in.wavelength_um, in.R0);
     const double sd_R = (1.0 - R) * std::sqrt(in.relative_noise_tot * in.relative_noise_tot +
                                               in.relative_noise_dif * in.relative_noise_dif);
     const double dsdR = d_sigma_d_specular_reflectance(R, in.theta_rad, in.wavelength_um, in.R0);
     RoughnessEstimate est;
-    est.sigma_um = Estimate{sigma, std::abs(dsdR) * sd_R};
+    const double sd_sigma = sd_R == 0.0 ? 0.0 : std::abs(dsdR) * sd_R;
+    est.sigma_um = Estimate{sigma, sd_sigma};
+    if (!std::isfinite(sd_sigma))
+        est.warnings.push_back(
+            "the standard error of sigma is unavailable: at R_spec = " + check::format_number(R) +
+            " dsigma/dR_spec times the noise exceeds the double range (R_spec is too close to 0 "
+            "for the noise to bound sigma)");
     // Eq. 12 (the coherent term) holds in every regime: no class is assumed.
     const Geometry geom = specular_geometry(in.theta_rad);
     fill_roughness_class(est, {geom}, sigma, in.wavelength_um, std::nullopt);
@@ -772,8 +800,8 @@ RoughnessEstimate estimate_slope(const SlopeInput& in) {
     est.sigma_over_T = Estimate{s, sd_s};
     const std::vector<Geometry> geoms{in.geom1, in.geom2};
     if (in.sigma_um) {
-        check::positive("sigma", *in.sigma_um, "um");
-        check::positive("wavelength", o.wavelength_um, "um");
+        check_length_um("sigma", *in.sigma_um);
+        check_length_um("wavelength", o.wavelength_um);
         est.sigma_um = Estimate{*in.sigma_um, 0.0};
         est.T_um = Estimate{*in.sigma_um / s, *in.sigma_um / (s * s) * sd_s};
         fill_roughness_class(est, geoms, *in.sigma_um, o.wavelength_um, RoughnessClass::VeryRough);

@@ -7,11 +7,14 @@
 #include <cmath>
 #include <exception>
 #include <memory>
+#include <mutex>
 #include <numeric>
 #include <string>
+#include <vector>
 
 #include <Eigen/Dense>
 #include <ceres/ceres.h>
+#include <glog/logging.h>
 
 #include "roughscope/core/errors.hpp"
 #include "roughscope/core/names.hpp"
@@ -354,6 +357,78 @@ class EngineCost final : public ceres::CostFunction {
   private:
     const Evaluator& e_;
     mutable std::vector<double> last_x_, last_r_;
+};
+
+// ---------------------------------------------------------------------------------------------
+// Ceres' own log lines (glog): kept off the terminal and put in the result's message instead.
+//
+// Ceres writes through glog whatever the solver options say (e.g. "Terminating: Residual and
+// Jacobian evaluation failed." at ERROR). Before glog is initialised every such line goes to
+// stderr, so on the first solve, if the host program has not initialised glog itself, the library
+// does: no log files, nothing on stderr below FATAL (the environment's GLOG_* settings still
+// apply). A host that initialised glog keeps its own configuration. Either way one process-wide
+// sink copies each line logged by a thread inside solve_least_squares into that solve's capture.
+
+thread_local std::vector<std::string>* t_solver_log = nullptr;
+
+class SolverLogSink final : public google::LogSink {
+  public:
+    void send(google::LogSeverity /*severity*/, const char* /*full_filename*/,
+              const char* /*base_filename*/, int /*line*/, const google::LogMessageTime& /*time*/,
+              const char* message, std::size_t message_len) override {
+        if (t_solver_log != nullptr) t_solver_log->emplace_back(message, message_len);
+    }
+};
+
+void quiet_solver_logging() {
+    static std::once_flag once;
+    std::call_once(once, [] {
+        if (!google::IsGoogleLoggingInitialized()) {
+            google::InitGoogleLogging("roughscope");
+            for (int severity = google::GLOG_INFO; severity < google::NUM_SEVERITIES; ++severity)
+                google::SetLogDestination(severity, "");
+            FLAGS_stderrthreshold = google::GLOG_FATAL;
+        }
+        static SolverLogSink sink;
+        google::AddLogSink(&sink);
+    });
+}
+
+// Collects the lines Ceres logs on this thread while alive.
+class SolverLogCapture {
+  public:
+    SolverLogCapture() : previous_(t_solver_log) {
+        quiet_solver_logging();
+        t_solver_log = &lines_;
+    }
+    ~SolverLogCapture() { t_solver_log = previous_; }
+    SolverLogCapture(const SolverLogCapture&) = delete;
+    SolverLogCapture& operator=(const SolverLogCapture&) = delete;
+
+    // "; solver log: <line> (N times); <line>" with each distinct line once, in order; empty
+    // when nothing was logged.
+    std::string summary() const {
+        std::vector<std::pair<std::string, int>> distinct;
+        for (const std::string& line : lines_) {
+            auto it = std::find_if(distinct.begin(), distinct.end(),
+                                   [&](const auto& d) { return d.first == line; });
+            if (it == distinct.end())
+                distinct.emplace_back(line, 1);
+            else
+                ++it->second;
+        }
+        std::string out;
+        for (const auto& [line, count] : distinct) {
+            out += out.empty() ? "; solver log: " : "; ";
+            out += line;
+            if (count > 1) out += " (" + std::to_string(count) + " times)";
+        }
+        return out;
+    }
+
+  private:
+    std::vector<std::string> lines_;
+    std::vector<std::string>* previous_;
 };
 
 // Ceres solve from start x (size n, or n + 1 with a free gain).
@@ -722,6 +797,7 @@ LeastSquaresResult solve_least_squares(const LeastSquaresProblem& P, const Least
     if (has_gain) res.parameters.push_back({"gain", kNaN, 0.0, -kInf, kInf, false, true});
 
     // Starts, then one Ceres run per start; the lowest final cost wins.
+    SolverLogCapture solver_log;
     const std::vector<std::vector<double>> starts = grid_starts(e, P, O, O.num_starts);
     std::vector<double> r(e.size());
     bool have_run = false;
@@ -746,7 +822,7 @@ LeastSquaresResult solve_least_squares(const LeastSquaresProblem& P, const Least
     }
     res.initial_cost = best.summary.initial_cost;
     res.final_cost = best.summary.final_cost;
-    res.message = best.summary.message;
+    res.message = best.summary.message + solver_log.summary();
     switch (best.summary.termination_type) {
         case ceres::CONVERGENCE:
             res.status = SolverStatus::Converged;

@@ -74,6 +74,8 @@ bool LineReader::next(std::string_view& line) {
         return false;
     }
     ++line_;
+    if (const auto nul = buffer_.find('\0'); nul != std::string::npos)
+        throw DataError(where() + "not a text file: NUL byte at column " + std::to_string(nul + 1));
     std::string_view view = buffer_;
     if (line_ == 1 && view.starts_with("\xEF\xBB\xBF")) view.remove_prefix(3);  // UTF-8 BOM
     if (!view.empty() && view.back() == '\r') view.remove_suffix(1);
@@ -145,10 +147,11 @@ void CsvReader::read_header() {
         for (const auto f : split_fields(line, ',')) {
             std::string name(trim(f));
             if (name.empty())
-                throw DataError(lines_.where() + "empty column name in the header '" +
-                                std::string(line) + "'");
+                throw DataError(lines_.where() + "empty column name in the header " +
+                                quote_input(line));
             if (!seen.insert(name).second)
-                throw DataError(lines_.where() + "duplicate column '" + name + "' in the header");
+                throw DataError(lines_.where() + "duplicate column " + quote_input(name) +
+                                " in the header");
             header_.push_back(std::move(name));
         }
         std::vector<std::string> missing;
@@ -206,8 +209,8 @@ bool CsvReader::next(CsvRow& row) {
             std::string reason;
             const auto value = try_parse_number(cell, reason);
             if (!value)
-                throw DataError(lines_.where() + "column " + header_[c] + ": '" +
-                                std::string(cell) + "' is " + reason);
+                throw DataError(lines_.where() + "column " + header_[c] + ": " + quote_input(cell) +
+                                " is " + reason);
             row.numbers[c] = *value;
             row.present[c] = 1;
         }

@@ -14,7 +14,7 @@
 #include "roughscope/core/names.hpp"
 #include "roughscope/scattering/geometry.hpp"
 
-#if defined(__x86_64__) && defined(__GLIBC__) && (defined(__GNUC__) || defined(__clang__))
+#if defined(__x86_64__) && defined(__GLIBC__) && defined(__GNUC__) && !defined(__clang__)
 #define ROUGHSCOPE_HAVE_LIBMVEC 1
 #include <immintrin.h>
 #else
@@ -332,24 +332,27 @@ template <Correlation C, GeometricFactor F, Radiometry R, AngleUnit U, VectorIsa
                     if constexpr (F == GeometricFactor::Kirchhoff) f *= ci / cs;
                     F2 = f * f;
                 }
+                // q_xy²/m² (× the constant of km): 0 on the specular direction however small m
+                // is (km = +inf when m² underflows; 0 × inf would be NaN).
+                const double qxy2_km = qxy2 == 0.0 ? 0.0 : qxy2 * km[j];
                 // The radiometric factor 1/cos θs of intensity (§3.3) joins the denominator.
                 if constexpr (C == Correlation::Gaussian) {
                     // Eq. 4 shape: F²/q_z² exp(−q_xy²/(4 m² q_z²))
                     if constexpr (R == Radiometry::Intensity) {
                         const double r = 1.0 / (qz2 * cs);
                         pref[j] = F2 * r;
-                        arg[j] = -(qxy2 * km[j]) * (cs * r);
+                        arg[j] = -qxy2_km * (cs * r);
                     } else {
                         const double r = 1.0 / qz2;
                         pref[j] = F2 * r;
-                        arg[j] = -(qxy2 * km[j]) * r;
+                        arg[j] = -qxy2_km * r;
                     }
                 } else {
                     // Eq. 5 shape: F²/(q_z² t^{3/2}), t = 1 + q_xy²/(m² q_z²). With w = q_z² t =
                     // q_z² + q_xy²/m² (> 0, no cancellation) and √q_z² = cos θi + cos θs:
                     // F²/(q_z² t^{3/2}) = F² (cos θi + cos θs)/(w √w); the root is taken below.
                     pref[j] = F2 * sum_c;
-                    arg[j] = qz2 + qxy2 * km[j];
+                    arg[j] = qz2 + qxy2_km;
                     if constexpr (R == Radiometry::Intensity) pref[j] /= cs;
                 }
             }

@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "roughscope/core/errors.hpp"
+#include "roughscope/scattering/beckmann.hpp"
 #include "roughscope/scattering/factors.hpp"
 
 namespace roughscope {
@@ -51,9 +52,9 @@ double retro_vh_exponential_very_rough(double theta_rad, double sigma_over_T) {
 double retro_vh_gaussian_slightly_rough(double theta_rad, double sigma_um, double T_um,
                                         double wavelength_um) {
     check::polar_angle("theta", theta_rad);
-    check::positive("sigma", sigma_um, "um");
-    check::positive("T", T_um, "um");
-    check::positive("wavelength", wavelength_um, "um");
+    check_length_um("sigma", sigma_um);
+    check_length_um("T", T_um);
+    check_length_um("wavelength", wavelength_um);
     const double k = wavenumber_per_um(wavelength_um);
     const double c = std::cos(theta_rad), s = std::sin(theta_rad);
     const double Ts = T_um * s, sc2 = 2.0 * sigma_um * c;

@@ -14,7 +14,9 @@ Json to_json(const ScatteredPower& p) {
             {"total", number(p.total)},
             {"g", number(p.g)},
             {"regime", std::string(to_string(p.regime))},
-            {"roughness_class", std::string(to_string(p.roughness_class))}};
+            {"roughness_class", std::string(to_string(p.roughness_class))},
+            {"method", std::string(to_string(p.method))},
+            {"relative_error_bound", number(p.relative_error_bound)}};
 }
 
 }  // namespace roughscope::serialize

@@ -1,10 +1,16 @@
 #include "roughscope/serialize/paper_tables.hpp"
 
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
 #include <cstddef>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
 #include <functional>
+#include <iterator>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "roughscope/core/errors.hpp"
@@ -101,23 +107,27 @@ PrintedTable open_table(const Json& reference, const char* key, const std::strin
     std::string w = where + ": " + key;
     const Json& t = need(reference, key, where);
     const Json& cond = need(t, "conditions", w);
-    const double theta1_rad = deg_to_rad(num_at(cond, "theta1_deg", w));
-    const double theta2_rad = deg_to_rad(num_at(cond, "theta2_deg", w));
+    const std::string wc = w + ".conditions";
+    const double theta1_rad = deg_to_rad(num_at(cond, "theta1_deg", wc));
+    const double theta2_rad = deg_to_rad(num_at(cond, "theta2_deg", wc));
     return {std::move(w), t, cond, theta1_rad, theta2_rad};
 }
 
 Json table1(const Json& reference, const std::string& where) {
     const PrintedTable t = open_table(reference, "table1_slightly_rough", where);
     const std::string& w = t.where;
-    const double theta_rad = deg_to_rad(num_at(t.conditions, "specular_theta_deg", w));
+    const double theta_rad =
+        deg_to_rad(num_at(t.conditions, "specular_theta_deg", w + ".conditions"));
     const double theta1_rad = t.theta1_rad, theta2_rad = t.theta2_rad;
-    const double wavelength_um = num_at(t.conditions, "lambda_um", w);
+    const double wavelength_um = num_at(t.conditions, "lambda_um", w + ".conditions");
     const auto T_of = [&](const Inputs& x) {  // x = {σ, E1/E2}: Eq. 15
         return correlation_length_from_ratio(x[1], x[0], theta1_rad, theta2_rad, wavelength_um);
     };
     Json rows = Json::array();
-    for (const Json& row : rows_of(t.table, w)) {
-        const std::string wr = w + " row";
+    const Json& printed_rows = rows_of(t.table, w);
+    for (std::size_t i = 0; i < printed_rows.size(); ++i) {
+        const Json& row = printed_rows[i];
+        const std::string wr = w + ".rows[" + std::to_string(i) + "]";
         const double R_spec = num_at(row, "R_spec", wr);
         const double sigma_um = num_at(row, "sigma_um", wr);
         const double ratio = num_at(row, "E1_over_E2", wr);
@@ -140,8 +150,10 @@ Json table2(const Json& reference, const std::string& where) {
     const std::string& w = t.where;
     const double theta1_rad = t.theta1_rad, theta2_rad = t.theta2_rad;
     Json rows = Json::array();
-    for (const Json& row : rows_of(t.table, w)) {
-        const std::string wr = w + " row";
+    const Json& printed_rows = rows_of(t.table, w);
+    for (std::size_t i = 0; i < printed_rows.size(); ++i) {
+        const Json& row = printed_rows[i];
+        const std::string wr = w + ".rows[" + std::to_string(i) + "]";
         const double ratio = num_at(row, "E1_over_E2", wr);
         Json r = {{"surface", text_at(row, "surface", wr)}, {"E1_over_E2", number(ratio)}};
         add_slope_checks(r, row, wr, ratio, 3, theta1_rad, theta2_rad);
@@ -162,14 +174,16 @@ Json table3(const Json& reference, const std::string& where) {
     const std::string& w = t.where;
     const double theta1_rad = t.theta1_rad, theta2_rad = t.theta2_rad;
     Json rows = Json::array();
-    for (const Json& row : rows_of(t.table, w)) {
-        const std::string wr = w + " row";
+    const Json& printed_rows = rows_of(t.table, w);
+    for (std::size_t i = 0; i < printed_rows.size(); ++i) {
+        const Json& row = printed_rows[i];
+        const std::string wr = w + ".rows[" + std::to_string(i) + "]";
         const double ratio = num_at(row, "E1_over_E2", wr);
         std::string name = text_at(row, "name", wr);
         if (row.contains("sample")) {
             if (!row["sample"].is_number_integer())
                 throw DataError(wr + ": key 'sample' is not an integer");
-            name += " (" + std::to_string(row["sample"].get<int>()) + ")";
+            name += " (" + row["sample"].dump() + ")";
         }
         Json r = {{"sample", name}, {"E1_over_E2", number(ratio)}};
         add_slope_checks(r, row, wr, ratio, 6, theta1_rad, theta2_rad);
@@ -178,13 +192,65 @@ Json table3(const Json& reference, const std::string& where) {
     return {{"conditions", t.conditions}, {"rows", rows}};
 }
 
+// One table; an estimator's refusal of a printed input (InvalidArgument, NoSolution) becomes a
+// DataError naming the file and the table.
+Json one_table(Json (*compute)(const Json&, const std::string&), const char* key,
+               const Json& reference, const std::string& where) {
+    try {
+        return compute(reference, where);
+    } catch (const DataError&) {
+        throw;
+    } catch (const Error& e) {
+        throw DataError(where + ": " + key + ": " + e.what());
+    }
+}
+
+// "line L, column C" of byte `offset` (0-based) of `text`.
+std::string line_and_column(std::string_view text, std::size_t offset) {
+    offset = std::min(offset, text.size());
+    const std::string_view before = text.substr(0, offset);
+    const std::size_t line =
+        1 + static_cast<std::size_t>(std::count(before.begin(), before.end(), '\n'));
+    const std::size_t last_newline = before.rfind('\n');
+    const std::size_t column =
+        last_newline == std::string_view::npos ? offset + 1 : offset - last_newline;
+    return "line " + std::to_string(line) + ", column " + std::to_string(column);
+}
+
 }  // namespace
 
 Json recompute_paper_tables(const Json& reference, const std::string& where) {
     if (!reference.is_object()) throw DataError(where + ": not a JSON object");
-    return {{"table1", table1(reference, where)},
-            {"table2", table2(reference, where)},
-            {"table3", table3(reference, where)}};
+    return {{"table1", one_table(table1, "table1_slightly_rough", reference, where)},
+            {"table2", one_table(table2, "table2_very_rough", reference, where)},
+            {"table3", one_table(table3, "table3_curet_parameters", reference, where)}};
+}
+
+Json read_paper_tables_reference(const std::filesystem::path& path) {
+    const std::string name = path.string();
+    std::error_code ec;
+    if (!std::filesystem::exists(path, ec)) throw DataError(name + ": does not exist");
+    if (std::filesystem::is_directory(path, ec))
+        throw DataError(name + ": is a directory, not a file");
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw DataError(name + ": cannot open: " + std::strerror(errno));
+    std::string text{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+    if (in.bad()) throw DataError(name + ": read error");
+    if (const auto nul = text.find('\0'); nul != std::string::npos)
+        throw DataError(name + ": " + line_and_column(text, nul) + ": not a text file: NUL byte");
+    try {
+        return Json::parse(text);
+    } catch (const Json::parse_error& e) {
+        // nlohmann's text: "[json.exception.parse_error.101] parse error at line L, column C:
+        // syntax error while parsing value - <what>; last read: '<text>'": keep <what>.
+        std::string what = e.what();
+        if (const auto colon = what.find(": ", what.find("column")); colon != std::string::npos)
+            what = what.substr(colon + 2);
+        if (const auto last = what.find("; last read"); last != std::string::npos)
+            what.resize(last);
+        const std::size_t offset = e.byte > 0 ? e.byte - 1 : 0;
+        throw DataError(name + ": " + line_and_column(text, offset) + ": not valid JSON: " + what);
+    }
 }
 
 }  // namespace roughscope::serialize

@@ -100,3 +100,42 @@ def python_env():
     env["PYTHONPATH"] = os.pathsep.join(p for p in sys.path if p)
     env.setdefault("MPLBACKEND", "Agg")
     return env
+
+
+# ---------------------------------------------------------------------------------------------
+# Tests that drive only the command-line tool carry the marker `cli`: `make sanitize` runs them
+# (`pytest -m cli`) against the AddressSanitizer + UBSan build of the executable. Every test in
+# a file named test_cli_*.py has it; another file joins with `pytestmark = pytest.mark.cli`
+# (or one test with @pytest.mark.cli). Such tests may use the Python module too (it is the
+# release build's), but what they check must come from the executable.
+
+def pytest_configure(config):
+    config.addinivalue_line(
+        "markers", "cli: drives only the roughscope executable (also run under ASan by "
+                   "`make sanitize`)")
+
+
+def pytest_collection_modifyitems(config, items):
+    for item in items:
+        if item.path.name.startswith("test_cli_"):
+            item.add_marker(pytest.mark.cli)
+
+
+# Under `make sanitize`, sanitizer reports of the executable go to files in
+# $ROUGHSCOPE_SANITIZER_LOG_DIR (ASAN_OPTIONS/UBSAN_OPTIONS log_path): a report written during a
+# test fails it, whatever exit code the test expected.
+SANITIZER_LOG_DIR = os.environ.get("ROUGHSCOPE_SANITIZER_LOG_DIR")
+
+
+@pytest.fixture(autouse=True)
+def no_sanitizer_report():
+    if not SANITIZER_LOG_DIR:
+        yield
+        return
+    log_dir = pathlib.Path(SANITIZER_LOG_DIR)
+    before = set(log_dir.glob("report*"))
+    yield
+    new = sorted(set(log_dir.glob("report*")) - before)
+    if new:
+        text = "\n".join(f"--- {p}\n{p.read_text(errors='replace')[:20000]}" for p in new)
+        pytest.fail(f"sanitizer report from the roughscope executable:\n{text}", pytrace=False)

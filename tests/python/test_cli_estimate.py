@@ -83,7 +83,7 @@ def test_slope_general_geometry_and_text_output():
 
 def test_slope_errors():
     p = run("estimate", "slope", "--ratio", "1.0", "--theta1", "30", "--theta2", "45", check=False)
-    assert_error(p, EXIT_NO_SOLUTION, "E1/E2 = 1", "must be in (1.025019, inf)")
+    assert_error(p, EXIT_NO_SOLUTION, "E1/E2 = 1", "must be > 1.025019")
     p = run("estimate", "slope", "--ratio", "4", "--theta1", "30", "--theta2", "45",
             "--correlation", "exponential", check=False)
     assert_error(p, EXIT_NO_SOLUTION, "(1.025019, 3.786583)")
@@ -158,7 +158,7 @@ def test_correlation_length_table1():
 def test_correlation_length_errors():
     p = run("estimate", "correlation-length", "--sigma", "0.094", "--ratio", "0.5", "--theta1",
             "30", "--theta2", "45", check=False)
-    assert_error(p, EXIT_NO_SOLUTION, "Eq. 15", "must be in (")
+    assert_error(p, EXIT_NO_SOLUTION, "Eq. 15", "must be > 0.769")
     p = run("estimate", "correlation-length", "--ratio", "1.04", "--theta1", "30", "--theta2", "45",
             check=False)
     assert_error(p, EXIT_USAGE, "--sigma")

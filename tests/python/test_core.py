@@ -422,7 +422,7 @@ def test_broadcasting_matches_elementwise_scalar_calls():
 def test_mean_scattered_power_returns_dict_of_arrays_or_scalars():
     p = rs.mean_scattered_power(30.0, 30.0, 0.0, 0.1, 1.0)
     assert set(p) == {"coherent", "diffuse", "total", "brightness", "g", "regime",
-                      "roughness_class"}
+                      "roughness_class", "method", "relative_error_bound"}
     assert type(p["total"]) is float and type(p["regime"]) is str
     assert p["regime"] in rs.REGIMES and p["regime"] != "auto"
     assert p["total"] == pytest.approx(p["coherent"] + p["diffuse"], rel=1e-15)

@@ -1,8 +1,11 @@
 // Typed errors of the public API (the "invalid input" tier of DEVELOPERS.md).
 //
 // Every exception message names the offending input, its value and the valid range, so that a
-// front end can show it to the user verbatim. The CLI turns any roughscope::Error into a one-line
-// message and a non-zero exit status; the Python module raises ValueError subclasses.
+// front end can show it to the user verbatim. The message is made printable and bounded on the
+// way in (core/text.hpp: control characters and invalid UTF-8 escaped, at most kMessageMaxBytes
+// kept), so a value read from a file can never reach a terminal raw, cut a C string at a NUL
+// byte, or make a Python exception without a message. The CLI turns any roughscope::Error into a
+// one-line message and a non-zero exit status; the Python module raises ValueError subclasses.
 #pragma once
 
 #include <stdexcept>
@@ -14,7 +17,7 @@ namespace roughscope {
 // Base of every error the library throws on purpose.
 class Error : public std::runtime_error {
   public:
-    using std::runtime_error::runtime_error;
+    explicit Error(std::string_view message);
 };
 
 // An argument is outside its valid range, NaN, or inconsistent with another argument.
@@ -55,8 +58,8 @@ void polar_angle(std::string_view name, double theta_rad);
 // wrapped by the functions that use them).
 void azimuth(std::string_view name, double phi_rad);
 
-// Formats a double for messages: format_message of numbers.hpp (shortest round-trip form,
-// "nan"/"inf" spelled out).
+// Formats a double for messages: format_message of numbers.hpp (shortest round-trip form, so that
+// a value is never shown equal to the limit it breaks; "nan"/"inf" spelled out).
 std::string format_number(double value);
 
 }  // namespace check

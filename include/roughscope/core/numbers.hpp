@@ -10,9 +10,15 @@
 //                         output); refuses NaN/infinity (results are never printed as NaN);
 //  * format_significant — fixed number of significant digits ("%.*g") for human-readable text;
 //                         refuses NaN/infinity too;
-//  * format_message     — error messages: shortest round-trip form (or fixed significant
-//                         digits), "nan", "inf" and "-inf" spelled out (the value being reported
-//                         may be the bad one).
+//  * format_message     — error messages: shortest round-trip form, or fixed significant
+//                         digits when asked, but never rounded to a shorter, rounder number
+//                         that is not the value ("kappa = 1.00000001 must exceed 1", not
+//                         "kappa = 1 must exceed 1"); "nan", "inf" and "-inf" spelled out (the
+//                         value being reported may be the bad one).
+//
+// Integers (counts, sample and measurement numbers given as text): try_parse_integer, the same
+// rules as numbers (decimal digits only, optional sign, surrounding spaces allowed; no "0x19",
+// no "25.0", no exponent).
 #pragma once
 
 #include <cstddef>
@@ -32,8 +38,18 @@ std::string_view trim_space(std::string_view text);
 // the range of double-precision numbers", ...) otherwise.
 std::optional<double> try_parse_number(std::string_view text, std::string& reason);
 
-// As try_parse_number but throws InvalidArgument "<what>: '<text>' is <reason>" (text trimmed).
+// As try_parse_number but throws InvalidArgument "<what>: '<text>' is <reason>" (text trimmed,
+// quoted by quote_input of core/text.hpp).
 double parse_number(std::string_view text, std::string_view what);
+
+// Parses the whole of `text` as a decimal integer in [lo, hi] (surrounding spaces/tabs allowed, a
+// leading '+' or '-' allowed; no hexadecimal, no fraction, no exponent). Returns std::nullopt and
+// sets `reason` ("not an integer", "out of the range [lo, hi]", ...) otherwise.
+std::optional<long long> try_parse_integer(std::string_view text, long long lo, long long hi,
+                                           std::string& reason);
+
+// As try_parse_integer but throws InvalidArgument "<what>: '<text>' is <reason>".
+long long parse_integer(std::string_view text, long long lo, long long hi, std::string_view what);
 
 // Parses "a,b,c" into exactly `count` finite numbers; throws InvalidArgument naming `what` (and
 // the item, 1-based, for a bad number).
@@ -48,8 +64,10 @@ std::string format_roundtrip(double value, std::string_view name = "value");
 // roughscope::Error naming `name` for NaN or infinity.
 std::string format_significant(double value, int digits, std::string_view name = "value");
 
-// For error messages only: shortest round-trip form (or `digits` significant digits when
-// digits > 0), "nan", "inf", "-inf" spelled out.
+// For error messages only: the shortest round-trip form, or `digits` significant digits when
+// digits > 0 — unless the rounded text has fewer significant digits than `digits` and differs
+// from the value by more than floating-point noise (relative 1e-14): 1.00000001 at 7 digits is
+// "1.00000001", not "1", while 29.999999999999996 is "30". "nan", "inf", "-inf" spelled out.
 std::string format_message(double value, int digits = 0);
 
 // `value` rounded to `digits` significant digits (the value format_significant prints). NaN,

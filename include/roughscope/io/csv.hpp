@@ -1,11 +1,14 @@
 // Reading delimited text files: the library's one CSV reader and the line/field splitter under it.
 //
 // Conventions shared by every text format the library reads (CSV tables, CUReT's table.txt and
-// *.dat files):
+// *.dat files; the JSON reference file too) — the one reading policy of docs/input-files.md:
 //  * a UTF-8 byte-order mark at the start of the file is skipped; CRLF and LF line ends are both
-//    accepted (one trailing CR is removed from every line);
-//  * numbers are parsed strictly (roughscope/core/numbers.hpp): "nan", "inf", "1.5x" are errors;
-//  * every error is a DataError "<file>:<line>: <reason>" naming the column or field.
+//    accepted (one trailing CR is removed from every line); spaces and tabs around fields too;
+//  * numbers are parsed strictly (roughscope/core/numbers.hpp): decimal only, "0x19", "nan",
+//    "inf", "1.5x" are errors; integers are decimal digits only;
+//  * a NUL byte makes it a binary file: DataError "<file>:<line>: not a text file: NUL byte ...";
+//  * every error is a DataError "<file>:<line>: <reason>" naming the column or field, with the
+//    input quoted by quote_input (core/text.hpp: escaped, at most 64 bytes shown).
 //
 // CSV (CsvReader): comma-separated, one header line naming the columns, then data rows.
 //  * Blank lines and lines whose first non-space character is '#' are skipped (before or after

@@ -46,20 +46,41 @@ std::string_view to_string(Regime r);       // "auto", "series", "slightly_rough
 Correlation parse_correlation(std::string_view name);  // throws InvalidArgument listing names
 Regime parse_regime(std::string_view name);
 
+// How the diffuse term D was evaluated.
+enum class DiffuseMethod {
+    ClosedForm,       // the one-term or very-rough closed form of the regime (Eq. 3, 4, 5, ...)
+    Summation,        // the series summed (g ≲ 1e7, or where the summation is the more accurate)
+    LargeGExpansion,  // the series by its large-g expansion: the very-rough limit × (1 + R1/g)
+};
+std::string_view to_string(DiffuseMethod m);  // "closed_form", "summation", "large_g_expansion"
+
 // ---------------------------------------------------------------------------------------------
-// Dimensionless Poisson-weighted sums (the series without their prefactors).
-// Exact for every g in [0, 1e7] and every T²v_xy² ≥ 0 (relative error ≲ 1e−13, checked against
-// 40-digit references): summed outward from the peak of the summand, so no term count is fixed
-// and nothing overflows; for wide peaks (g ≳ 200) the sum is evaluated by the exponentially
-// convergent trapezoid rule on the analytic continuation of the summand (Poisson summation), so
-// the cost stays bounded (~1 µs) however large g is.
-// Underflow to 0 is an expected physical zero (far outside the diffuse lobe).
+// Dimensionless Poisson-weighted sums (the series without their prefactors), correct for every
+// finite g ≥ 0 and T²v_xy² ≥ 0 with a stated relative error bound:
+//  * Summation (g ≤ 1e13): summed outward from the peak of the summand, so no term count is
+//    fixed and nothing overflows; for wide peaks (g ≳ 200) by the exponentially convergent
+//    trapezoid rule on the analytic continuation of the summand (Poisson summation), so the cost
+//    stays bounded (~1 µs) however large g is. Relative error ≲ 1e−13 up to g = 1e7 (checked
+//    against 40-digit references), bound stated as 2e−13 + 1e−21·g.
+//  * Large-g expansion (g ≥ 1e4 where its bound is the smaller, always for g > 1e13): the
+//    very-rough limit (Eq. 4; for the exponential case the series limit) times 1 + R1/g, with
+//    the bound 2(|R2|/g² + |R3|/g³) + rounding from the next terms (series.cpp,
+//    docs/exponential-correlation.md). At g = 1e7 the bound is ~4e−14 inside the lobe.
+// Underflow to 0 is an expected physical zero (far outside the diffuse lobe, or g·e^{−a}
+// below the smallest double for tiny g).
+struct SeriesResult {
+    double value = 0.0;
+    DiffuseMethod method = DiffuseMethod::Summation;
+    double relative_error_bound = 0.0;
+};
 
 // S_G(g, a) = e^{−g} Σ_{n≥1} gⁿ/(n! n) exp(−a/n),  a = T² v_xy²/4                   (Eq. 2)
-double gaussian_series_sum(double g, double T2_vxy2);
+SeriesResult gaussian_series(double g, double T2_vxy2);
+double gaussian_series_sum(double g, double T2_vxy2);  // gaussian_series(...).value
 
 // S_E(g, b) = e^{−g} Σ_{n≥1} gⁿ/n! · n/(n² + b)^{3/2},  b = T² v_xy²
-double exponential_series_sum(double g, double T2_vxy2);
+SeriesResult exponential_series(double g, double T2_vxy2);
+double exponential_series_sum(double g, double T2_vxy2);  // exponential_series(...).value
 
 // Textbook summation from n = 1 with a fixed number of terms and e^{−g} applied at the end:
 // the baseline the benchmarks compare against. Overflows (returns inf/nan) beyond g ≈ 709 and
@@ -72,7 +93,10 @@ double exponential_series_sum_naive(double g, double T2_vxy2, int max_terms);
 
 // ρ0 = sinc(vx X) sinc(vy Y) for a 2X × 2Y patch (§3.1); ρ0 = 1 in the specular direction.
 inline double specular_amplitude_rho0(double vx, double vy, double X_um, double Y_um) {
-    auto sinc = [](double x) { return std::abs(x) < 1e-8 ? 1.0 - x * x / 6.0 : std::sin(x) / x; };
+    auto sinc = [](double x) {  // → 0 as |x| → ∞ (also where vx·X overflows)
+        if (!(std::abs(x) <= 1.7976931348623157e308)) return 0.0;
+        return std::abs(x) < 1e-8 ? 1.0 - x * x / 6.0 : std::sin(x) / x;
+    };
     return sinc(vx * X_um) * sinc(vy * Y_um);
 }
 
@@ -89,6 +113,17 @@ inline double diffuse_power_gaussian_series(double F2, double T_um, double area_
 inline double diffuse_power_slightly_rough_gaussian(double F2, double T_um, double area_um2,
                                                     double g, double vxy2) {
     return kPi * T_um * T_um / area_um2 * g * F2 * std::exp(-g - T_um * T_um * vxy2 / 4.0);
+}
+
+// t² = q_xy²/((σ/T)² q_z²) = T² v_xy²/(σ² v_z²), the argument of the very-rough forms: finite
+// or +inf for every positive σ/T (never 0/0 or inf/inf): 0 on the specular direction, and from
+// the ratio (q_xy/q_z)/(σ/T) where (σ/T)² q_z² underflows or overflows.
+inline double very_rough_argument(double qxy2, double qz2, double sigma_over_T) {
+    if (qxy2 == 0.0) return 0.0;
+    const double den = sigma_over_T * sigma_over_T * qz2;
+    if (den > 0.0 && den <= 1.7976931348623157e308) return qxy2 / den;
+    const double t = std::sqrt(qxy2 / qz2) / sigma_over_T;
+    return t * t;
 }
 
 // Eq. 4.
@@ -131,19 +166,29 @@ inline double diffuse_power_very_rough_exponential_series_limit(double F2, doubl
 //   Gaussian (Eq. 4):    F²/q_z² · exp(−q_xy² /(4 (σ/T)² q_z²))
 //   Exponential (Eq. 5): F²/(q_z² [1 + q_xy²/((σ/T)² q_z²)]^{3/2})
 // with q = v/k. Eq. 4 = (πT²/(Aσ²k²)) × shape, Eq. 5 = (2πT²/(Aσ²k²)) × shape.
+// Finite for every σ/T > 0 (σ/T → 0 gives 0 off the specular direction, the specular value on
+// it; σ/T → ∞ gives F²/q_z²).
 inline double very_rough_shape_gaussian(double F2, const ScatteringDirection& q,
                                         double sigma_over_T) {
-    const double m2 = sigma_over_T * sigma_over_T;
-    return F2 / q.qz2() * std::exp(-q.qxy2() / (4.0 * m2 * q.qz2()));
+    return F2 / q.qz2() * std::exp(-0.25 * very_rough_argument(q.qxy2(), q.qz2(), sigma_over_T));
 }
 inline double very_rough_shape_exponential(double F2, const ScatteringDirection& q,
                                            double sigma_over_T) {
-    const double m2 = sigma_over_T * sigma_over_T;
-    return F2 / (q.qz2() * std::pow(1.0 + q.qxy2() / (m2 * q.qz2()), 1.5));
+    return F2 /
+           (q.qz2() * std::pow(1.0 + very_rough_argument(q.qxy2(), q.qz2(), sigma_over_T), 1.5));
 }
 
 // ---------------------------------------------------------------------------------------------
 // Validated, user-facing evaluation.
+
+// Lengths (σ, T, λ, X, Y) accepted by the validated functions, in µm: from below the Planck
+// length to beyond the observable universe, so that no product of lengths and wavenumbers in
+// Eq. 1–5 overflows or underflows to a meaningless 0/0.
+inline constexpr double kMinLengthUm = 1e-30;
+inline constexpr double kMaxLengthUm = 1e30;
+// Throws InvalidArgument "<name> = <value> um is outside the valid range [1e-30, 1e+30] um"
+// unless kMinLengthUm <= value_um <= kMaxLengthUm.
+void check_length_um(std::string_view name, double value_um);
 
 struct Surface {
     double sigma_um = 0.0;  // RMS height σ
@@ -171,10 +216,18 @@ struct ScatteredPower {
     double g = 0.0;                  // σ² v_z² at this geometry
     Regime regime = Regime::Series;  // the regime actually used (never Auto)
     RoughnessClass roughness_class = RoughnessClass::SlightlyRough;
+    // How D was evaluated (for regime Series: summation, or the large-g expansion where the sum
+    // underflows or loses accuracy) and a bound on its relative error against the exact series
+    // (regime Series, or SlightlyRough chosen by Auto: the omitted terms); 0 for a closed form
+    // asked for by name, which is evaluated as defined (rounding only).
+    DiffuseMethod method = DiffuseMethod::Summation;
+    double relative_error_bound = 0.0;
 };
 
-// Eq. 1 at one geometry. Validates: θi, θs in [0°, 90°), φs finite, σ, T, λ, X, Y > 0 and
-// finite, auto_tolerance in (0, 1); throws InvalidArgument naming the input otherwise.
+// Eq. 1 at one geometry. Validates: θi, θs in [0°, 90°), φs finite, σ, T, λ, X, Y in
+// [kMinLengthUm, kMaxLengthUm], auto_tolerance in (0, 1); throws InvalidArgument naming the
+// input otherwise. Every result field is finite: where the power itself exceeds the double range
+// (grazing geometries with a patch far below the wavelength) it throws InvalidArgument saying so.
 ScatteredPower mean_scattered_power(const Geometry& geom, const Surface& surface,
                                     const ModelOptions& options = {});
 
@@ -184,12 +237,19 @@ double very_rough_brightness(const Geometry& geom, double sigma_over_T, Correlat
                              GeometricFactor factor = GeometricFactor::VernoldHarvey,
                              Radiometry radiometry = Radiometry::Radiance);
 
-// The diffuse Kirchhoff integral evaluated by direct numerical quadrature (adaptive
-// Gauss–Kronrod), independent of the series:
+// The diffuse Kirchhoff integral evaluated by direct numerical quadrature (Gauss–Kronrod on
+// intervals split at the peak scale and the half-periods of J0), independent of the series:
 //   D = (2π/A) F² e^{−g} ∫₀^∞ [exp(g C(τ)) − 1] J0(v_xy τ) τ dτ
-// Used to verify the series; slow (~0.1–10 ms), intended for g ≲ 50 and T·v_xy ≲ 50. Its error
-// is absolute (~1e−16 of the integrand's scale), so relative accuracy is lost where D is many
-// decades below that scale (far tails of the Gaussian lobe, e.g. T·v_xy = 20 at g < 1).
+// Used to verify the series. Domain (else InvalidArgument naming the value and the domain):
+//   0 <= g <= kQuadratureMaxG (1e4),  0 <= T·v_xy <= kQuadratureMaxTvxy (100),
+//   F² >= 0, T > 0, A > 0 finite with (2π/A) F² T² finite.
+// Inside it the run time is bounded (≲ 50 ms) and the error is absolute, ≲ 1e−12 × the scale
+// (2π/A) F² T² × (1 − e^{−g})/max(g, 1)^p (p = 1 Gaussian, 2 exponential: the integral's size
+// at the lobe centre), so relative accuracy is lost only where D is many decades below that
+// scale (far tails of the lobe, e.g. T·v_xy = 20 at g < 1). Never negative: results below 0
+// (rounding in a tail) are returned as 0.
+inline constexpr double kQuadratureMaxG = 1e4;
+inline constexpr double kQuadratureMaxTvxy = 100.0;
 double diffuse_power_quadrature(Correlation correlation, double F2, double T_um, double area_um2,
                                 double g, double vxy2);
 

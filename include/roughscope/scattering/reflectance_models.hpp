@@ -22,6 +22,12 @@ struct OrenNayarParams {
     double albedo = 1.0;
 };
 
+// σ²/(σ² + c), the saturating factor of every Oren–Nayar coefficient (c = 0.33, 0.09, 0.13),
+// without inf/inf when σ² overflows: → 1 as σ → ∞.
+inline double oren_nayar_saturation(double s2, double c) {
+    return s2 > 1.0 ? 1.0 / (1.0 + c / s2) : s2 / (s2 + c);
+}
+
 // Full Oren–Nayar model with the inter-reflection term (Oren & Nayar, SIGGRAPH 1994, Eq. 30
 // plus the L2 term): L = L1 + L2 with
 //   L1 = (ρ/π) cos θi [C1 + cos(φr−φi) C2 tan β + (1 − |cos(φr−φi)|) C3 tan((α+β)/2)]

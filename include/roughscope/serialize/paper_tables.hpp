@@ -13,14 +13,21 @@
 // The command line (`roughscope paper tables`) and the Python report both show this document.
 #pragma once
 
+#include <filesystem>
 #include <string>
 
 #include "roughscope/serialize/json.hpp"
 
 namespace roughscope::serialize {
 
-// {"table1": {"conditions", "rows"}, "table2": ..., "table3": ...}. Throws DataError naming
-// `where` (the file) and the missing or malformed key.
+// {"table1": {"conditions", "rows"}, "table2": ..., "table3": ...}. Throws DataError
+// "<where>: <place in the document>: <what>" for a missing or malformed key (places as
+// "table1_slightly_rough.rows[0]") or a printed input the estimators refuse.
 Json recompute_paper_tables(const Json& reference, const std::string& where);
+
+// Reads the reference document (docs/input-files.md: UTF-8 BOM, CRLF accepted). Throws DataError
+// "<path>: does not exist", "<path>: is a directory, not a file", "<path>: line L, column C: not
+// a text file: NUL byte" or "<path>: line L, column C: not valid JSON: <what>".
+Json read_paper_tables_reference(const std::filesystem::path& path);
 
 }  // namespace roughscope::serialize

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <map>
 #include <sstream>
 #include <string>
@@ -514,4 +515,164 @@ TEST(CuretAll, EverySampleIsProcessedAndSample61ExplainsItsMissingEstimate) {
         EXPECT_EQ(one[k].result(ComparisonModel::VhExponentialFit).errors.gain_sse,
                   all[k].result(ComparisonModel::VhExponentialFit).errors.gain_sse);
     EXPECT_THROW(compare_curet_all(database(), {}, -1), InvalidArgument);
+}
+
+// ---------------------------------------------------------------------------------------------
+// The reading policy of docs/input-files.md on the CUReT files and the BRDF table CSV
+
+namespace {
+
+std::string load_error(const fs::path& dir) {
+    try {
+        load_curet(dir);
+    } catch (const DataError& e) {
+        return e.what();
+    }
+    return "no error";
+}
+
+// table.txt of `s` rewritten line by line by `edit`.
+void rewrite_table(const SyntheticCuret& s,
+                   const std::function<std::string(const std::string&)>& edit,
+                   const std::string& prefix = "") {
+    std::ifstream in(s.dir / "table.txt");
+    std::string text = prefix, line;
+    while (std::getline(in, line)) text += edit(line);
+    in.close();
+    std::ofstream(s.dir / "table.txt", std::ios::binary) << text;
+}
+
+}  // namespace
+
+TEST(CuretFiles, BomCrlfAndSurroundingSpacesAreAccepted) {
+    SyntheticCuret s("policy");
+    s.write_samples("abrdf.dat", {3}, 0.05);
+    rewrite_table(
+        s, [](const std::string& line) { return " \t" + line + " \t\r\n"; }, "\xEF\xBB\xBF");
+    const CuretDatabase db = load_curet(s.dir);
+    EXPECT_EQ(db.angles.size(), static_cast<std::size_t>(kCuretMeasurementCount));
+    EXPECT_EQ(db.samples, std::vector<int>{3});
+}
+
+TEST(CuretFiles, HexNanBinaryAndNonDecimalIntegersAreRefusedWithFileAndLine) {
+    {
+        SyntheticCuret s("hex");
+        s.write_samples("abrdf.dat", {3}, 0.05);
+        rewrite_table(s, [](const std::string& line) {
+            return (line.starts_with("7 ") ? "0x" : "") + line + "\n";
+        });
+        const std::string e = load_error(s.dir);
+        EXPECT_NE(e.find("table.txt:7: field 1 (measurement): '0x7' is not an integer"),
+                  std::string::npos)
+            << e;
+    }
+    {
+        SyntheticCuret s("decimal_sample");
+        s.write_samples("abrdf.dat", {3}, 0.05);
+        std::string text;
+        {
+            std::ifstream in(s.dir / "abrdf.dat");
+            std::getline(in, text);
+        }
+        std::ofstream(s.dir / "abrdf.dat") << "3.0" << text.substr(1) << "\n";
+        const std::string e = load_error(s.dir);
+        EXPECT_NE(e.find("abrdf.dat:1: field 1 (sample number): '3.0' is not an integer"),
+                  std::string::npos)
+            << e;
+    }
+    {
+        SyntheticCuret s("binary");
+        s.write_samples("abrdf.dat", {3}, 0.05);
+        std::ofstream(s.dir / "table.txt", std::ios::binary) << "\x7f"
+                                                                "ELF\x02\x01\x01"
+                                                             << '\0' << "\x1b[2J";
+        const std::string e = load_error(s.dir);
+        EXPECT_NE(e.find("table.txt:1: not a text file: NUL byte at column 8"), std::string::npos)
+            << e;
+        EXPECT_EQ(e.find('\x1b'), std::string::npos);
+    }
+    {
+        SyntheticCuret s("empty");
+        s.write_samples("abrdf.dat", {3}, 0.05);
+        std::ofstream(s.dir / "table.txt", std::ios::trunc).close();
+        const std::string e = load_error(s.dir);
+        EXPECT_NE(e.find("table.txt: 0 measurement rows"), std::string::npos) << e;
+    }
+    {
+        SyntheticCuret s("dir");
+        s.write_samples("abrdf.dat", {3}, 0.05);
+        fs::remove(s.dir / "table.txt");
+        fs::create_directory(s.dir / "table.txt");
+        // find_curet_directory wants a regular file; load_curet says what is wrong.
+        const std::string e = load_error(s.dir);
+        EXPECT_NE(e.find("table.txt: is a directory, not a file"), std::string::npos) << e;
+    }
+}
+
+TEST(CuretFiles, DataPathThatIsAFileIsNotADirectory) {
+    SyntheticCuret s("notdir");
+    s.write_samples("abrdf.dat", {3}, 0.05);
+    try {
+        find_curet_directory(s.dir / "abrdf.dat");
+        FAIL() << "expected DataError";
+    } catch (const DataError& e) {
+        const std::string m = e.what();
+        EXPECT_NE(m.find("abrdf.dat is not a directory"), std::string::npos) << m;
+        EXPECT_EQ(m.find("does not exist"), std::string::npos) << m;
+    }
+}
+
+TEST(BrdfCsvPolicy, SameVariantsAsEveryReader) {
+    const std::string header = "theta_i,phi_i,theta_s,phi_s,value\n";
+    const std::string row = "30,180,20,0,0.5\n";
+    // Accepted: BOM, CRLF, spaces and tabs around fields.
+    EXPECT_EQ(parse_brdf_csv("\xEF\xBB\xBF" + header + row, "t.csv").size(), 1u);
+    EXPECT_EQ(
+        parse_brdf_csv("theta_i,phi_i,theta_s,phi_s,value\r\n30,180,20,0,0.5\r\n", "t.csv").size(),
+        1u);
+    EXPECT_EQ(parse_brdf_csv(
+                  " theta_i ,\tphi_i, theta_s,phi_s ,value \t\n 30 ,180\t, 20,0 ,0.5 \t\n", "t.csv")
+                  .size(),
+              1u);
+    // Refused, naming the file and the line: hex, NaN, NUL bytes, a huge bad cell (cut).
+    auto error_of = [](const std::string& text) {
+        try {
+            parse_brdf_csv(text, "t.csv");
+        } catch (const DataError& e) {
+            return std::string(e.what());
+        }
+        return std::string("no error");
+    };
+    EXPECT_NE(error_of(header + "0x1e,180,20,0,0.5\n").find("t.csv:2: column theta_i: '0x1e'"),
+              std::string::npos);
+    EXPECT_NE(error_of(header + "30,180,20,0,nan\n").find("t.csv:2: column value: 'nan'"),
+              std::string::npos);
+    EXPECT_NE(error_of(header + std::string("30,180,20,0,0.5\0\n", 17))
+                  .find("t.csv:2: not a text file: NUL byte at column 16"),
+              std::string::npos)
+        << error_of(header + std::string("30,180,20,0,0.5\0\n", 17));
+    const std::string huge =
+        error_of(header + "30,180,20,0," + std::string(10'000'000, '5') + "x\n");
+    EXPECT_LT(huge.size(), 200u);
+    EXPECT_NE(huge.find("t.csv:2: column value: '555"), std::string::npos) << huge;
+    EXPECT_NE(huge.find("(10000001 bytes in all)"), std::string::npos) << huge;
+    const std::string ansi = error_of("theta_i,\x1b[31mphi_i,theta_s,phi_s,value\n" + row);
+    EXPECT_EQ(ansi.find('\x1b'), std::string::npos) << ansi;
+    EXPECT_NE(ansi.find("\\x1b[31mphi_i"), std::string::npos) << ansi;
+}
+
+TEST(BrdfCsvPolicy, MeasurementNumbersAreDecimalDigitsOnly) {
+    const std::string header = "theta_i,phi_i,theta_s,phi_s,value,measurement\n";
+    EXPECT_EQ(parse_brdf_csv(header + "30,180,20,0,0.5, 7 \n", "t.csv").measurements[0].index, 7);
+    for (const char* bad : {"7.0", "0x7", "7e0"}) {
+        try {
+            parse_brdf_csv(header + "30,180,20,0,0.5," + bad + "\n", "t.csv");
+            FAIL() << bad;
+        } catch (const DataError& e) {
+            EXPECT_NE(std::string(e.what()).find("t.csv:2: column measurement: '" +
+                                                 std::string(bad) + "' is not a"),
+                      std::string::npos)
+                << e.what();
+        }
+    }
 }

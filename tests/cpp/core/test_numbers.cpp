@@ -107,3 +107,56 @@ TEST(Numbers, MessagesSpellOutNonFinite) {
     EXPECT_EQ(format_message(1.0 / 3.0, 3), "0.333");
     EXPECT_EQ(check::format_number(0.25), "0.25");  // the message helper of errors.hpp
 }
+
+TEST(Numbers, IntegersAreDecimalDigitsOnly) {
+    std::string reason;
+    EXPECT_EQ(try_parse_integer("25", 1, 61, reason), 25);
+    EXPECT_EQ(try_parse_integer(" 25\t", 1, 61, reason), 25);
+    EXPECT_EQ(try_parse_integer("+25", 1, 61, reason), 25);
+    EXPECT_EQ(try_parse_integer("-3", -5, 5, reason), -3);
+}
+
+TEST(Numbers, IntegersRefuseHexFractionsExponentsAndRange) {
+    for (const char* text :
+         {"0x19", "0X19", "25.0", "2.5e1", "1e3", "", " ", "25x", "+-3", "nan", "inf", "0b11001"}) {
+        std::string reason;
+        EXPECT_FALSE(try_parse_integer(text, 1, 100, reason).has_value()) << text;
+        EXPECT_FALSE(reason.empty()) << text;
+    }
+    std::string reason;
+    EXPECT_FALSE(try_parse_integer("101", 1, 100, reason).has_value());
+    EXPECT_EQ(reason, "out of the range [1, 100]");
+    EXPECT_FALSE(try_parse_integer("99999999999999999999999", 1, 100, reason).has_value());
+    EXPECT_EQ(reason, "out of the range [1, 100]");
+    EXPECT_THROW(parse_integer("0x19", 1, 100, "--sample"), InvalidArgument);
+    EXPECT_EQ(message_of([] { parse_integer("0x19", 1, 100, "--sample"); }),
+              "--sample: '0x19' is not an integer (decimal digits only)");
+}
+
+TEST(Numbers, NumbersRefuseDoubleSigns) {
+    std::string reason;
+    EXPECT_FALSE(try_parse_number("+-3", reason).has_value());
+    EXPECT_FALSE(try_parse_number("0x1p3", reason).has_value());
+}
+
+TEST(Numbers, MessagesNeverRoundAValueOntoTheLimitItBreaks) {
+    // 7 significant digits would print 1.0000001 as "1": "kappa = 1 must exceed 1".
+    EXPECT_EQ(format_message(1.00000001, 7), "1.00000001");
+    EXPECT_EQ(format_message(0.5, 7), "0.5");
+    EXPECT_EQ(format_message(1.0 + 1e-15), "1.000000000000001");
+    EXPECT_EQ(format_message(90.0 - 1e-9, 6), "89.999999999");
+    EXPECT_EQ(format_message(0.9999999, 6), "0.9999999");
+    EXPECT_EQ(format_message(1.0 + 1e-13, 7), "1.0000000000001");
+    // Floating-point noise of a unit conversion is not shown: 30 deg through radians.
+    EXPECT_EQ(format_message(29.999999999999996, 7), "30");
+    EXPECT_EQ(format_message(0.0010000000000000002, 6), "0.001");
+    // Rounding to all the digits asked for is kept (it cannot collapse onto a round limit).
+    EXPECT_EQ(format_message(1.0250190123, 7), "1.025019");
+    EXPECT_EQ(format_message(-2.0 / 3.0, 4), "-0.6667");
+    try {
+        check::positive("sigma", -5e-324);
+        FAIL() << "expected InvalidArgument";
+    } catch (const InvalidArgument& e) {
+        EXPECT_NE(std::string(e.what()).find("-5e-324"), std::string::npos) << e.what();
+    }
+}

@@ -362,3 +362,133 @@ TEST(SeriesBadInput, NegativeOrNonFiniteArgumentsThrowInvalidArgument) {
 }
 
 }  // namespace
+
+// ---------------------------------------------------------------------------------------------
+// Every finite g: the summation and the large-g expansion (the very-rough limit × (1 + R1/g)).
+
+// At tiny g the sum is its first term e^{−g} g h(1) (n = 1 dominates by a factor 1/g): the
+// small-g early exit once compared only the terms n ≥ 5 with the underflow threshold and gave 0.
+TEST(SeriesEveryG, TinyGIsTheFirstTermNotZero) {
+    for (double g : {1e-300, 1e-200, 1e-100, 1e-30}) {
+        for (double X : {0.0, 1.0, 10.0}) {
+            EXPECT_NEAR(gaussian_series_sum(g, X) / (g * std::exp(-X / 4.0)), 1.0, 1e-12) << g;
+            EXPECT_NEAR(exponential_series_sum(g, X) / (g / std::pow(1.0 + X, 1.5)), 1.0, 1e-12)
+                << g;
+        }
+    }
+    EXPECT_GT(gaussian_series_sum(1e-320, 0.0), 0.0);  // subnormal g: still its first term
+}
+
+// Large g: S/L − 1 = R1/g + O(1/g²) with L the g → ∞ limit (Eq. 4: e^{−c}/g, c = a/g; and
+// 1/(g²(1+β)^{3/2}), β = b/g², for the exponential series). Near g = 1e15 the summation gave 0.
+TEST(SeriesEveryG, LargeGFollowsTheVeryRoughLimitWithItsFirstCorrection) {
+    for (double g : {1e8, 1e13, 1.6716e15, 1e20, 1e100, 1e300}) {
+        for (double c : {0.0, 0.5, 3.0}) {
+            const double sG = gaussian_series_sum(g, 4.0 * c * g);
+            const double LG = std::exp(-c) / g;
+            EXPECT_NEAR(sG / LG - 1.0, (c * c / 2 - 2 * c + 1) / g, 1e-14) << g << " " << c;
+            if (c * g * g > 1.7e308) continue;
+            const double sE = exponential_series_sum(g, c * g * g);
+            const double LE = 1.0 / g / g / std::pow(1.0 + c, 1.5);
+            if (LE < 1e-300) continue;
+            EXPECT_NEAR(sE / LE - 1.0, 3.0 * (2 - 3 * c) / (2 * (1 + c) * (1 + c)) / g, 1e-14)
+                << g << " " << c;
+        }
+    }
+}
+
+TEST(SeriesEveryG, MethodAndBoundAreReported) {
+    const auto small = roughscope::gaussian_series(3.0, 1.0);
+    EXPECT_EQ(small.method, roughscope::DiffuseMethod::Summation);
+    EXPECT_GT(small.relative_error_bound, 0.0);
+    EXPECT_LE(small.relative_error_bound, 1e-12);
+    const auto large = roughscope::exponential_series(1e15, 1e30);
+    EXPECT_EQ(large.method, roughscope::DiffuseMethod::LargeGExpansion);
+    EXPECT_GT(large.relative_error_bound, 0.0);
+    EXPECT_LE(large.relative_error_bound, 1e-14);
+    // On both sides of the switch (summation up to ~1e7, expansion beyond) the value follows
+    // the expansion to second order (c = a/g = 1/4: R1 = 17/32, R2 = c⁴/8 − 11c³/6 + 15c²/2 −
+    // 9c + 2) within the reported bound.
+    const double c = 0.25, R1 = c * c / 2 - 2 * c + 1;
+    const double R2 = c * c * c * c / 8 - 11 * c * c * c / 6 + 15 * c * c / 2 - 9 * c + 2;
+    for (double g : {1e5, 1e6, 1e7, 1e9}) {
+        const auto s = roughscope::gaussian_series(g, 4.0 * c * g);
+        const double expansion = std::exp(-c) / g * (1.0 + R1 / g + R2 / (g * g));
+        EXPECT_NEAR(s.value / expansion, 1.0, s.relative_error_bound + 1e-14) << g;
+    }
+}
+
+// The B–K model at metre scale (σ = 2 m, T = 4 m, g = 1.67e15): the default Auto
+// regime equals the very-rough form (Eq. 4) and says it used the expansion.
+TEST(SeriesEveryG, ModelAtMetreScaleUsesTheExpansion) {
+    using namespace roughscope;
+    const Geometry geom = make_geometry(deg_to_rad(30), deg_to_rad(20), deg_to_rad(45));
+    const ScatteredPower p = mean_scattered_power(geom, Surface{2e6, 4e6, Correlation::Gaussian});
+    ModelOptions vr;
+    vr.regime = Regime::VeryRough;
+    const ScatteredPower q =
+        mean_scattered_power(geom, Surface{2e6, 4e6, Correlation::Gaussian}, vr);
+    EXPECT_EQ(p.regime, Regime::Series);
+    EXPECT_EQ(p.method, DiffuseMethod::LargeGExpansion);
+    EXPECT_NEAR(p.diffuse / q.diffuse, 1.0, 1e-14);
+    EXPECT_NEAR(p.diffuse, 2.5061086778e-8, 1e-17);
+    EXPECT_EQ(q.method, DiffuseMethod::ClosedForm);
+}
+
+TEST(SeriesEveryG, LengthsOutsideTheRangeThrowNamingThem) {
+    using namespace roughscope;
+    const Geometry geom = make_geometry(deg_to_rad(30), deg_to_rad(20), deg_to_rad(45));
+    expect_invalid(
+        [&] {
+            mean_scattered_power(geom, Surface{1e300, 1.0});
+        },
+        "sigma = 1e+300 um", "huge sigma");
+    ModelOptions o;
+    o.patch_x_um = 5e-324;
+    expect_invalid(
+        [&] {
+            mean_scattered_power(geom, Surface{0.1, 1.0}, o);
+        },
+        "patch_x", "subnormal patch");
+}
+
+// ---------------------------------------------------------------------------------------------
+// Quadrature: agreement with the series inside its documented domain, InvalidArgument outside.
+
+TEST(Quadrature, AgreesWithTheSeriesInsideItsDomain) {
+    using namespace roughscope;
+    for (Correlation c : {Correlation::Gaussian, Correlation::Exponential}) {
+        for (auto [g, w] : {std::pair{1e-3, 0.5},
+                            {0.5, 1.0},
+                            {10.0, 5.0},
+                            {1e3, 3.0},
+                            {1e4, 100.0},
+                            {1e4, 0.0},
+                            {50.0, 50.0}}) {
+            const double vxy2 = (w / 2.0) * (w / 2.0);  // T = 2
+            const double q = diffuse_power_quadrature(c, 0.8, 2.0, 1e4, g, vxy2);
+            const double s = c == Correlation::Gaussian
+                                 ? diffuse_power_gaussian_series(0.8, 2.0, 1e4, g, vxy2)
+                                 : diffuse_power_exponential_series(0.8, 2.0, 1e4, g, vxy2);
+            const double p = c == Correlation::Gaussian ? 1.0 : 2.0;
+            const double scale =
+                2 * kPi / 1e4 * 0.8 * 4.0 * -std::expm1(-g) / std::pow(std::max(g, 1.0), p);
+            EXPECT_GE(q, 0.0);
+            EXPECT_LE(std::abs(q - s), 1e-12 * scale) << to_string(c) << " g = " << g;
+        }
+    }
+}
+
+TEST(Quadrature, OutsideItsDomainThrowsInvalidArgument) {
+    using namespace roughscope;
+    for (Correlation c : {Correlation::Gaussian, Correlation::Exponential}) {
+        expect_invalid([&] { diffuse_power_quadrature(c, 1.0, 2.0, 1.0, 2e4, 1.0); }, "g = 20000",
+                       "g above the domain");
+        expect_invalid([&] { diffuse_power_quadrature(c, 1.0, 2.0, 1.0, 1e300, 1.0); },
+                       "g = 1e+300", "huge g (was NaN)");
+        expect_invalid([&] { diffuse_power_quadrature(c, 1.0, 2.0, 1.0, 1.0, 1e6); },
+                       "T v_xy = 2000", "T v_xy above the domain (was seconds)");
+        expect_invalid([&] { diffuse_power_quadrature(c, 1e300, 1e300, 1e-300, 1.0, 0.0); },
+                       "(2 pi/A) F2 T^2", "overflowing prefactor");
+    }
+}

@@ -2,6 +2,8 @@
 // on a reference document written here, whose "printed" values are computed from the estimators
 // and then rounded or perturbed on purpose, and the errors for malformed documents.
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -123,4 +125,92 @@ TEST(PaperTables, MalformedDocumentsNameTheFileAndKey) {
     bad["table3_curet_parameters"]["rows"][0]["E1_over_E2"] = "1.88";
     EXPECT_THROW(rs::serialize::recompute_paper_tables(bad, "t"), rs::DataError);
     EXPECT_THROW(rs::serialize::recompute_paper_tables(Json::array(), "t"), rs::DataError);
+}
+
+// ---------------------------------------------------------------------------------------------
+// The reference file: the reading policy of docs/input-files.md, errors "<file>: <place>: <what>"
+
+namespace {
+
+struct TempFile {
+    std::filesystem::path path;
+    TempFile(const std::string& name, const std::string& content) {
+        path = std::filesystem::temp_directory_path() /
+               ("roughscope_paper_" + name + "_" +
+                std::to_string(::testing::UnitTest::GetInstance()->random_seed()));
+        std::ofstream(path, std::ios::binary) << content;
+    }
+    ~TempFile() {
+        std::error_code ec;
+        std::filesystem::remove_all(path, ec);
+    }
+};
+
+std::string read_error(const std::filesystem::path& path) {
+    try {
+        rs::serialize::read_paper_tables_reference(path);
+    } catch (const rs::DataError& e) {
+        return e.what();
+    }
+    return "no error";
+}
+
+}  // namespace
+
+TEST(PaperTablesFile, BomAndCrlfAreAccepted) {
+    const std::string doc = reference(0.3957).dump(1);
+    std::string crlf;
+    for (char c : doc) crlf += c == '\n' ? std::string("\r\n") : std::string(1, c);
+    const TempFile f("bom", "\xEF\xBB\xBF" + crlf + " \t\r\n");
+    const Json ref = rs::serialize::read_paper_tables_reference(f.path);
+    EXPECT_NO_THROW(rs::serialize::recompute_paper_tables(ref, f.path.string()));
+}
+
+TEST(PaperTablesFile, ErrorsNameTheFileAndWhereInIt) {
+    const TempFile bad("bad", "{\n  \"table1_slightly_rough\": tru\n}\n");
+    EXPECT_EQ(read_error(bad.path), bad.path.string() +
+                                        ": line 2, column 31: not valid JSON: syntax error while "
+                                        "parsing value - invalid literal");
+    const TempFile binary("binary", std::string("\x7f"
+                                                "ELF\x02\x01\x01\0\0",
+                                                9));
+    EXPECT_EQ(read_error(binary.path),
+              binary.path.string() + ": line 1, column 8: not a text file: NUL byte");
+    const TempFile empty("empty", "");
+    EXPECT_NE(
+        read_error(empty.path).find(empty.path.string() + ": line 1, column 1: not valid JSON"),
+        std::string::npos)
+        << read_error(empty.path);
+    const TempFile dir("dir", "");
+    std::filesystem::remove(dir.path);
+    std::filesystem::create_directory(dir.path);
+    EXPECT_EQ(read_error(dir.path), dir.path.string() + ": is a directory, not a file");
+    EXPECT_EQ(read_error(dir.path / "absent.json"),
+              (dir.path / "absent.json").string() + ": does not exist");
+}
+
+TEST(PaperTablesFile, WrongTypesAndRefusedInputsNameThePlace) {
+    Json bad = reference(0.3957);
+    bad["table1_slightly_rough"]["rows"][0]["R_spec"] = "0.014";
+    try {
+        rs::serialize::recompute_paper_tables(bad, "tables.json");
+        FAIL() << "expected DataError";
+    } catch (const rs::DataError& e) {
+        EXPECT_STREQ(e.what(),
+                     "tables.json: table1_slightly_rough.rows[0]: key 'R_spec' is not a number");
+    }
+    Json negative = reference(0.3957);
+    negative["table1_slightly_rough"]["conditions"]["lambda_um"] = -1;
+    try {
+        rs::serialize::recompute_paper_tables(negative, "tables.json");
+        FAIL() << "expected DataError";
+    } catch (const rs::DataError& e) {
+        EXPECT_NE(std::string(e.what()).find("tables.json: table1_slightly_rough: wavelength"),
+                  std::string::npos)
+            << e.what();
+    }
+    Json big = reference(0.3957);
+    big["table3_curet_parameters"]["rows"][0]["sample"] = 1000000000000LL;
+    EXPECT_EQ(rs::serialize::recompute_paper_tables(big, "t")["table3"]["rows"][0]["sample"],
+              "Quarry tile (1000000000000)");
 }

@@ -181,9 +181,12 @@ TEST(SerializeModel, ScatteredPowerKeys) {
     p.g = 3.0;
     p.regime = Regime::Series;
     p.roughness_class = RoughnessClass::ModeratelyRough;
+    p.method = DiffuseMethod::LargeGExpansion;
+    p.relative_error_bound = 0.125;
     const Json j = serialize::to_json(p);
     EXPECT_EQ(j.dump(), R"({"brightness":null,"coherent":0.25,"diffuse":0.5,"total":0.75,"g":3.0,)"
-                        R"("regime":"series","roughness_class":"moderately_rough"})");
+                        R"("regime":"series","roughness_class":"moderately_rough",)"
+                        R"("method":"large_g_expansion","relative_error_bound":0.125})");
 }
 
 BrdfTable small_table() {
