@@ -10,6 +10,10 @@
 //                                     ns_per_row, and time_vs_compute = its per-row time over the
 //                                     baseline's (timed once before the runs; processor time)
 //        io/csv_read/<rows>           io::CsvReader alone over the same file (parsing only)
+//        io/curet_compute/<rows>      compare_brdf on the same geometries as an in-memory BRDF
+//                                     table (the baseline; predictions not kept)
+//        io/curet_table/<rows>        the CLI's `curet --table FILE --json --output FILE` on that
+//                                     table written as CSV; counters as for io/model_csv
 // The rows cover θi, θs in [0, 80) degrees and φs in [0, 360) (σ = 1 µm, T = 2 µm, λ = 0.555 µm).
 #include <cstdio>
 #include <ctime>
@@ -20,6 +24,8 @@
 
 #include <benchmark/benchmark.h>
 
+#include "roughscope/brdf/comparison.hpp"
+#include "roughscope/brdf/table.hpp"
 #include "roughscope/core/numbers.hpp"
 #include "roughscope/io/csv.hpp"
 #include "roughscope/scattering/beckmann.hpp"
@@ -40,8 +46,9 @@ constexpr std::size_t kRows = 20000;
 
 // The benchmark's input: a CSV file of kRows geometries (degrees) and the same geometries parsed.
 struct Rows {
-    fs::path dir, csv, output;
+    fs::path dir, csv, output, brdf_csv;
     std::vector<Geometry> geometries;
+    BrdfTable table;  // the same geometries with a BRDF value (curet --table)
 };
 
 const Rows& rows() {
@@ -51,15 +58,22 @@ const Rows& rows() {
         fs::create_directories(out.dir);
         out.csv = out.dir / "rows.csv";
         out.output = out.dir / "out.txt";
+        out.brdf_csv = out.dir / "brdf.csv";
         std::ofstream f(out.csv, std::ios::binary);
+        std::ofstream b(out.brdf_csv, std::ios::binary);
         f << "theta_i,theta_s,phi_s\n";
+        b << "theta_i,phi_i,theta_s,phi_s,value\n";
         for (std::size_t k = 0; k < kRows; ++k) {
             const double ti = static_cast<double>(k * 7 % 800) / 10.0;
             const double ts = static_cast<double>(k * 13 % 800) / 10.0;
             const double ps = static_cast<double>(k * 17 % 3600) / 10.0;
             f << ti << ',' << ts << ',' << ps << '\n';
+            b << ti << ",180," << ts << ',' << ps << ',' << 0.5 + static_cast<double>(k % 97) / 100
+              << '\n';
             out.geometries.push_back(make_geometry(deg_to_rad(ti), deg_to_rad(ts), deg_to_rad(ps)));
         }
+        b.close();
+        out.table = read_brdf_csv(out.brdf_csv);
         return out;
     }();
     return r;
@@ -102,6 +116,19 @@ void BM_csv_read(benchmark::State& state) {
     state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(kRows));
 }
 BENCHMARK(BM_csv_read)->Name("io/csv_read/20000")->Unit(benchmark::kMillisecond);
+
+ComparisonOptions curet_options() {
+    ComparisonOptions o;
+    o.keep_predictions = false;  // as the CLI without --series
+    return o;
+}
+
+void BM_curet_compute(benchmark::State& state) {
+    const Rows& r = rows();
+    for (auto _ : state) benchmark::DoNotOptimize(compare_brdf(r.table, curet_options()));
+    state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(kRows));
+}
+BENCHMARK(BM_curet_compute)->Name("io/curet_compute/20000")->Unit(benchmark::kMillisecond);
 
 #ifdef ROUGHSCOPE_BENCH_HAS_CLI
 // Runs `roughscope model --csv ... --output ...` in-process through the CLI's own code.
@@ -149,6 +176,35 @@ BENCHMARK_CAPTURE(BM_model_csv, csv, false)
 BENCHMARK_CAPTURE(BM_model_csv, json, true)
     ->Name("io/model_csv/json/20000")
     ->Unit(benchmark::kMillisecond);
+
+// `roughscope curet --table FILE --json --output FILE` in-process, against compare_brdf on the
+// table already in memory (timed once before the runs, processor time).
+void BM_curet_table(benchmark::State& state) {
+    const Rows& r = rows();
+    const double t0 = cpu_seconds();
+    benchmark::DoNotOptimize(compare_brdf(r.table, curet_options()));
+    const double compute_s = cpu_seconds() - t0;
+    double cli_s = 0.0;
+    for (auto _ : state) {
+        const double t1 = cpu_seconds();
+        CLI::App app{"bench", "roughscope"};
+        cli::register_curet(app);
+        std::vector<std::string> args = {"roughscope",        "curet",  "--table",
+                                         r.brdf_csv.string(), "--json", "--output",
+                                         r.output.string()};
+        std::vector<char*> argv;
+        argv.reserve(args.size());
+        for (std::string& a : args) argv.push_back(a.data());
+        app.parse(static_cast<int>(argv.size()), argv.data());
+        cli_s += cpu_seconds() - t1;
+    }
+    const auto n = static_cast<double>(state.iterations());
+    state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(kRows));
+    state.counters["ns_per_row"] = cli_s / n / static_cast<double>(kRows) * 1e9;
+    state.counters["compute_ns_per_row"] = compute_s / static_cast<double>(kRows) * 1e9;
+    state.counters["time_vs_compute"] = (cli_s / n) / compute_s;
+}
+BENCHMARK(BM_curet_table)->Name("io/curet_table/20000")->Unit(benchmark::kMillisecond);
 #endif
 
 }  // namespace

@@ -260,7 +260,9 @@ void run(Args& a) {
         options["on_albedo"] = a.on_albedo;
     }
     if (given(a.o_max_overflow)) options["max_overflow"] = a.max_overflow;
-    const ComparisonOptions o = serialize::comparison_options_from(options);
+    ComparisonOptions o = serialize::comparison_options_from(options);
+    // The predictions (N values per model) are output only in the series and the figure.
+    o.keep_predictions = a.series || !a.plot_path.empty();
 
     std::string text;
     json plot_document;  // one comparison with its series (Fig. 10), or the list (summary)

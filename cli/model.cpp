@@ -8,11 +8,13 @@
 
 #include <algorithm>
 #include <array>
+#include <charconv>
 #include <cmath>
 #include <filesystem>
 #include <iostream>
 #include <memory>
 #include <optional>
+#include <span>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -277,8 +279,100 @@ std::vector<LafortuneLobe> lafortune_lobes(const Args& a) {
 
 json to_json_number(const std::optional<double>& v) { return serialize::number(v); }
 
+// A result record: its keys (string literals) in output order and their values. Unlike a JSON
+// object it allocates no key, and one record is reused row after row (clear() keeps the slots and
+// their strings' storage); to_json() gives the object, and RecordWriter formats the record
+// directly with the bytes the object's dump would give.
+class Record {
+  public:
+    // A JSON value: null, a boolean, a number, a string, or (Nested) any other JSON value.
+    struct Value {
+        enum class Kind { Null, Boolean, Number, Text, Nested };
+        Kind kind = Kind::Null;
+        bool boolean = false;
+        double number = 0.0;
+        std::string text;
+        json nested;
+
+        Value& operator=(std::nullptr_t) {
+            kind = Kind::Null;
+            return *this;
+        }
+        Value& operator=(bool b) {
+            kind = Kind::Boolean;
+            boolean = b;
+            return *this;
+        }
+        Value& operator=(std::string_view t) {
+            kind = Kind::Text;
+            text.assign(t);
+            return *this;
+        }
+        Value& operator=(const char* t) { return *this = std::string_view(t); }
+        Value& operator=(const std::string& t) { return *this = std::string_view(t); }
+        Value& operator=(const json& j) {
+            if (j.is_null()) return *this = nullptr;
+            if (j.is_boolean()) return *this = j.get<bool>();
+            if (j.is_string()) return *this = std::string_view(j.get_ref<const std::string&>());
+            if (j.is_number_float()) {
+                kind = Kind::Number;
+                number = j.get<double>();
+                return *this;
+            }
+            kind = Kind::Nested;
+            nested = j;
+            return *this;
+        }
+        json to_json() const {
+            switch (kind) {
+                case Kind::Null:
+                    return nullptr;
+                case Kind::Boolean:
+                    return boolean;
+                case Kind::Number:
+                    return number;
+                case Kind::Text:
+                    return text;
+                case Kind::Nested:
+                    break;
+            }
+            return nested;
+        }
+    };
+    struct Item {
+        std::string_view key;
+        Value value;
+    };
+
+    Record() { items_.reserve(32); }  // every key of a record without regrowing
+    void clear() { size_ = 0; }
+    Value& operator[](std::string_view key) {
+        for (std::size_t k = 0; k < size_; ++k)
+            if (items_[k].key == key) return items_[k].value;
+        if (size_ == items_.size()) items_.emplace_back();
+        Item& item = items_[size_++];
+        item.key = key;
+        item.value = nullptr;
+        return item.value;
+    }
+    bool contains(std::string_view key) const {
+        return std::any_of(items_.begin(), items_.begin() + static_cast<std::ptrdiff_t>(size_),
+                           [key](const Item& item) { return item.key == key; });
+    }
+    std::span<const Item> items() const { return {items_.data(), size_}; }
+    json to_json() const {
+        json out = json::object();
+        for (const Item& item : items()) out[std::string(item.key)] = item.value.to_json();
+        return out;
+    }
+
+  private:
+    std::vector<Item> items_;
+    std::size_t size_ = 0;
+};
+
 // B–K model (Eq. 1–5, §3.2–3.3) at one point: adds its keys to `out`, returns the brightness.
-double evaluate_bk(const Args& a, const Point& p, const Roughness& r, json& out) {
+double evaluate_bk(const Args& a, const Point& p, const Roughness& r, Record& out) {
     const bool absolute = r.sigma_um.has_value();
     std::optional<double> coherent, diffuse, total, g;
     std::optional<std::string> regime, roughness_class;
@@ -363,10 +457,9 @@ double evaluate_bk(const Args& a, const Point& p, const Roughness& r, json& out)
     return brightness;
 }
 
-// Evaluates the chosen model at one point; returns the result record (keys in output order).
-json evaluate(const Args& a, const Point& p, const Roughness& r) {
-    json out = json::object();
-    out.get_ref<json::object_t&>().reserve(32);  // every key of a record without regrowing
+// Evaluates the chosen model at one point into `out` (keys in output order).
+void evaluate(const Args& a, const Point& p, const Roughness& r, Record& out) {
+    out.clear();
     out["model"] = model_name(a.model);
     // Angles of a geometry echoed as the shortest degrees that map to the same radians.
     const auto angle = [&](double deg, const std::optional<double> rad) {
@@ -423,7 +516,6 @@ json evaluate(const Args& a, const Point& p, const Roughness& r) {
         }
     }
     out["brightness"] = serialize::number(brightness);
-    return out;
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -481,24 +573,111 @@ std::string csv_text(const json& record) {
     return out;
 }
 
+// A string that JSON and CSV output write as its bytes: printable ASCII without quote, backslash
+// or CSV separator (every key and word of a record).
+bool plain_text(std::string_view text) {
+    return std::all_of(text.begin(), text.end(), [](char c) {
+        return c >= 0x20 && c < 0x7f && c != '"' && c != '\\' && c != ',';
+    });
+}
+
+// Appends a value as dump() writes it (outside an array or object); false (nothing appended) for
+// a nested value or a string that needs escaping.
+bool append_json_scalar(std::string& out, const Record::Value& v) {
+    using Kind = Record::Value::Kind;
+    switch (v.kind) {
+        case Kind::Null:
+            out += "null";
+            return true;
+        case Kind::Boolean:
+            out += v.boolean ? "true" : "false";
+            return true;
+        case Kind::Number: {
+            if (!std::isfinite(v.number)) {
+                out += "null";
+                return true;
+            }
+            // nlohmann's own shortest round-trip formatter, as its serializer calls it.
+            std::array<char, 64> buf{};
+            const char* end =
+                nlohmann::detail::to_chars(buf.data(), buf.data() + buf.size(), v.number);
+            out.append(buf.data(), static_cast<std::size_t>(end - buf.data()));
+            return true;
+        }
+        case Kind::Text:
+            if (!plain_text(v.text)) return false;
+            out += '"';
+            out += v.text;
+            out += '"';
+            return true;
+        case Kind::Nested:
+            break;
+    }
+    return false;
+}
+
+// Appends the CSV cell of a value (cell_text, quoted by csv_field when needed).
+void append_csv_cell(std::string& out, const Record::Value& v) {
+    using Kind = Record::Value::Kind;
+    if (v.kind == Kind::Number && std::isfinite(v.number)) {
+        // format_result's "%.10g" (no "-0"), without a temporary string.
+        std::array<char, 64> buf{};
+        const auto [end, ec] =
+            std::to_chars(buf.data(), buf.data() + buf.size(), v.number == 0.0 ? 0.0 : v.number,
+                          std::chars_format::general, kPrintDigits);
+        if (ec == std::errc()) {
+            out.append(buf.data(), static_cast<std::size_t>(end - buf.data()));
+            return;
+        }
+    }
+    if (v.kind == Kind::Null) return;  // cell_text: ""
+    if (v.kind == Kind::Text && plain_text(v.text)) {
+        out += v.text;
+        return;
+    }
+    const std::string cell = cell_text(v.to_json());
+    if (cell.find_first_of(",\"\n\r") == std::string::npos)
+        out += cell;  // csv_field would return it unchanged
+    else
+        out += csv_field(cell);
+}
+
 // Writes the records of `model --csv` one at a time: CSV (header from the first record) or a JSON
-// array byte-identical to serialize::dump of the whole array, without holding the records.
+// array byte-identical to serialize::dump of the whole array, without holding the records. Each
+// record is formatted straight into the output buffer.
 class RecordWriter {
   public:
     RecordWriter(io::OutputFile& out, bool json_output) : out_(out), json_(json_output) {}
 
-    void add(json record) {
+    void add(const Record& record) {
         chunk_.clear();
         if (json_) {
-            // The element as the whole array's dump indents it: "[\n" + element + "\n]\n".
-            json one = json::array();
-            one.push_back(std::move(record));
-            const std::string text = serialize::dump(one);
             chunk_.append(count_ == 0 ? "[\n" : ",\n");
-            chunk_.append(text, 2, text.size() - 5);
+            if (!append_json_element(record)) {
+                // Nested values (Lafortune lobes): the element as the whole array's dump indents
+                // it: "[\n" + element + "\n]\n".
+                json one = json::array();
+                one.push_back(record.to_json());
+                const std::string text = serialize::dump(one);
+                chunk_.append(text, 2, text.size() - 5);
+            }
         } else {
-            if (count_ == 0) chunk_ = csv_header(record);
-            append_csv_line(chunk_, record);
+            if (count_ == 0) {
+                bool first = true;
+                for (const auto& item : record.items()) {
+                    if (!first) chunk_ += ',';
+                    chunk_ += csv_field(std::string(item.key));
+                    first = false;
+                }
+                chunk_ += '\n';
+            }
+            bool first = true;
+            for (const auto& item : record.items()) {
+                if (!first) chunk_ += ',';
+                append_csv_cell(chunk_, item.value);
+                first = false;
+            }
+            chunk_ += '\n';
         }
         out_.write(chunk_);
         ++count_;
@@ -512,6 +691,31 @@ class RecordWriter {
     std::size_t count() const { return count_; }
 
   private:
+    // The element "  {\n    \"key\": value,\n ...\n  }" as dump(2) indents it inside the array;
+    // false (chunk_ unchanged) when a value is nested or needs escaping.
+    bool append_json_element(const Record& record) {
+        const std::size_t mark = chunk_.size();
+        if (record.items().empty()) {
+            chunk_ += "  {}";
+            return true;
+        }
+        chunk_ += "  {\n";
+        bool first = true;
+        for (const Record::Item& item : record.items()) {
+            if (!first) chunk_ += ",\n";
+            first = false;
+            chunk_ += "    \"";
+            chunk_ += item.key;
+            chunk_ += "\": ";
+            if (!plain_text(item.key) || !append_json_scalar(chunk_, item.value)) {
+                chunk_.resize(mark);
+                return false;
+            }
+        }
+        chunk_ += "\n  }";
+        return true;
+    }
+
     io::OutputFile& out_;
     bool json_;
     std::size_t count_ = 0;
@@ -580,7 +784,9 @@ void run_model(const Args& a) {
 
     if (!given(a.o_csv)) {
         const Point p = point_from_flags(a);
-        const json record = evaluate(a, p, roughness_from_flags(a));
+        Record result;
+        evaluate(a, p, roughness_from_flags(a), result);
+        const json record = result.to_json();
         std::string text;
         if (a.json_output) {
             text = serialize::dump(record);
@@ -603,6 +809,7 @@ void run_model(const Args& a) {
     const std::size_t c_ps = *reader.column_index("phi_s");
     io::OutputFile out = io::open_output(output);
     RecordWriter writer(out, a.json_output);
+    Record record;  // reused row after row
     CsvRow row;
     while (reader.next(row)) {
         const double ti = *row.value(c_ti), ts = *row.value(c_ts), ps = *row.value(c_ps);
@@ -618,7 +825,8 @@ void run_model(const Args& a) {
                 a.model == ModelKind::BK ? roughness_for_row(a, row, where) : Roughness{};
             const Point p =
                 point_from(make_geometry(deg_to_rad(ti), deg_to_rad(ts), deg_to_rad(ps)));
-            writer.add(evaluate(a, p, r));
+            evaluate(a, p, r, record);
+            writer.add(record);
         } catch (const UsageError&) {
             throw;  // about the flags, not the row
         } catch (const roughscope::DataError&) {

@@ -6,6 +6,7 @@
 #include <array>
 #include <atomic>
 #include <cmath>
+#include <cstdint>
 #include <exception>
 #include <functional>
 #include <limits>
@@ -61,9 +62,10 @@ const ModelInfo& info(ComparisonModel m) {
 // The used measurements with everything the model evaluations need, computed once per table.
 
 struct Prepared {
-    std::vector<Geometry> geom;
-    std::vector<double> d;  // data brightness normalised by its maximum
-    std::vector<double> w;
+    std::span<const Geometry> geom;  // the comparison's (not copied: N can be 1e6)
+    std::vector<double> d;           // data brightness normalised by its maximum
+    std::span<const double> w;
+    bool keep_predictions = true;  // ModelResult::prediction kept after the errors
     double sum_w = 0.0;
     double sum_wdd = 0.0;
     Radiometry radiometry = Radiometry::Radiance;  // §3.3 interpretation of the B–K models
@@ -79,11 +81,11 @@ struct Prepared {
 
 // The geometry-only terms of every model, computed once per table (the geometries of a BrdfTable
 // are valid: check::geometry holds).
-Prepared prepare(const std::vector<Geometry>& geom, const std::vector<double>& d_normalised,
+Prepared prepare(const std::vector<Geometry>& geom, std::vector<double> d_normalised,
                  const std::vector<double>& w, Radiometry radiometry) {
     Prepared p;
     p.geom = geom;
-    p.d = d_normalised;
+    p.d = std::move(d_normalised);
     p.w = w;
     const std::size_t n = geom.size();
     p.radiometry = radiometry;
@@ -124,15 +126,63 @@ void oren_nayar_prediction(const Prepared& p, const OrenNayarParams& on, std::ve
 }
 
 // "N measurements at K distinct geometries": why a fit or search cannot determine its parameters.
-std::string distinct_geometries_text(const std::vector<Geometry>& geom) {
+std::string distinct_geometries_text(std::span<const Geometry> geom) {
     std::vector<std::array<double, 3>> distinct;
-    for (const Geometry& g : geom) {
-        const std::array<double, 3> a{g.theta_i_rad, g.theta_s_rad, g.phi_s_rad};
-        if (std::find(distinct.begin(), distinct.end(), a) == distinct.end()) distinct.push_back(a);
-    }
+    distinct.reserve(geom.size());
+    for (const Geometry& g : geom) distinct.push_back({g.theta_i_rad, g.theta_s_rad, g.phi_s_rad});
+    std::sort(distinct.begin(), distinct.end());
+    const auto count =
+        static_cast<std::size_t>(std::unique(distinct.begin(), distinct.end()) - distinct.begin());
     return std::to_string(geom.size()) + " measurement" + (geom.size() == 1 ? "" : "s") + " at " +
-           std::to_string(distinct.size()) + " distinct geometr" +
-           (distinct.size() == 1 ? "y" : "ies");
+           std::to_string(count) + " distinct geometr" + (count == 1 ? "y" : "ies");
+}
+
+// The Lafortune diffuse lobe cos θi exp(n ln(cos θi cos θs)) depends on the measurement through
+// (cos θi, ln(cos θi cos θs)) only: the distinct pairs (`cos_i`, `log_cos_i_cos_s`) and, per
+// measurement, the index of its pair (`group`). Tables measured on a grid repeat each (θi, θs)
+// at many azimuths, so that the search evaluates far fewer exponentials than measurements.
+struct LafortuneGroups {
+    std::vector<double> cos_i, log_cos_i_cos_s;
+    std::vector<std::uint32_t> group;
+};
+
+LafortuneGroups lafortune_groups(const Prepared& p) {
+    LafortuneGroups g;
+    std::vector<std::uint32_t> order(p.size());
+    std::iota(order.begin(), order.end(), 0U);
+    const auto key = [&p](std::uint32_t j) { return std::pair(p.cos_i[j], p.log_cos_i_cos_s[j]); };
+    std::sort(order.begin(), order.end(),
+              [&key](std::uint32_t a, std::uint32_t b) { return key(a) < key(b); });
+    g.group.resize(p.size());
+    for (std::size_t k = 0; k < order.size(); ++k) {
+        if (k == 0 || key(order[k]) != key(order[k - 1])) {
+            g.cos_i.push_back(p.cos_i[order[k]]);
+            g.log_cos_i_cos_s.push_back(p.log_cos_i_cos_s[order[k]]);
+        }
+        g.group[order[k]] = static_cast<std::uint32_t>(g.cos_i.size() - 1);
+    }
+    return g;
+}
+
+// paper_sse (below) of the Lafortune diffuse lobe with exponent n, through the distinct pairs:
+// the same operations on the same values as paper_sse of lafortune_prediction, so the same result
+// to the last bit. `M` is scratch space (one value per pair).
+double lafortune_paper_sse(const Prepared& p, const LafortuneGroups& g, double n,
+                           std::vector<double>& M) {
+    M.resize(g.cos_i.size());
+    double mmax = -kInf;
+    for (std::size_t u = 0; u < M.size(); ++u) {
+        M[u] = g.cos_i[u] * std::exp(n * g.log_cos_i_cos_s[u]);
+        mmax = std::max(mmax, M[u]);
+    }
+    if (!(mmax > 0.0) || !std::isfinite(mmax)) return kInf;
+    for (double& m : M) m /= mmax;
+    double s = 0.0;
+    for (std::size_t j = 0; j < p.size(); ++j) {
+        const double r = M[g.group[j]] - p.d[j];
+        s += p.w[j] * r * r;
+    }
+    return s;
 }
 
 // min over K of Σ w (K M − d)²; K returned through `gain`. A model that is zero everywhere
@@ -178,6 +228,12 @@ ErrorMeasures measures(const Prepared& p, const std::vector<double>& M) {
     return e;
 }
 
+// The errors of the model's prediction; the prediction itself is then released unless kept.
+void set_errors(const Prepared& p, ModelResult& r) {
+    r.errors = measures(p, r.prediction);
+    if (!p.keep_predictions) std::vector<double>().swap(r.prediction);
+}
+
 // ---------------------------------------------------------------------------------------------
 // Fits (the "+ fit" columns): min over (θ, gain) of Σ w (gain · M(θ) − d)² with d = data/max data,
 // on the library's least-squares engine (fit/engine.hpp): absolute residuals, the gain profiled out
@@ -192,7 +248,9 @@ LeastSquaresProblem fit_problem(const Prepared& p, std::vector<ParameterSpec> pa
     LeastSquaresProblem P;
     P.parameters = std::move(parameters);
     P.data = p.d;
-    P.weights = p.w;
+    // All weights 1 (every table without a weight column) is the engine's default: no copy.
+    if (std::any_of(p.w.begin(), p.w.end(), [](double v) { return v != 1.0; }))
+        P.weights.assign(p.w.begin(), p.w.end());
     P.residual = ResidualType::Absolute;
     P.gain = GainMode::Profiled;
     P.model = [predict = std::move(predict)](std::span<const double> theta, std::span<double> out) {
@@ -246,7 +304,7 @@ void run_fit(const Prepared& p, ModelResult& r, const LeastSquaresProblem& probl
                 r.covariance[static_cast<std::size_t>(a * k + b)] = lsq.covariance(a, b);
     }
     r.prediction = lsq.model;
-    r.errors = measures(p, r.prediction);
+    set_errors(p, r);
 }
 
 // σ/T (B–K or V–H, Gaussian or exponential): 41 log-spaced starts over the bounds.
@@ -305,7 +363,7 @@ void finish_at_lambert(const Prepared& p, ModelResult& r, double rho, double sig
     r.evaluations = evaluations + 1;
     r.available = true;
     r.fit_status = SolverStatus::NotIdentifiable;
-    r.errors = measures(p, r.prediction);
+    set_errors(p, r);
     r.parameters = {{"sigma_rad", 0.0, std::nullopt, true},
                     {"albedo", rho, std::nullopt, false},
                     {"gain", r.errors.gain, std::nullopt, false}};
@@ -598,9 +656,11 @@ ErrorMeasures error_measures(std::span<const double> model, std::span<const doub
         throw InvalidArgument("max(model) = " + check::format_number(mmax) +
                               " must be > 0 to normalise the model");
     Prepared p;
-    p.w.assign(data.size(), 1.0);
-    if (!weights.empty()) p.w.assign(weights.begin(), weights.end());
-    p.geom.resize(data.size());
+    std::vector<double> w(data.size(), 1.0);
+    if (!weights.empty()) w.assign(weights.begin(), weights.end());
+    p.w = w;
+    const std::vector<Geometry> geom(data.size());  // only its size is used
+    p.geom = geom;
     p.d.resize(data.size());
     for (std::size_t j = 0; j < data.size(); ++j) {
         p.d[j] = data[j] / dmax;
@@ -656,7 +716,11 @@ void validate(const ComparisonOptions& o) {
             " is outside the valid range [0, 1]");
 }
 
-Comparison compare_brdf(const BrdfTable& table, const ComparisonOptions& o) {
+namespace {
+
+// compare_brdf; `release`, when given, is `table` itself, whose measurements are released as soon
+// as the comparison has taken what it needs of them.
+Comparison compare(const BrdfTable& table, const ComparisonOptions& o, BrdfTable* release) {
     validate(o);
     if (table.measurements.empty())
         throw InvalidArgument("BRDF table '" + table.name + "' has no measurements");
@@ -709,6 +773,11 @@ Comparison compare_brdf(const BrdfTable& table, const ComparisonOptions& o) {
         }
     }
     double dmax = -kInf;
+    const auto num_used = static_cast<std::size_t>(std::count(used.begin(), used.end(), true));
+    c.measurement.reserve(num_used);
+    c.geometry.reserve(num_used);
+    c.brightness.reserve(num_used);
+    c.weight.reserve(num_used);
     for (std::size_t k = 0; k < table.size(); ++k) {
         if (!used[k]) continue;
         const BrdfMeasurement& m = table.measurements[k];
@@ -720,6 +789,7 @@ Comparison compare_brdf(const BrdfTable& table, const ComparisonOptions& o) {
     }
 
     c.two_point = two_point_estimate(table, used, o);
+    if (release) std::vector<BrdfMeasurement>().swap(release->measurements);
 
     c.models.reserve(kComparisonModels.size());
     for (ComparisonModel m : kComparisonModels) {
@@ -741,7 +811,8 @@ Comparison compare_brdf(const BrdfTable& table, const ComparisonOptions& o) {
     }
     std::vector<double> d(c.brightness.size());
     for (std::size_t j = 0; j < d.size(); ++j) d[j] = c.brightness[j] / dmax;
-    const Prepared p = prepare(c.geometry, d, c.weight, o.radiometry);
+    Prepared p = prepare(c.geometry, std::move(d), c.weight, o.radiometry);
+    p.keep_predictions = o.keep_predictions;
 
     // Oren–Nayar with given parameters.
     {
@@ -753,7 +824,7 @@ Comparison compare_brdf(const BrdfTable& table, const ComparisonOptions& o) {
                             {"albedo", o.oren_nayar->albedo, std::nullopt, true}};
             oren_nayar_prediction(p, *o.oren_nayar, r.prediction);
             r.evaluations = 1;
-            r.errors = measures(p, r.prediction);
+            set_errors(p, r);
             if (!std::isfinite(r.errors.paper_sse)) {  // albedo 0: the model is 0 everywhere
                 r.available = false;
                 r.reason = "the Oren-Nayar model with albedo = " +
@@ -772,13 +843,13 @@ Comparison compare_brdf(const BrdfTable& table, const ComparisonOptions& o) {
         ModelResult& r = result(ComparisonModel::Lafortune);
         const auto steps = static_cast<long>(
             std::floor((o.lafortune_n_max - o.lafortune_n_min) / o.lafortune_n_step + 1e-9));
-        std::vector<double> M(p.size());
+        const LafortuneGroups groups = lafortune_groups(p);
+        std::vector<double> M;
         double best_err = kInf, worst_err = -kInf, best_n = o.lafortune_n_min;
         long best_k = 0;
         for (long k = 0; k <= steps; ++k) {
             const double n = o.lafortune_n_min + static_cast<double>(k) * o.lafortune_n_step;
-            lafortune_prediction(p, n, M);
-            const double e = paper_sse(p, M);
+            const double e = lafortune_paper_sse(p, groups, n, M);
             worst_err = std::max(worst_err, e);
             if (e < best_err) {
                 best_err = e;
@@ -810,7 +881,7 @@ Comparison compare_brdf(const BrdfTable& table, const ComparisonOptions& o) {
         r.parameters = {{"n", best_n, std::nullopt, !flat}};
         r.prediction.resize(p.size());
         lafortune_prediction(p, best_n, r.prediction);
-        r.errors = measures(p, r.prediction);
+        set_errors(p, r);
     }
     // B–K (F_Beck) and V–H (F_VH) at the two-point estimate.
     struct VeryRoughVariant {
@@ -850,7 +921,7 @@ Comparison compare_brdf(const BrdfTable& table, const ComparisonOptions& o) {
         r.parameters = {{"sigma_over_T", *sigma_over_T, std::nullopt, true}};
         r.evaluations = 1;
         very_rough_prediction(p, v.factor, v.correlation, *sigma_over_T, r.prediction);
-        r.errors = measures(p, r.prediction);
+        set_errors(p, r);
     }
 
     if (o.fits) {
@@ -879,6 +950,16 @@ Comparison compare_brdf(const BrdfTable& table, const ComparisonOptions& o) {
     }
     pick_winners(c);
     return c;
+}
+
+}  // namespace
+
+Comparison compare_brdf(const BrdfTable& table, const ComparisonOptions& o) {
+    return compare(table, o, nullptr);
+}
+
+Comparison compare_brdf(BrdfTable&& table, const ComparisonOptions& o) {
+    return compare(table, o, &table);
 }
 
 Comparison compare_curet_sample(const CuretDatabase& db, int sample,

@@ -193,11 +193,14 @@ class Evaluator {
           n_(static_cast<int>(P.parameters.size())),
           loss_(make_loss(O.loss, O.loss_scale)) {
         const std::size_t N = P.data.size();
-        sw_.resize(N);
-        w_.resize(N);
-        for (std::size_t i = 0; i < N; ++i) {
-            w_[i] = P.weights.empty() ? 1.0 : P.weights[i];
-            sw_[i] = std::sqrt(w_[i]);
+        // No weights: all 1, nothing stored (N can be 1e6).
+        if (!P.weights.empty()) {
+            sw_.resize(N);
+            w_.resize(N);
+            for (std::size_t i = 0; i < N; ++i) {
+                w_[i] = P.weights[i];
+                sw_[i] = std::sqrt(w_[i]);
+            }
         }
         theta_.resize(static_cast<std::size_t>(n_));
         M_.resize(N);
@@ -220,7 +223,10 @@ class Evaluator {
     std::size_t size() const { return P_.data.size(); }
     GainMode gain() const { return gain_; }
     const ceres::LossFunction* loss() const { return loss_.get(); }
+    // The weights, empty when all are 1; w_i and √w_i.
     const std::vector<double>& weights() const { return w_; }
+    double weight(std::size_t i) const { return w_.empty() ? 1.0 : w_[i]; }
+    double sqrt_weight(std::size_t i) const { return sw_.empty() ? 1.0 : sw_[i]; }
     int evaluations() const { return evaluations_; }
 
     // M(θ(u)) into M; false when the model fails or gives a non-finite value.
@@ -255,13 +261,13 @@ class Evaluator {
         for (std::size_t i = 0; i < size(); ++i) {
             const double KM = K * M_[i];
             if (P_.residual == ResidualType::Log && !(KM > 0.0)) {
-                if (w_[i] == 0.0) {
+                if (weight(i) == 0.0) {
                     r[i] = 0.0;
                     continue;
                 }
                 return false;
             }
-            double ri = residual_of(P_.residual, sw_[i], KM, P_.data[i]);
+            double ri = residual_of(P_.residual, sqrt_weight(i), KM, P_.data[i]);
             if (robust && loss_) {
                 double rho[3];
                 loss_->Evaluate(ri * ri, rho);
@@ -581,12 +587,11 @@ bool jacobian(const Evaluator& e, const LeastSquaresProblem& P, std::vector<doub
     const bool has_gain = e.gain() != GainMode::None;
     const auto N = static_cast<Eigen::Index>(e.size());
     J.setZero(N, n + (has_gain ? 1 : 0));
-    const std::vector<double>& w = e.weights();
     // d r_i / d(K M_i).
     std::vector<double> drdKM(e.size(), 0.0);
     for (std::size_t i = 0; i < e.size(); ++i) {
-        if (w[i] == 0.0) continue;
-        const double sw = std::sqrt(w[i]);
+        if (e.weight(i) == 0.0) continue;
+        const double sw = e.sqrt_weight(i);
         drdKM[i] = P.residual == ResidualType::Absolute   ? sw
                    : P.residual == ResidualType::Relative ? sw / P.data[i]
                                                           : sw / (K * M[i]);
@@ -610,6 +615,14 @@ bool jacobian(const Evaluator& e, const LeastSquaresProblem& P, std::vector<doub
             J.row(i) *= std::sqrt(std::max(rho[1], 0.0));
         }
     return J.allFinite();
+}
+
+// The upper-triangular factor R (p×p) of the thin QR decomposition J = QR of a tall J (rows ≥
+// columns), computed in place: J is overwritten (and released by the caller's reassignment).
+Eigen::MatrixXd triangular_factor(Eigen::MatrixXd& J) {
+    const Eigen::Index p = J.cols();
+    const Eigen::HouseholderQR<Eigen::Ref<Eigen::MatrixXd>> qr(J);
+    return qr.matrixQR().topRows(p).triangularView<Eigen::Upper>();
 }
 
 // Identifiability of the columns `cols` of J: the names of the parameters that the data do not
@@ -770,9 +783,11 @@ LeastSquaresResult solve_least_squares(const LeastSquaresProblem& P, const Least
     const int n = e.n();
     const bool has_gain = P.gain != GainMode::None;
     const int p = n + (has_gain ? 1 : 0);
-    const std::vector<double>& w = e.weights();
+    const std::vector<double>& w = e.weights();  // empty: all 1
     const int N =
-        static_cast<int>(std::count_if(w.begin(), w.end(), [](double v) { return v > 0; }));
+        w.empty()
+            ? static_cast<int>(e.size())
+            : static_cast<int>(std::count_if(w.begin(), w.end(), [](double v) { return v > 0; }));
 
     LeastSquaresResult res;
     res.num_data = N;
@@ -852,10 +867,6 @@ LeastSquaresResult solve_least_squares(const LeastSquaresProblem& P, const Least
         res.evaluations = e.evaluations();
         return res;
     }
-    res.model = M;
-    res.predicted.resize(M.size());
-    for (std::size_t i = 0; i < M.size(); ++i) res.predicted[i] = K * M[i];
-    res.residuals = r;
     double sse = 0.0;
     for (double v : r) sse += v * v;
     res.sse = sse;
@@ -895,6 +906,10 @@ LeastSquaresResult solve_least_squares(const LeastSquaresProblem& P, const Least
                 }
                 if (!held) free_cols.push_back(j);
             }
+            // Everything below depends on J only through JᵀJ: J = QR (thin, Householder, in
+            // place) gives the p×p factor R with RᵀR = JᵀJ, the same column norms and singular
+            // values, so that no further copy of the N×p Jacobian is needed (N can be 1e6).
+            J = triangular_factor(J);
             // The rank test compares relative effects: the gain's column as ∂r/∂ln K = K ∂r/∂K,
             // like a Log parameter's (∂r/∂ln θ); in natural units a large K would make its column
             // look like one "without effect" and hide the parameter it trades off with.
@@ -960,6 +975,11 @@ LeastSquaresResult solve_least_squares(const LeastSquaresProblem& P, const Least
         res.message += "; on a bound: " + list;
         if (res.status == SolverStatus::Converged) res.status = SolverStatus::AtBound;
     }
+    // The N-sized outputs last: the Jacobian and its factor are gone by now (N can be 1e6).
+    res.predicted.resize(M.size());
+    for (std::size_t i = 0; i < M.size(); ++i) res.predicted[i] = K * M[i];
+    res.model = std::move(M);
+    res.residuals = std::move(r);
     return res;
 }
 

@@ -132,7 +132,8 @@ struct ModelResult {
                                      // empty when unavailable
     int evaluations = 0;             // model evaluations over the whole table
     ErrorMeasures errors;
-    std::vector<double> prediction;  // model brightness at each used measurement
+    std::vector<double> prediction;  // model brightness at each used measurement (empty when
+                                     // ComparisonOptions::keep_predictions is false)
 
     // The value of parameter `name`; none when there is no such parameter or the data do not
     // determine it (ModelParameter::identified false).
@@ -193,6 +194,9 @@ struct ComparisonOptions {
     double fit_oren_nayar_sigma_max_rad = 1.5;  // σ_ON in [0, this], ρ_ON in [0, 1]
     // Exclude measurements whose published overflow fraction exceeds this (default: keep all).
     std::optional<double> max_overflow_fraction;
+    // Keep ModelResult::prediction (N values per model); false leaves it empty once the errors
+    // are computed (a large table whose predictions are not output).
+    bool keep_predictions = true;
 };
 
 struct Comparison {
@@ -224,6 +228,9 @@ void validate(const ComparisonOptions& options);
 // table; data problems (non-positive values, a missing pair, no positive value at all) are
 // reported in the result, never thrown.
 Comparison compare_brdf(const BrdfTable& table, const ComparisonOptions& options = {});
+// The same, releasing the table's measurements as soon as they have been read (less memory for
+// a large table); `table` is left with its name and channel only.
+Comparison compare_brdf(BrdfTable&& table, const ComparisonOptions& options = {});
 
 // One CUReT sample: compare_brdf on its table, with the paper's Table 3 O–N parameters when the
 // options give none and the sample has them. InvalidArgument for a sample not in the database.

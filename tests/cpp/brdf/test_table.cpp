@@ -3,9 +3,11 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <random>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -575,4 +577,69 @@ TEST(ComparisonNames, RoundTripAndRejectUnknown) {
     EXPECT_TRUE(is_fit(ComparisonModel::OrenNayarFit));
     EXPECT_FALSE(is_fit(ComparisonModel::Lafortune));
     EXPECT_THROW(parse_comparison_model("phong"), InvalidArgument);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Large tables: the same results with less memory
+
+TEST(Comparison, PredictionsNotKeptGiveTheSameResults) {
+    // keep_predictions = false (the CLI without --series) and a table given by value (released
+    // once read) change nothing but the stored predictions.
+    const BrdfTable t = mixed_table();
+    const Comparison kept = compare_brdf(t, {});
+    ComparisonOptions o;
+    o.keep_predictions = false;
+    const Comparison released = compare_brdf(BrdfTable(t), o);
+    ASSERT_EQ(kept.models.size(), released.models.size());
+    for (std::size_t k = 0; k < kept.models.size(); ++k) {
+        const ModelResult& a = kept.models[k];
+        const ModelResult& b = released.models[k];
+        SCOPED_TRACE(std::string(to_string(a.model)));
+        EXPECT_EQ(a.available, b.available);
+        EXPECT_EQ(a.errors.paper_sse, b.errors.paper_sse);
+        EXPECT_EQ(a.errors.gain_sse, b.errors.gain_sse);
+        ASSERT_EQ(a.parameters.size(), b.parameters.size());
+        for (std::size_t j = 0; j < a.parameters.size(); ++j)
+            EXPECT_EQ(a.parameters[j].value, b.parameters[j].value);
+        EXPECT_EQ(a.prediction.size(), a.available ? t.size() : 0U);
+        EXPECT_TRUE(b.prediction.empty());
+    }
+    EXPECT_EQ(kept.winner, released.winner);
+}
+
+TEST(Comparison, LafortuneSearchOnRepeatedGeometriesIsTheDirectSearch) {
+    // Each (θi, θs) measured at several azimuths (as on a grid): the search over the distinct
+    // (θi, θs) must find the n of the direct search, with the direct Table-4 error.
+    BrdfTable t;
+    t.name = "grid";
+    int index = 0;
+    for (double ti_deg : {10.0, 30.0, 50.0, 70.0})
+        for (double tv_deg : {0.0, 20.0, 40.0, 60.0})
+            for (double pv_deg : {0.0, 90.0, 180.0, 270.0}) {
+                const double ti = deg_to_rad(ti_deg), tv = deg_to_rad(tv_deg);
+                const double pv = deg_to_rad(pv_deg);
+                const double E = std::pow(std::cos(ti) * std::cos(tv), 2.3) * std::cos(ti) *
+                                 (1.0 + 0.1 * std::sin(++index));
+                t.measurements.push_back(
+                    make_brdf_measurement(index, ti, kPi, tv, pv, E / std::cos(ti)));
+            }
+    const Comparison c = compare_brdf(t, {});
+    std::vector<double> d, M(c.geometry.size());
+    for (double b : c.brightness) d.push_back(b);
+    double best_n = 0.0, best_err = std::numeric_limits<double>::infinity();
+    for (int k = 0; k <= 1990; ++k) {
+        const double n = 0.1 + k * 0.01;
+        for (std::size_t j = 0; j < M.size(); ++j)
+            M[j] = lafortune_diffuse_brightness(c.geometry[j], n);
+        const double e = error_measures(M, d).paper_sse;
+        if (e < best_err) {
+            best_err = e;
+            best_n = n;
+        }
+    }
+    const ModelResult& laf = c.result(ComparisonModel::Lafortune);
+    ASSERT_TRUE(laf.parameter("n").has_value());
+    EXPECT_EQ(*laf.parameter("n"), best_n);
+    EXPECT_NEAR(laf.errors.paper_sse, best_err, 1e-12 * best_err);
+    EXPECT_NEAR(best_n, 2.3, 0.5);  // an interior minimum near the exponent of the data
 }
