@@ -16,6 +16,9 @@ import pytest
 
 from conftest import cli_path
 
+# Drives the CLI: also run against the sanitizer build (`make sanitize`, DEVELOPERS.md).
+pytestmark = pytest.mark.cli
+
 SANITIZED = os.environ.get("ROUGHSCOPE_SANITIZED") == "1"
 ROWS = 100_000 if SANITIZED else 1_000_000  # the same code path; ASan is ~5x slower
 LIMIT_KB = 200 * 1024
