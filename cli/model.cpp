@@ -309,6 +309,10 @@ class Record {
             return *this;
         }
         Value& operator=(const char* t) { return *this = std::string_view(t); }
+        // Numbers go through serialize::number (rounded as every printed result): a bare double
+        // would otherwise convert to bool.
+        Value& operator=(double) = delete;
+        Value& operator=(int) = delete;
         Value& operator=(const std::string& t) { return *this = std::string_view(t); }
         Value& operator=(const json& j) {
             if (j.is_null()) return *this = nullptr;
@@ -436,7 +440,7 @@ double evaluate_bk(const Args& a, const Point& p, const Roughness& r, Record& ou
         out["regime"] = regime ? json(*regime) : json(nullptr);
         out["roughness_class"] = roughness_class ? json(*roughness_class) : json(nullptr);
         out["method"] = std::string(to_string(DiffuseMethod::ClosedForm));
-        out["relative_error_bound"] = 0.0;
+        out["relative_error_bound"] = serialize::number(0.0);
     }
     out["scale"] = absolute ? "absolute" : "relative";
     out["correlation"] = std::string(to_string(a.correlation));

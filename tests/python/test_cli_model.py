@@ -139,6 +139,9 @@ def test_retro_vh_gaussian_equals_eq9(theta, m):
     assert out["regime"] == "very_rough"
     assert out["g"] is None and out["coherent"] is None and out["total"] is None
     assert out["roughness_class"] is None
+    # A closed form (Eq. 4) is exact: method closed_form, error bound the number 0 (not a bool).
+    assert out["method"] == "closed_form"
+    assert type(out["relative_error_bound"]) in (int, float) and out["relative_error_bound"] == 0
     assert out["scale"] == "relative"
     assert out["theta_i_deg"] == theta and out["theta_s_deg"] == theta
     assert out["phi_s_deg"] == 180
