@@ -11,25 +11,15 @@
 #include "roughscope/io/data_locator.hpp"
 #include "roughscope/io/output_file.hpp"
 #include "shared_data.hpp"
+#include "test_files.hpp"
 
 using namespace roughscope;
 namespace fs = std::filesystem;
 
 namespace {
 
-fs::path fresh_dir(const std::string& name) {
-    const fs::path d = fs::temp_directory_path() / ("roughscope_io_" + name);
-    fs::remove_all(d);
-    fs::create_directories(d);
-    return d;
-}
-
-std::string slurp(const fs::path& p) {
-    std::ifstream in(p, std::ios::binary);
-    std::ostringstream s;
-    s << in.rdbuf();
-    return s.str();
-}
+using roughscope::testing::fresh_dir;
+using roughscope::testing::slurp;
 
 // Sets an environment variable for one scope, restoring the previous value.
 class ScopedEnv {

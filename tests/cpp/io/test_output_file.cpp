@@ -15,26 +15,15 @@
 
 #include "roughscope/core/errors.hpp"
 #include "roughscope/io/output_file.hpp"
+#include "test_files.hpp"
 
 using namespace roughscope;
 namespace fs = std::filesystem;
 
 namespace {
 
-fs::path fresh_dir(const std::string& name) {
-    const fs::path d =
-        fs::temp_directory_path() / ("roughscope_out_" + std::to_string(::getpid()) + "_" + name);
-    fs::remove_all(d);
-    fs::create_directories(d);
-    return d;
-}
-
-std::string slurp(const fs::path& p) {
-    std::ifstream in(p, std::ios::binary);
-    std::ostringstream s;
-    s << in.rdbuf();
-    return s.str();
-}
+using roughscope::testing::fresh_dir;
+using roughscope::testing::slurp;
 
 void put(const fs::path& p, const std::string& text) { std::ofstream(p, std::ios::binary) << text; }
 
@@ -174,10 +163,10 @@ TEST(OutputSink, CharacterDeviceStaysADevice) {
 TEST(OutputSink, DashIsStandardOutput) {
     io::OutputFile out(fs::path("-"));
     EXPECT_EQ(out.mode(), io::OutputFile::Mode::Stdout);
-    testing::internal::CaptureStdout();
+    ::testing::internal::CaptureStdout();
     out.write("to stdout\n");
     out.commit();
-    EXPECT_EQ(testing::internal::GetCapturedStdout(), "to stdout\n");
+    EXPECT_EQ(::testing::internal::GetCapturedStdout(), "to stdout\n");
 }
 
 TEST(OutputSink, ReadOnlyFileOfAnotherUserIsRefused) {
