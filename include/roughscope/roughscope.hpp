@@ -36,6 +36,12 @@
 #include "roughscope/brdf/curet.hpp"
 #include "roughscope/brdf/table.hpp"
 
+// surface: height maps, their files, statistics and generated surfaces
+#include "roughscope/surface/formats.hpp"
+#include "roughscope/surface/generate.hpp"
+#include "roughscope/surface/height_map.hpp"
+#include "roughscope/surface/statistics.hpp"
+
 // serialize: every result type to JSON, CSV and Markdown
 #include "roughscope/serialize/comparison.hpp"
 #include "roughscope/serialize/estimation.hpp"

@@ -1,0 +1,36 @@
+// Random rough surfaces of known statistics (paper §3.1): Gaussian height distribution with
+// Gaussian C(τ) = exp(−τ²/T²) or exponential C(τ) = exp(−|τ|/T) correlation (or any given
+// isotropic PSD), made by filtering white noise in the Fourier domain (FFTW3). The surfaces are
+// periodic; the ensemble ACF equals the target on the lattice; a seed gives the same surface on
+// every run and machine. Method and its exactness: docs/surface.md.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+
+#include "roughscope/scattering/beckmann.hpp"
+#include "roughscope/surface/height_map.hpp"
+
+namespace roughscope::surface {
+
+struct GenerationOptions {
+    Correlation correlation = Correlation::Gaussian;
+    double sigma_um = 1.0;  // RMS height σ, > 0
+    double T_um = 10.0;     // correlation length T, > 0
+    std::size_t nx = 256;
+    std::size_t ny = 256;  // 1 = a profile
+    double dx_um = 1.0;
+    double dy_um = 1.0;
+    std::uint64_t seed = 1;
+};
+
+// InvalidArgument naming the option and its range for anything out of range.
+HeightMap generate_surface(const GenerationOptions& options);
+
+// The same with the correlation replaced by an isotropic two-sided PSD W(k) of the spatial
+// angular frequency k = |k| (rad/µm), scaled so that the surface's RMS height is sigma_um.
+HeightMap generate_surface_from_psd(const std::function<double(double k_rad_per_um)>& psd,
+                                    const GenerationOptions& options);
+
+}  // namespace roughscope::surface

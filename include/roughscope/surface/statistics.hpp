@@ -1,0 +1,101 @@
+// Roughness statistics of a height map (paper §3.1; ISO 25178-2 / ISO 4287 names): levelling,
+// the Gaussian roughness filter, height moments, autocorrelation, correlation length T, RMS slope
+// and the power spectral density. Every definition, with its formula, levelling and estimator, and
+// where it differs from Gwyddion's and ISO's defaults: docs/surface.md. All functions are
+// mask-aware: missing (NaN) points are left out of every sum.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "roughscope/scattering/beckmann.hpp"
+#include "roughscope/surface/height_map.hpp"
+
+namespace roughscope::surface {
+
+// ---- Levelling (least squares over the valid points) ---------------------------------------
+enum class Leveling {
+    none,        // heights as read
+    mean,        // subtract the mean height
+    line,        // subtract each row's least-squares mean line (profile practice, Gwyddion's
+                 // "row levelling"); for a profile this is the paper's mean line (§3.1)
+    plane,       // subtract the least-squares plane (areal default)
+    polynomial,  // subtract a least-squares polynomial surface in x, y of total order 1..3
+};
+std::string to_string(Leveling leveling);
+Leveling parse_leveling(std::string_view name);
+
+// `map` minus its background. polynomial_order: 1..3, used by Leveling::polynomial only.
+// InvalidArgument when too few valid points determine the background.
+HeightMap level(const HeightMap& map, Leveling leveling, int polynomial_order = 1);
+
+// ---- Gaussian filter: ISO 16610-21 (profiles, along x) and ISO 16610-61 (areal) --------------
+// Weighting s(x) = 1/(α λc) exp(−π (x/(α λc))²), α = sqrt(ln 2 / π): 50 % transmission of a
+// sinusoid of wavelength λc. Missing points are left out with the weights renormalised.
+struct FilteredHeights {
+    HeightMap waviness;   // the mean surface (long wavelengths)
+    HeightMap roughness;  // map − waviness (short wavelengths)
+};
+FilteredHeights gaussian_filter(const HeightMap& map, double cutoff_um);
+
+// ---- Statistics -----------------------------------------------------------------------------
+enum class AcfEstimator {
+    unbiased,  // C_j = (1/(N−j)) Σ z_k z_{k+j} / σ²   (paper §3.1, "unbiased")
+    biased,    // C_j = (1/N) Σ z_k z_{k+j} / σ²       (paper §3.1, "biased"; Gwyddion's)
+};
+std::string to_string(AcfEstimator estimator);
+AcfEstimator parse_acf_estimator(std::string_view name);
+
+struct Curve {
+    std::vector<double> x;  // lag τ (µm) or spatial frequency (1/µm)
+    std::vector<double> y;  // normalised ACF, or PSD (µm² · µm for 1-D, µm² · µm² for 2-D)
+};
+
+struct StatisticsOptions {
+    Leveling leveling = Leveling::plane;
+    int polynomial_order = 1;
+    std::optional<double> cutoff_um;  // λc of the Gaussian roughness filter; none = no filter
+    AcfEstimator acf_estimator = AcfEstimator::unbiased;
+    bool keep_curves = true;  // fill acf_x, acf_y, acf_radial, psd_x, psd_radial
+};
+
+struct SurfaceStatistics {
+    // Heights after levelling/filtering (µm); σ = Sq (Rq for a profile).
+    std::size_t points = 0;                 // valid points used
+    double sigma_um = 0;                    // Sq = sqrt((1/N) Σ z²)
+    double Sa_um = 0;                       // (1/N) Σ |z|
+    double Ssk = 0;                         // (1/(N σ³)) Σ z³ (0 when σ = 0)
+    double Sku = 0;                         // (1/(N σ⁴)) Σ z⁴
+    double Sp_um = 0;                       // max z
+    double Sv_um = 0;                       // −min z (≥ 0)
+    double Sz_um = 0;                       // Sp + Sv
+    std::optional<double> sigma_stderr_um;  // spread of σ over rows (profile: blocks)
+
+    // Correlation length: 1/e crossing of the ACF, interpolated between lags.
+    std::optional<double> T_um;    // along x (rows)
+    std::optional<double> T_y_um;  // along y (columns); none for a profile
+    std::optional<double> T_stderr_um;
+    // Least-squares fits of exp(−τ²/T²) and exp(−|τ|/T) to the ACF; the better by AIC.
+    std::optional<double> T_fit_gaussian_um;
+    std::optional<double> T_fit_exponential_um;
+    std::optional<Correlation> correlation;  // scattering/beckmann.hpp
+    // T against 1/L over sub-profiles, extrapolated to 1/L = 0.
+    std::optional<double> T_extrapolated_um;
+    // ISO 25178-2 with s = 0.2: fastest-decay length of the 2-D ACF and texture aspect ratio.
+    std::optional<double> Sal_um;
+    std::optional<double> Str;
+    // RMS slope by finite differences (Rdq/Sdq) and m = σ√2/T from the 1/e T.
+    std::optional<double> rms_slope;
+    std::optional<double> m_from_T;
+
+    std::vector<std::string> warnings;  // e.g. L/T < 50: the 1/e T is biased low
+
+    // Curves for the report (empty unless StatisticsOptions::keep_curves).
+    Curve acf_x, acf_y, acf_radial;
+    Curve psd_x, psd_radial;
+};
+
+SurfaceStatistics surface_statistics(const HeightMap& map, const StatisticsOptions& options = {});
+
+}  // namespace roughscope::surface

@@ -1,0 +1,181 @@
+// Dispatch of the height-map readers and writers (formats.hpp); the formats themselves live in
+// src/surface/format_<family>.cpp.
+#include "roughscope/surface/formats.hpp"
+
+#include <array>
+#include <cerrno>
+#include <cstring>
+#include <fstream>
+#include <iterator>
+#include <string>
+#include <system_error>
+
+#include "roughscope/core/errors.hpp"
+#include "roughscope/core/names.hpp"
+#include "roughscope/core/text.hpp"
+#include "roughscope/io/output_file.hpp"
+
+namespace roughscope::surface {
+
+namespace {
+
+constexpr std::array<NameEntry<HeightFormat>, 9> kFormatNames{{
+    {"csv_matrix", HeightFormat::csv_matrix},
+    {"xyz", HeightFormat::xyz},
+    {"sdf", HeightFormat::sdf},
+    {"x3p", HeightFormat::x3p},
+    {"gwy", HeightFormat::gwy},
+    {"gsf", HeightFormat::gsf},
+    {"png", HeightFormat::png},
+    {"tiff", HeightFormat::tiff},
+    {"raw", HeightFormat::raw},
+}};
+
+struct ExtensionEntry {
+    std::string_view extension;  // lower case, with the dot
+    HeightFormat format;
+};
+
+constexpr std::array<ExtensionEntry, 16> kExtensions{{
+    {".csv", HeightFormat::csv_matrix},
+    {".txt", HeightFormat::csv_matrix},
+    {".asc", HeightFormat::csv_matrix},
+    {".xyz", HeightFormat::xyz},
+    {".sdf", HeightFormat::sdf},
+    {".x3p", HeightFormat::x3p},
+    {".gwy", HeightFormat::gwy},
+    {".gsf", HeightFormat::gsf},
+    {".png", HeightFormat::png},
+    {".tif", HeightFormat::tiff},
+    {".tiff", HeightFormat::tiff},
+    {".raw", HeightFormat::raw},
+    {".bin", HeightFormat::raw},
+    {".f32", HeightFormat::raw},
+    {".f64", HeightFormat::raw},
+    {".dat", HeightFormat::raw},
+}};
+
+std::string extension_list() {
+    std::string out;
+    for (const auto& entry : kExtensions) {
+        if (!out.empty()) out += ", ";
+        out += entry.extension;
+    }
+    return out;
+}
+
+HeightFormat format_for(const std::filesystem::path& path,
+                        const std::optional<HeightFormat>& given) {
+    if (given) return *given;
+    if (auto found = height_format_from_extension(path)) return *found;
+    std::string message = "cannot tell the height-map format of ";
+    message.append(quote_input(path.string()))
+        .append(" from its extension; use one of ")
+        .append(extension_list())
+        .append(" or name the format");
+    throw InvalidArgument(message);
+}
+
+std::string read_whole_file(const std::filesystem::path& path) {
+    std::error_code ec;
+    const auto status = std::filesystem::status(path, ec);
+    if (ec || !std::filesystem::exists(status)) {
+        throw DataError("cannot read " + quote_input(path.string()) + ": no such file");
+    }
+    if (std::filesystem::is_directory(status)) {
+        throw DataError("cannot read " + quote_input(path.string()) + ": it is a directory");
+    }
+    std::ifstream in(path, std::ios::binary);
+    if (!in) {
+        std::string message = "cannot read " + quote_input(path.string());
+        message.append(": ").append(std::strerror(errno));
+        throw DataError(message);
+    }
+    std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    if (in.bad()) throw DataError("cannot read " + quote_input(path.string()) + ": read error");
+    return bytes;
+}
+
+}  // namespace
+
+std::string to_string(HeightFormat format) { return std::string(name_of(kFormatNames, format)); }
+
+HeightFormat parse_height_format(std::string_view name) {
+    return parse_name(kFormatNames, "height-map format", name);
+}
+
+std::optional<HeightFormat> height_format_from_extension(const std::filesystem::path& path) {
+    const std::string extension = normalize_name(path.extension().string());
+    for (const auto& entry : kExtensions) {
+        if (entry.extension == extension) return entry.format;
+    }
+    return std::nullopt;
+}
+
+HeightMap decode_height_map(std::string_view bytes, const std::string& name, HeightFormat format,
+                            const HeightReadOptions& options) {
+    switch (format) {
+        case HeightFormat::csv_matrix:
+            return formats::decode_csv_matrix(bytes, name, options);
+        case HeightFormat::xyz:
+            return formats::decode_xyz(bytes, name, options);
+        case HeightFormat::sdf:
+            return formats::decode_sdf(bytes, name, options);
+        case HeightFormat::x3p:
+            return formats::decode_x3p(bytes, name, options);
+        case HeightFormat::gwy:
+            return formats::decode_gwy(bytes, name, options);
+        case HeightFormat::gsf:
+            return formats::decode_gsf(bytes, name, options);
+        case HeightFormat::png:
+            return formats::decode_png(bytes, name, options);
+        case HeightFormat::tiff:
+            return formats::decode_tiff(bytes, name, options);
+        case HeightFormat::raw:
+            return formats::decode_raw(bytes, name, options);
+    }
+    throw InvalidArgument("unknown height-map format");
+}
+
+std::string encode_height_map(const HeightMap& map, HeightFormat format,
+                              const HeightWriteOptions& options) {
+    validate(map, "height map");
+    switch (format) {
+        case HeightFormat::csv_matrix:
+            return formats::encode_csv_matrix(map, options);
+        case HeightFormat::xyz:
+            return formats::encode_xyz(map, options);
+        case HeightFormat::sdf:
+            return formats::encode_sdf(map, options);
+        case HeightFormat::x3p:
+            return formats::encode_x3p(map, options);
+        case HeightFormat::gwy:
+            throw InvalidArgument(
+                "height-map format 'gwy' can be read but not written; "
+                "write .gsf or .x3p for Gwyddion");
+        case HeightFormat::gsf:
+            return formats::encode_gsf(map, options);
+        case HeightFormat::png:
+            return formats::encode_png(map, options);
+        case HeightFormat::tiff:
+            return formats::encode_tiff(map, options);
+        case HeightFormat::raw:
+            return formats::encode_raw(map, options);
+    }
+    throw InvalidArgument("unknown height-map format");
+}
+
+HeightMap read_height_map(const std::filesystem::path& path, const HeightReadOptions& options) {
+    const HeightFormat format = format_for(path, options.format);
+    const std::string bytes = read_whole_file(path);
+    return decode_height_map(bytes, path.string(), format, options);
+}
+
+void write_height_map(const HeightMap& map, const std::filesystem::path& path,
+                      const HeightWriteOptions& options) {
+    const HeightFormat format = format_for(path, options.format);
+    const std::string bytes = encode_height_map(map, format, options);
+    io::write_file_atomic(path, bytes);
+}
+
+}  // namespace roughscope::surface

@@ -1,0 +1,114 @@
+#include "roughscope/surface/height_map.hpp"
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <string>
+
+#include "roughscope/core/errors.hpp"
+#include "roughscope/core/numbers.hpp"
+
+namespace roughscope::surface {
+
+std::size_t HeightMap::count_valid() const {
+    return static_cast<std::size_t>(std::count_if(heights_um.begin(), heights_um.end(),
+                                                  [](double z) { return !std::isnan(z); }));
+}
+
+std::vector<std::uint8_t> HeightMap::mask() const {
+    std::vector<std::uint8_t> out(heights_um.size());
+    std::transform(heights_um.begin(), heights_um.end(), out.begin(),
+                   [](double z) { return static_cast<std::uint8_t>(!std::isnan(z)); });
+    return out;
+}
+
+namespace {
+
+void check_dimensions(const std::string& what, std::size_t nx, std::size_t ny) {
+    if (nx < 1 || ny < 1 || nx > kMaxHeightMapPoints / ny) {
+        std::string message = what;
+        message.append(": the grid must have 1 to ")
+            .append(std::to_string(kMaxHeightMapPoints))
+            .append(" points with nx, ny >= 1 (got nx = ")
+            .append(std::to_string(nx))
+            .append(", ny = ")
+            .append(std::to_string(ny))
+            .append(")");
+        throw InvalidArgument(message);
+    }
+}
+
+void check_spacing(const std::string& what, const char* name, double value_um) {
+    if (!(std::isfinite(value_um) && value_um > 0.0)) {
+        std::string message = what;
+        message.append(": ")
+            .append(name)
+            .append(" must be a finite spacing > 0 um (got ")
+            .append(format_message(value_um))
+            .append(")");
+        throw InvalidArgument(message);
+    }
+}
+
+}  // namespace
+
+HeightMap make_height_map(std::size_t nx, std::size_t ny, double dx_um, double dy_um) {
+    check_dimensions("height map", nx, ny);
+    check_spacing("height map", "dx_um", dx_um);
+    check_spacing("height map", "dy_um", dy_um);
+    HeightMap map;
+    map.nx = nx;
+    map.ny = ny;
+    map.dx_um = dx_um;
+    map.dy_um = dy_um;
+    map.heights_um.assign(nx * ny, 0.0);
+    return map;
+}
+
+void validate(const HeightMap& map, const std::string& what) {
+    check_dimensions(what, map.nx, map.ny);
+    check_spacing(what, "dx_um", map.dx_um);
+    check_spacing(what, "dy_um", map.dy_um);
+    if (!std::isfinite(map.x_offset_um) || !std::isfinite(map.y_offset_um)) {
+        throw InvalidArgument(what + ": the grid offsets must be finite");
+    }
+    if (map.heights_um.size() != map.nx * map.ny) {
+        std::string message = what;
+        message.append(": ")
+            .append(std::to_string(map.heights_um.size()))
+            .append(" heights for a grid of ")
+            .append(std::to_string(map.nx))
+            .append(" x ")
+            .append(std::to_string(map.ny))
+            .append(" points");
+        throw InvalidArgument(message);
+    }
+    bool any_valid = false;
+    for (const double z : map.heights_um) {
+        if (std::isinf(z)) {
+            throw InvalidArgument(what + ": heights must be finite or NaN (missing), not infinite");
+        }
+        any_valid = any_valid || !std::isnan(z);
+    }
+    if (!any_valid) throw InvalidArgument(what + ": every point is missing (no valid height)");
+}
+
+bool bitwise_equal(const HeightMap& a, const HeightMap& b) {
+    auto same = [](double u, double v) {
+        return std::bit_cast<std::uint64_t>(u) == std::bit_cast<std::uint64_t>(v);
+    };
+    if (a.nx != b.nx || a.ny != b.ny || !same(a.dx_um, b.dx_um) || !same(a.dy_um, b.dy_um) ||
+        !same(a.x_offset_um, b.x_offset_um) || !same(a.y_offset_um, b.y_offset_um) ||
+        a.heights_um.size() != b.heights_um.size()) {
+        return false;
+    }
+    for (std::size_t i = 0; i < a.heights_um.size(); ++i) {
+        const double u = a.heights_um[i];
+        const double v = b.heights_um[i];
+        if (std::isnan(u) && std::isnan(v)) continue;
+        if (!same(u, v)) return false;
+    }
+    return true;
+}
+
+}  // namespace roughscope::surface
