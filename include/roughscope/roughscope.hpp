@@ -40,6 +40,7 @@
 #include "roughscope/surface/formats.hpp"
 #include "roughscope/surface/generate.hpp"
 #include "roughscope/surface/height_map.hpp"
+#include "roughscope/surface/spectral.hpp"
 #include "roughscope/surface/statistics.hpp"
 
 // serialize: every result type to JSON, CSV and Markdown
