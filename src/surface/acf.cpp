@@ -31,21 +31,33 @@ double acf_value(const std::vector<double>& sums, const std::vector<double>& pai
     return (sums[j] / pairs[j]) / (sums[0] / pairs[0]);
 }
 
-std::optional<double> crossing_1e_samples(const std::vector<double>& sums,
-                                          const std::vector<double>& pairs,
+std::optional<double> crossing_1e_samples(const double* sums, const double* pairs, std::size_t n,
                                           AcfEstimator estimator) {
-    if (sums.empty() || !(sums[0] > 0)) return std::nullopt;
+    if (n == 0 || !(sums[0] > 0)) return std::nullopt;
+    const auto pair_count = [&](std::size_t j) {
+        return pairs != nullptr ? pairs[j] : static_cast<double>(n - j);
+    };
+    const double mean_square = sums[0] / pair_count(0);
     double prev_lag = 0;
     double prev_c = 1;
-    for (std::size_t j = 1; j < sums.size(); ++j) {
-        const double c = acf_value(sums, pairs, j, estimator);
-        if (std::isnan(c)) continue;
+    for (std::size_t j = 1; j < n; ++j) {
+        const double count = pair_count(j);
+        if (count <= 0) continue;
+        const double c =
+            estimator == AcfEstimator::biased ? sums[j] / sums[0] : sums[j] / count / mean_square;
         const auto lag = static_cast<double>(j);
         if (c <= kInvE) return prev_lag + (prev_c - kInvE) / (prev_c - c) * (lag - prev_lag);
         prev_lag = lag;
         prev_c = c;
     }
     return std::nullopt;
+}
+
+std::optional<double> crossing_1e_samples(const std::vector<double>& sums,
+                                          const std::vector<double>& pairs,
+                                          AcfEstimator estimator) {
+    return crossing_1e_samples(sums.data(), pairs.data(), std::min(sums.size(), pairs.size()),
+                               estimator);
 }
 
 LineAcf::LineAcf(std::size_t length, AcfEstimator estimator, bool per_line)
@@ -85,28 +97,28 @@ void LineAcf::add(const double* z) {
     std::fill(r + length_, r + nfft, 0.0);
     fft_->autocorrelate_in_place();
     for (std::size_t j = 0; j < length_; ++j) sums[j] += r[j] * inv;
-    if (per_line_)
-        for (std::size_t j = 0; j < length_; ++j) line_sums_[j] = r[j] * inv;
-
-    if (missing) {
-        for (std::size_t k = 0; k < length_; ++k) r[k] = std::isnan(z[k]) ? 0.0 : 1.0;
-        std::fill(r + length_, r + nfft, 0.0);
-        fft_->autocorrelate_in_place();
-        for (std::size_t j = 0; j < length_; ++j) {
-            const double count = std::round(r[j] * inv);  // an integer up to FFT round-off
-            pairs[j] += count;
-            if (per_line_) line_pairs_[j] = count;
-        }
-    } else {
+    if (!missing) {
         ++full_lines_;
-        if (per_line_)
-            for (std::size_t j = 0; j < length_; ++j)
-                line_pairs_[j] = static_cast<double>(length_ - j);
+        if (per_line_) record_line(sum_sq, valid, r, nullptr);  // the 1/e crossing is scale-free
+        return;
     }
-    if (!per_line_) return;
+    if (per_line_) std::copy(r, r + length_, line_sums_.begin());
+    for (std::size_t k = 0; k < length_; ++k) r[k] = std::isnan(z[k]) ? 0.0 : 1.0;
+    std::fill(r + length_, r + nfft, 0.0);
+    fft_->autocorrelate_in_place();
+    for (std::size_t j = 0; j < length_; ++j) {
+        const double count = std::round(r[j] * inv);  // an integer up to FFT round-off
+        pairs[j] += count;
+        if (per_line_) line_pairs_[j] = count;
+    }
+    if (per_line_) record_line(sum_sq, valid, line_sums_.data(), line_pairs_.data());
+}
+
+void LineAcf::record_line(double sum_sq, std::size_t valid, const double* line_sums,
+                          const double* line_pairs) {
     line_rms_um.push_back(std::sqrt(sum_sq / static_cast<double>(valid)));
     if (sum_sq <= 0) return;
-    if (const auto crossing = crossing_1e_samples(line_sums_, line_pairs_, estimator_))
+    if (const auto crossing = crossing_1e_samples(line_sums, line_pairs, length_, estimator_))
         line_crossing.push_back(*crossing);
     else
         ++lines_without_crossing;
@@ -125,15 +137,23 @@ void accumulate_rows(const HeightMap& map, LineAcf& acc) {
 void accumulate_columns(const HeightMap& map, LineAcf& acc) {
     // Columns are gathered a block at a time into contiguous lines (row segments are read
     // contiguously), then handled as rows.
-    constexpr std::size_t kBlock = 16;
-    std::vector<double> block(kBlock * map.ny);
+    // The block's lines are padded to a stride that is not a multiple of a cache line set's
+    // span, so the write streams do not evict each other.
+    constexpr std::size_t kBlock = 64;
+    constexpr std::size_t kAhead = 8;
+    const std::size_t stride = map.ny + 8;
+    std::vector<double> block(kBlock * stride);
     for (std::size_t c0 = 0; c0 < map.nx; c0 += kBlock) {
         const std::size_t width = std::min(kBlock, map.nx - c0);
         for (std::size_t iy = 0; iy < map.ny; ++iy) {
             const double* row = &map.heights_um[iy * map.nx + c0];
-            for (std::size_t k = 0; k < width; ++k) block[k * map.ny + iy] = row[k];
+            // The hardware prefetcher does not follow a row-sized stride: fetch rows ahead.
+            if (iy + kAhead < map.ny)
+                for (std::size_t k = 0; k < width; k += 8)
+                    __builtin_prefetch(row + kAhead * map.nx + k);
+            for (std::size_t k = 0; k < width; ++k) block[k * stride + iy] = row[k];
         }
-        for (std::size_t k = 0; k < width; ++k) acc.add(&block[k * map.ny]);
+        for (std::size_t k = 0; k < width; ++k) acc.add(&block[k * stride]);
     }
 }
 

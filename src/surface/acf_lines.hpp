@@ -28,6 +28,9 @@ double acf_value(const std::vector<double>& sums, const std::vector<double>& pai
                  AcfEstimator estimator);
 
 // The 1/e crossing in samples from the sums (linear interpolation between lags), or none.
+// `pairs` null: every pair present (n_j = n − j).
+std::optional<double> crossing_1e_samples(const double* sums, const double* pairs, std::size_t n,
+                                          AcfEstimator estimator);
 std::optional<double> crossing_1e_samples(const std::vector<double>& sums,
                                           const std::vector<double>& pairs, AcfEstimator estimator);
 
@@ -56,6 +59,8 @@ class LineAcf {
     std::size_t lines_without_crossing = 0;  // lines with data whose ACF never reaches 1/e
 
   private:
+    void record_line(double sum_sq, std::size_t valid, const double* line_sums,
+                     const double* line_pairs);
     std::size_t length_;
     AcfEstimator estimator_;
     bool per_line_;

@@ -88,6 +88,8 @@ void subtract_polynomial(HeightMap& map, int order) {
     std::array<double, 7> pu{};   // Σ u^a over a row's valid points, a ≤ 6
     std::array<double, 4> puz{};  // Σ u^a z, a ≤ 3
     std::array<double, 7> vpow{};
+    std::vector<double> u_of(map.nx);
+    for (std::size_t ix = 0; ix < map.nx; ++ix) u_of[ix] = scaled(ix, map.nx);
     for (std::size_t iy = 0; iy < map.ny; ++iy) {
         pu.fill(0);
         puz.fill(0);
@@ -96,7 +98,7 @@ void subtract_polynomial(HeightMap& map, int order) {
             const double z = row[ix];
             if (std::isnan(z)) continue;
             ++count;
-            const double u = scaled(ix, map.nx);
+            const double u = u_of[ix];
             double p = 1;
             for (int a = 0; a <= max_pow; ++a) {
                 pu[static_cast<std::size_t>(a)] += p;
@@ -142,7 +144,7 @@ void subtract_polynomial(HeightMap& map, int order) {
         }
         double* row = &map.heights_um[iy * map.nx];
         for (std::size_t ix = 0; ix < map.nx; ++ix) {
-            const double u = scaled(ix, map.nx);
+            const double u = u_of[ix];
             row[ix] -= row_coef[0] + u * (row_coef[1] + u * (row_coef[2] + u * row_coef[3]));
         }
     }
