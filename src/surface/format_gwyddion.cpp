@@ -72,7 +72,8 @@ std::optional<UnitScale> length_unit(std::string_view unit) {
     if (unit == "um" || unit == "\xc2\xb5m" || unit == "\xce\xbcm") return UnitScale{1.0, 1.0};
     if (unit == "nm") return UnitScale{1.0, 1e3};
     if (unit == "pm") return UnitScale{1.0, 1e6};
-    if (unit == "A" || unit == "\xc3\x85" || unit == "\xe2\x84\xab") return UnitScale{1.0, 1e4};
+    // Angstrom (the letter A alone is the ampere).
+    if (unit == "\xc3\x85" || unit == "\xe2\x84\xab") return UnitScale{1.0, 1e4};
     return std::nullopt;
 }
 
@@ -471,7 +472,7 @@ HeightMap decode_gsf(std::string_view bytes, const std::string& name, const Heig
         const auto s = length_unit(text);
         if (!s) {
             fail_at(name, it->second.second,
-                    cat(key, " is not a length unit (m, mm, um, nm, pm, A): ", quote_input(text)));
+                    cat(key, " is not a length unit (m, mm, um, nm, pm): ", quote_input(text)));
         }
         return *s;
     };
