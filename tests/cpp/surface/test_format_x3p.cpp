@@ -417,3 +417,29 @@ TEST(X3pFormat, RealFileWithAStaleMainXmlChecksum) {
 
 }  // namespace
 }  // namespace roughscope::surface
+
+namespace roughscope::surface {
+namespace {
+
+// The fuzz seeds come from fuzz/make_height_seeds_x3p.py, a second independent writer (Python's
+// zipfile, hashlib and struct): each must read as a valid map.
+TEST(HeightSeedFiles, EverySeedReads) {
+    const std::filesystem::path corpus =
+        std::filesystem::path(ROUGHSCOPE_SOURCE_DIR) / "fuzz" / "corpus";
+    std::size_t files = 0;
+    for (const auto& [target, format] : {std::pair{"height_x3p", HeightFormat::x3p},
+                                         {"height_gwy", HeightFormat::gwy},
+                                         {"height_gsf", HeightFormat::gsf}}) {
+        for (const auto& entry : std::filesystem::directory_iterator(corpus / target)) {
+            const std::string bytes = testing::slurp(entry.path());
+            const HeightMap map =
+                decode_height_map(bytes, entry.path().filename().string(), format);
+            EXPECT_GE(map.count_valid(), 1U) << entry.path();
+            ++files;
+        }
+    }
+    EXPECT_GE(files, 9U);
+}
+
+}  // namespace
+}  // namespace roughscope::surface
