@@ -44,7 +44,6 @@ RealToComplex::RealToComplex(std::size_t rows, std::size_t cols, Layout layout)
     if (data_ == nullptr) {
         throw std::bad_alloc();
     }
-    fill_zero();
     auto* spectrum = reinterpret_cast<fftw_complex*>(data_);
     const int n_rows = static_cast<int>(rows);
     const int n_cols = static_cast<int>(cols);

@@ -26,7 +26,8 @@ enum class Layout {
 class RealToComplex {
   public:
     // Allocates the (aligned) buffer and plans the forward and backward transforms; the buffer
-    // starts zeroed. Throws std::bad_alloc when the buffer cannot be allocated.
+    // starts uninitialised (fill_zero() clears it). Throws std::bad_alloc when the buffer cannot
+    // be allocated.
     RealToComplex(std::size_t rows, std::size_t cols, Layout layout);
     ~RealToComplex();
     RealToComplex(const RealToComplex&) = delete;

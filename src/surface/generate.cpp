@@ -35,6 +35,28 @@ class NormalStream {
             has_spare_ = false;
             return spare_;
         }
+        double first = 0;
+        pair(first, spare_);
+        has_spare_ = true;
+        return first;
+    }
+
+    // The next n deviates into out[0..n).
+    void fill(double* out, std::size_t n) {
+        std::size_t i = 0;
+        if (has_spare_ && n > 0) {
+            out[i++] = next();
+        }
+        for (; i + 1 < n; i += 2) {
+            pair(out[i], out[i + 1]);
+        }
+        if (i < n) {
+            out[i] = next();
+        }
+    }
+
+  private:
+    void pair(double& first, double& second) {
         double u = 0;
         double v = 0;
         double s = 0;
@@ -44,12 +66,10 @@ class NormalStream {
             s = u * u + v * v;
         } while (s >= 1.0 || s == 0.0);
         const double factor = std::sqrt(-2.0 * std::log(s) / s);
-        spare_ = v * factor;
-        has_spare_ = true;
-        return u * factor;
+        first = u * factor;
+        second = v * factor;
     }
 
-  private:
     // k·2^−52 − 1 with k the top 53 bits: exact, on [−1, 1).
     double uniform_pm1() { return static_cast<double>(engine_() >> 11) * 0x1.0p-52 - 1.0; }
     std::mt19937_64 engine_;
@@ -103,6 +123,21 @@ double signed_index(std::size_t j, std::size_t n) {
     return j <= n / 2 ? static_cast<double>(j) : static_cast<double>(j) - static_cast<double>(n);
 }
 
+// Offsets u + m·period (m integer) within r_max of 0: the periodic images of lag u that matter.
+std::vector<double> images_within(double u, double period, double r_max, bool periodic) {
+    std::vector<double> out;
+    if (!periodic) {
+        out.push_back(u);
+        return out;
+    }
+    const auto first = static_cast<long>(std::ceil((-r_max - u) / period));
+    const auto last = static_cast<long>(std::floor((r_max - u) / period));
+    for (long m = first; m <= last; ++m) {
+        out.push_back(u + static_cast<double>(m) * period);
+    }
+    return out;
+}
+
 // Fills f's real array with the target ACF C(τ) sampled on the lattice and periodised with the
 // map's periods Lx = nx dx, Ly = ny dy: C_p(τ) = Σ_{m,n} C(τ + (m Lx, n Ly)), normalised to
 // C_p(0) = 1 (it exceeds 1 by the images' overlap, e.g. by 2e^{−L/T} for an exponential ACF).
@@ -115,34 +150,58 @@ void fill_periodised_acf(const GenerationOptions& o, fft::RealToComplex& f) {
     const double lx = static_cast<double>(o.nx) * o.dx_um;
     const double ly = static_cast<double>(o.ny) * o.dy_um;
     const bool profile = o.ny == 1;
-    const auto images_x = static_cast<long>(std::ceil(r_max / lx)) + 1;
-    const auto images_y = profile ? 0L : static_cast<long>(std::ceil(r_max / ly)) + 1;
-    const auto acf = [&](double r2) {
-        return gaussian ? std::exp(-r2 / (T * T)) : std::exp(-std::sqrt(r2) / T);
-    };
     // C_p depends on |x| and |y| only: compute the quadrant jx ≤ nx/2, jy ≤ ny/2 and mirror it.
     const std::size_t hx = o.nx / 2;
     const std::size_t hy = o.ny / 2;
-    for (std::size_t jy = 0; jy <= hy; ++jy) {
-        const double y = static_cast<double>(jy) * o.dy_um;
-        double* row = f.real_row(jy);
-        for (std::size_t jx = 0; jx <= hx; ++jx) {
-            const double x = static_cast<double>(jx) * o.dx_um;
+    std::vector<std::vector<double>> x_images(hx + 1);
+    for (std::size_t jx = 0; jx <= hx; ++jx) {
+        x_images[jx] = images_within(static_cast<double>(jx) * o.dx_um, lx, r_max, true);
+    }
+    if (gaussian) {
+        // exp(−(x² + y²)/T²) = exp(−x²/T²) exp(−y²/T²): C_p is the product of the 1-D sums.
+        const auto periodised_1d = [&](const std::vector<double>& images) {
             double sum = 0;
-            for (long m = -images_x; m <= images_x; ++m) {
-                const double xm = x + static_cast<double>(m) * lx;
-                if (std::abs(xm) > r_max) {
-                    continue;
-                }
-                for (long n = -images_y; n <= images_y; ++n) {
-                    const double yn = y + static_cast<double>(n) * ly;
-                    const double r2 = xm * xm + yn * yn;
-                    if (r2 <= r_max * r_max) {
-                        sum += acf(r2);
+            for (const double u : images) {
+                sum += std::exp(-u * u / (T * T));
+            }
+            return sum;
+        };
+        std::vector<double> gx(hx + 1);
+        for (std::size_t jx = 0; jx <= hx; ++jx) {
+            gx[jx] = periodised_1d(x_images[jx]);
+        }
+        for (std::size_t jy = 0; jy <= hy; ++jy) {
+            const double gy = periodised_1d(
+                images_within(static_cast<double>(jy) * o.dy_um, ly, r_max, !profile));
+            double* row = f.real_row(jy);
+            for (std::size_t jx = 0; jx <= hx; ++jx) {
+                row[jx] = gx[jx] * gy;
+            }
+        }
+    } else {
+        for (std::size_t jy = 0; jy <= hy; ++jy) {
+            const std::vector<double> y_images =
+                images_within(static_cast<double>(jy) * o.dy_um, ly, r_max, !profile);
+            double* row = f.real_row(jy);
+            for (std::size_t jx = 0; jx <= hx; ++jx) {
+                double sum = 0;
+                for (const double xm : x_images[jx]) {
+                    for (const double yn : y_images) {
+                        const double r2 = xm * xm + yn * yn;
+                        if (r2 <= r_max * r_max) {
+                            sum += std::exp(-std::sqrt(r2) / T);
+                        }
                     }
                 }
+                row[jx] = sum;
             }
-            row[jx] = sum;
+        }
+    }
+    const double c0 = f.real_row(0)[0];
+    for (std::size_t jy = 0; jy <= hy; ++jy) {
+        double* row = f.real_row(jy);
+        for (std::size_t jx = 0; jx <= hx; ++jx) {
+            row[jx] /= c0;
         }
         for (std::size_t jx = hx + 1; jx < o.nx; ++jx) {
             row[jx] = row[o.nx - jx];
@@ -150,13 +209,6 @@ void fill_periodised_acf(const GenerationOptions& o, fft::RealToComplex& f) {
     }
     for (std::size_t jy = hy + 1; jy < o.ny; ++jy) {
         std::copy_n(f.real_row(o.ny - jy), o.nx, f.real_row(jy));
-    }
-    const double c0 = f.real_row(0)[0];
-    for (std::size_t jy = 0; jy < o.ny; ++jy) {
-        double* row = f.real_row(jy);
-        for (std::size_t jx = 0; jx < o.nx; ++jx) {
-            row[jx] /= c0;
-        }
     }
 }
 
@@ -167,10 +219,7 @@ HeightMap filter_noise(const GenerationOptions& o, const std::vector<double>& ga
                        fft::RealToComplex& f) {
     NormalStream normal(o.seed);
     for (std::size_t iy = 0; iy < o.ny; ++iy) {
-        double* row = f.real_row(iy);
-        for (std::size_t ix = 0; ix < o.nx; ++ix) {
-            row[ix] = normal.next();
-        }
+        normal.fill(f.real_row(iy), o.nx);
     }
     f.forward();
     const std::size_t cols = f.spectrum_cols();
