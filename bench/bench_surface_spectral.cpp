@@ -141,7 +141,7 @@ void acf(benchmark::State& state) {
     double total = 0;
     for (auto _ : state) {
         const double start = cpu_seconds();
-        benchmark::DoNotOptimize(acf_2d(map, AcfEstimator::unbiased));
+        benchmark::DoNotOptimize(acf_2d(map, AcfEstimator::Unbiased));
         const double t = cpu_seconds() - start;
         state.SetIterationTime(t);
         total += t;

@@ -27,7 +27,7 @@ double acf_value(const std::vector<double>& sums, const std::vector<double>& pai
                  AcfEstimator estimator) {
     if (pairs[j] <= 0 || pairs[0] <= 0 || sums[0] <= 0)
         return std::numeric_limits<double>::quiet_NaN();
-    if (estimator == AcfEstimator::biased) return sums[j] / sums[0];
+    if (estimator == AcfEstimator::Biased) return sums[j] / sums[0];
     return (sums[j] / pairs[j]) / (sums[0] / pairs[0]);
 }
 
@@ -44,7 +44,7 @@ std::optional<double> crossing_1e_samples(const double* sums, const double* pair
         const double count = pair_count(j);
         if (count <= 0) continue;
         const double c =
-            estimator == AcfEstimator::biased ? sums[j] / sums[0] : sums[j] / count / mean_square;
+            estimator == AcfEstimator::Biased ? sums[j] / sums[0] : sums[j] / count / mean_square;
         const auto lag = static_cast<double>(j);
         if (c <= kInvE) return prev_lag + (prev_c - kInvE) / (prev_c - c) * (lag - prev_lag);
         prev_lag = lag;

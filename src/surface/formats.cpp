@@ -20,15 +20,15 @@ namespace roughscope::surface {
 namespace {
 
 constexpr std::array<NameEntry<HeightFormat>, 9> kFormatNames{{
-    {"csv_matrix", HeightFormat::csv_matrix},
-    {"xyz", HeightFormat::xyz},
-    {"sdf", HeightFormat::sdf},
-    {"x3p", HeightFormat::x3p},
-    {"gwy", HeightFormat::gwy},
-    {"gsf", HeightFormat::gsf},
-    {"png", HeightFormat::png},
-    {"tiff", HeightFormat::tiff},
-    {"raw", HeightFormat::raw},
+    {"csv_matrix", HeightFormat::CsvMatrix},
+    {"xyz", HeightFormat::Xyz},
+    {"sdf", HeightFormat::Sdf},
+    {"x3p", HeightFormat::X3p},
+    {"gwy", HeightFormat::Gwy},
+    {"gsf", HeightFormat::Gsf},
+    {"png", HeightFormat::Png},
+    {"tiff", HeightFormat::Tiff},
+    {"raw", HeightFormat::Raw},
 }};
 
 struct ExtensionEntry {
@@ -37,22 +37,22 @@ struct ExtensionEntry {
 };
 
 constexpr std::array<ExtensionEntry, 16> kExtensions{{
-    {".csv", HeightFormat::csv_matrix},
-    {".txt", HeightFormat::csv_matrix},
-    {".asc", HeightFormat::csv_matrix},
-    {".xyz", HeightFormat::xyz},
-    {".sdf", HeightFormat::sdf},
-    {".x3p", HeightFormat::x3p},
-    {".gwy", HeightFormat::gwy},
-    {".gsf", HeightFormat::gsf},
-    {".png", HeightFormat::png},
-    {".tif", HeightFormat::tiff},
-    {".tiff", HeightFormat::tiff},
-    {".raw", HeightFormat::raw},
-    {".bin", HeightFormat::raw},
-    {".f32", HeightFormat::raw},
-    {".f64", HeightFormat::raw},
-    {".dat", HeightFormat::raw},
+    {".csv", HeightFormat::CsvMatrix},
+    {".txt", HeightFormat::CsvMatrix},
+    {".asc", HeightFormat::CsvMatrix},
+    {".xyz", HeightFormat::Xyz},
+    {".sdf", HeightFormat::Sdf},
+    {".x3p", HeightFormat::X3p},
+    {".gwy", HeightFormat::Gwy},
+    {".gsf", HeightFormat::Gsf},
+    {".png", HeightFormat::Png},
+    {".tif", HeightFormat::Tiff},
+    {".tiff", HeightFormat::Tiff},
+    {".raw", HeightFormat::Raw},
+    {".bin", HeightFormat::Raw},
+    {".f32", HeightFormat::Raw},
+    {".f64", HeightFormat::Raw},
+    {".dat", HeightFormat::Raw},
 }};
 
 std::string extension_list() {
@@ -115,23 +115,23 @@ std::optional<HeightFormat> height_format_from_extension(const std::filesystem::
 HeightMap decode_height_map(std::string_view bytes, const std::string& name, HeightFormat format,
                             const HeightReadOptions& options) {
     switch (format) {
-        case HeightFormat::csv_matrix:
+        case HeightFormat::CsvMatrix:
             return formats::decode_csv_matrix(bytes, name, options);
-        case HeightFormat::xyz:
+        case HeightFormat::Xyz:
             return formats::decode_xyz(bytes, name, options);
-        case HeightFormat::sdf:
+        case HeightFormat::Sdf:
             return formats::decode_sdf(bytes, name, options);
-        case HeightFormat::x3p:
+        case HeightFormat::X3p:
             return formats::decode_x3p(bytes, name, options);
-        case HeightFormat::gwy:
+        case HeightFormat::Gwy:
             return formats::decode_gwy(bytes, name, options);
-        case HeightFormat::gsf:
+        case HeightFormat::Gsf:
             return formats::decode_gsf(bytes, name, options);
-        case HeightFormat::png:
+        case HeightFormat::Png:
             return formats::decode_png(bytes, name, options);
-        case HeightFormat::tiff:
+        case HeightFormat::Tiff:
             return formats::decode_tiff(bytes, name, options);
-        case HeightFormat::raw:
+        case HeightFormat::Raw:
             return formats::decode_raw(bytes, name, options);
     }
     throw InvalidArgument("unknown height-map format");
@@ -141,25 +141,25 @@ std::string encode_height_map(const HeightMap& map, HeightFormat format,
                               const HeightWriteOptions& options) {
     validate(map, "height map");
     switch (format) {
-        case HeightFormat::csv_matrix:
+        case HeightFormat::CsvMatrix:
             return formats::encode_csv_matrix(map, options);
-        case HeightFormat::xyz:
+        case HeightFormat::Xyz:
             return formats::encode_xyz(map, options);
-        case HeightFormat::sdf:
+        case HeightFormat::Sdf:
             return formats::encode_sdf(map, options);
-        case HeightFormat::x3p:
+        case HeightFormat::X3p:
             return formats::encode_x3p(map, options);
-        case HeightFormat::gwy:
+        case HeightFormat::Gwy:
             throw InvalidArgument(
                 "height-map format 'gwy' can be read but not written; "
                 "write .gsf or .x3p for Gwyddion");
-        case HeightFormat::gsf:
+        case HeightFormat::Gsf:
             return formats::encode_gsf(map, options);
-        case HeightFormat::png:
+        case HeightFormat::Png:
             return formats::encode_png(map, options);
-        case HeightFormat::tiff:
+        case HeightFormat::Tiff:
             return formats::encode_tiff(map, options);
-        case HeightFormat::raw:
+        case HeightFormat::Raw:
             return formats::encode_raw(map, options);
     }
     throw InvalidArgument("unknown height-map format");

@@ -154,23 +154,23 @@ void subtract_polynomial(HeightMap& map, int order) {
 
 HeightMap level(const HeightMap& map, Leveling leveling, int polynomial_order) {
     validate(map, "heights");
-    if (leveling == Leveling::polynomial && (polynomial_order < 1 || polynomial_order > 3))
+    if (leveling == Leveling::Polynomial && (polynomial_order < 1 || polynomial_order > 3))
         throw InvalidArgument("level: polynomial_order = " + std::to_string(polynomial_order) +
                               " is out of range; valid values: 1, 2, 3");
     HeightMap out = map;
     switch (leveling) {
-        case Leveling::none:
+        case Leveling::None:
             break;
-        case Leveling::mean:
+        case Leveling::Mean:
             subtract_mean(out);
             break;
-        case Leveling::line:
+        case Leveling::Line:
             subtract_row_lines(out);
             break;
-        case Leveling::plane:
+        case Leveling::Plane:
             subtract_polynomial(out, 1);
             break;
-        case Leveling::polynomial:
+        case Leveling::Polynomial:
             subtract_polynomial(out, polynomial_order);
             break;
     }

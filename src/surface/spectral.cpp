@@ -177,7 +177,7 @@ Acf2d acf_2d(const HeightMap& levelled, AcfEstimator estimator) {
             double& c = row[jx + jx_max];
             if (pairs < 0.5) {
                 c = kNaN;  // no pair of valid points at this lag
-            } else if (estimator == AcfEstimator::unbiased) {
+            } else if (estimator == AcfEstimator::Unbiased) {
                 c = c / pairs / mean_square;  // (1/N(τ)) Σ z z' / σ²
             } else {
                 c = c / r0;  // (1/N) Σ z z' / σ²

@@ -26,18 +26,18 @@ namespace {
 using detail::cat;
 
 constexpr std::array<NameEntry<Leveling>, 7> kLevelingNames{{
-    {"none", Leveling::none},
-    {"mean", Leveling::mean},
-    {"line", Leveling::line},
-    {"plane", Leveling::plane},
-    {"polynomial", Leveling::polynomial},
-    {"row", Leveling::line},
-    {"poly", Leveling::polynomial},
+    {"none", Leveling::None},
+    {"mean", Leveling::Mean},
+    {"line", Leveling::Line},
+    {"plane", Leveling::Plane},
+    {"polynomial", Leveling::Polynomial},
+    {"row", Leveling::Line},
+    {"poly", Leveling::Polynomial},
 }};
 
 constexpr std::array<NameEntry<AcfEstimator>, 2> kEstimatorNames{{
-    {"unbiased", AcfEstimator::unbiased},
-    {"biased", AcfEstimator::biased},
+    {"unbiased", AcfEstimator::Unbiased},
+    {"biased", AcfEstimator::Biased},
 }};
 
 // Lines shorter than this many correlation lengths are not used for sub-profile T or blocks.

@@ -18,15 +18,15 @@
 namespace roughscope::surface {
 
 enum class HeightFormat {
-    csv_matrix,  // CSV/ASCII matrix: one row of heights per line (.csv, .txt, .asc)
-    xyz,         // x y z triples on a regular grid (.xyz)
-    sdf,         // ISO 25178-71 SDF, ASCII (aISO-1.0) or binary (bISO-1.0) (.sdf)
-    x3p,         // ISO 25178-72 / ISO 5436-2 XML in a zip (.x3p)
-    gwy,         // Gwyddion native GWYP (.gwy), read only
-    gsf,         // Gwyddion simple field (.gsf)
-    png,         // 16-bit (or 8-bit) grey PNG, heights = z_scale_um × count (.png)
-    tiff,        // 16-bit integer or 32/64-bit float grey TIFF (.tif, .tiff)
-    raw,         // headerless float32/float64, dimensions given (.raw, .bin, .f32, .f64)
+    CsvMatrix,   // CSV/ASCII matrix: one row of heights per line (.csv, .txt, .asc)
+    Xyz,         // x y z triples on a regular grid (.xyz)
+    Sdf,         // ISO 25178-71 SDF, ASCII (aISO-1.0) or binary (bISO-1.0) (.sdf)
+    X3p,         // ISO 25178-72 / ISO 5436-2 XML in a zip (.x3p)
+    Gwy,         // Gwyddion native GWYP (.gwy), read only
+    Gsf,         // Gwyddion simple field (.gsf)
+    Png,         // 16-bit (or 8-bit) grey PNG, heights = z_scale_um × count (.png)
+    Tiff,        // 16-bit integer or 32/64-bit float grey TIFF (.tif, .tiff)
+    Raw,         // headerless float32/float64, dimensions given (.raw, .bin, .f32, .f64)
 };
 
 // "x3p", "gsf", ... (core/names.hpp table; any case).
@@ -35,7 +35,7 @@ HeightFormat parse_height_format(std::string_view name);
 // The format a path's extension names; nullopt when the extension is not one of the above.
 std::optional<HeightFormat> height_format_from_extension(const std::filesystem::path& path);
 
-enum class RawSampleType { float32, float64 };
+enum class RawSampleType { Float32, Float64 };
 
 // What a file does not say itself. A value a format does carry (x3p spacings, SDF scales) wins
 // over these unless the option says otherwise in its comment.
@@ -53,7 +53,7 @@ struct HeightReadOptions {
     // raw: grid size, sample type, byte order.
     std::optional<std::size_t> nx;
     std::optional<std::size_t> ny;
-    RawSampleType raw_type = RawSampleType::float64;
+    RawSampleType raw_type = RawSampleType::Float64;
     bool raw_big_endian = false;
     // x3p: verify the MD5 checksums a file states (point data, validity bitmap, main.xml); false
     // reads a file whose checksums are stale. An absent checksum is never an error.
@@ -66,7 +66,7 @@ struct HeightWriteOptions {
     // png/tiff integer output: µm per count (required); tiff_float writes 32-bit float samples.
     std::optional<double> z_scale_um;
     bool tiff_float = true;
-    RawSampleType raw_type = RawSampleType::float64;
+    RawSampleType raw_type = RawSampleType::Float64;
 };
 
 // Reads `path` (format from options or extension). DataError for unreadable/malformed files,

@@ -16,17 +16,17 @@ namespace roughscope::surface {
 
 // ---- Levelling (least squares over the valid points) ---------------------------------------
 enum class Leveling {
-    none,        // heights as read
-    mean,        // subtract the mean height
-    line,        // subtract each row's least-squares mean line (profile practice, Gwyddion's
+    None,        // heights as read
+    Mean,        // subtract the mean height
+    Line,        // subtract each row's least-squares mean line (profile practice, Gwyddion's
                  // "row levelling"); for a profile this is the paper's mean line (§3.1)
-    plane,       // subtract the least-squares plane (areal default)
-    polynomial,  // subtract a least-squares polynomial surface in x, y of total order 1..3
+    Plane,       // subtract the least-squares plane (areal default)
+    Polynomial,  // subtract a least-squares polynomial surface in x, y of total order 1..3
 };
 std::string to_string(Leveling leveling);
 Leveling parse_leveling(std::string_view name);
 
-// `map` minus its background. polynomial_order: 1..3, used by Leveling::polynomial only.
+// `map` minus its background. polynomial_order: 1..3, used by Leveling::Polynomial only.
 // InvalidArgument when too few valid points determine the background.
 HeightMap level(const HeightMap& map, Leveling leveling, int polynomial_order = 1);
 
@@ -41,8 +41,8 @@ FilteredHeights gaussian_filter(const HeightMap& map, double cutoff_um);
 
 // ---- Statistics -----------------------------------------------------------------------------
 enum class AcfEstimator {
-    unbiased,  // C_j = (1/(N−j)) Σ z_k z_{k+j} / σ²   (paper §3.1, "unbiased")
-    biased,    // C_j = (1/N) Σ z_k z_{k+j} / σ²       (paper §3.1, "biased"; Gwyddion's)
+    Unbiased,  // C_j = (1/(N−j)) Σ z_k z_{k+j} / σ²   (paper §3.1, "unbiased")
+    Biased,    // C_j = (1/N) Σ z_k z_{k+j} / σ²       (paper §3.1, "biased"; Gwyddion's)
 };
 std::string to_string(AcfEstimator estimator);
 AcfEstimator parse_acf_estimator(std::string_view name);
@@ -53,10 +53,10 @@ struct Curve {
 };
 
 struct StatisticsOptions {
-    Leveling leveling = Leveling::plane;
+    Leveling leveling = Leveling::Plane;
     int polynomial_order = 1;
     std::optional<double> cutoff_um;  // λc of the Gaussian roughness filter; none = no filter
-    AcfEstimator acf_estimator = AcfEstimator::unbiased;
+    AcfEstimator acf_estimator = AcfEstimator::Unbiased;
     bool keep_curves = true;  // fill acf_x, acf_y, acf_radial, psd_x, psd_radial
 };
 

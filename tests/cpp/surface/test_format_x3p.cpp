@@ -427,9 +427,9 @@ TEST(HeightSeedFiles, EverySeedReads) {
     const std::filesystem::path corpus =
         std::filesystem::path(ROUGHSCOPE_SOURCE_DIR) / "fuzz" / "corpus";
     std::size_t files = 0;
-    for (const auto& [target, format] : {std::pair{"height_x3p", HeightFormat::x3p},
-                                         {"height_gwy", HeightFormat::gwy},
-                                         {"height_gsf", HeightFormat::gsf}}) {
+    for (const auto& [target, format] : {std::pair{"height_x3p", HeightFormat::X3p},
+                                         {"height_gwy", HeightFormat::Gwy},
+                                         {"height_gsf", HeightFormat::Gsf}}) {
         for (const auto& entry : std::filesystem::directory_iterator(corpus / target)) {
             const std::string bytes = testing::slurp(entry.path());
             const HeightMap map =

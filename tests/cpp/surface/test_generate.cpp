@@ -57,7 +57,7 @@ double rms(const HeightMap& m) {
 // T along x: the first lag where the unbiased ACF (of the map as generated, mean not removed)
 // falls to 1/e, interpolated linearly in ln C between lags (exact for exp(−τ/T)).
 double one_over_e_length(const HeightMap& m) {
-    const Acf2d acf = acf_2d(m, AcfEstimator::unbiased);
+    const Acf2d acf = acf_2d(m, AcfEstimator::Unbiased);
     double previous = 1.0;
     for (std::ptrdiff_t j = 1; j < static_cast<std::ptrdiff_t>(m.nx); ++j) {
         const double c = acf.at_lag(j, 0);

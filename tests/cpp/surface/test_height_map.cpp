@@ -53,18 +53,18 @@ TEST(HeightMap, BitwiseEqualTreatsNaNAlikeAndSignedZerosApart) {
 }
 
 TEST(HeightFormats, ExtensionsAndNames) {
-    EXPECT_EQ(height_format_from_extension("a/b.X3P"), HeightFormat::x3p);
-    EXPECT_EQ(height_format_from_extension("b.tif"), HeightFormat::tiff);
+    EXPECT_EQ(height_format_from_extension("a/b.X3P"), HeightFormat::X3p);
+    EXPECT_EQ(height_format_from_extension("b.tif"), HeightFormat::Tiff);
     EXPECT_EQ(height_format_from_extension("b.unknown"), std::nullopt);
-    EXPECT_EQ(parse_height_format("CSV-matrix"), HeightFormat::csv_matrix);
-    EXPECT_EQ(to_string(HeightFormat::gsf), "gsf");
+    EXPECT_EQ(parse_height_format("CSV-matrix"), HeightFormat::CsvMatrix);
+    EXPECT_EQ(to_string(HeightFormat::Gsf), "gsf");
     EXPECT_THROW(parse_height_format("jpeg"), InvalidArgument);
 }
 
 TEST(HeightFormats, ReadNamesTheProblem) {
     EXPECT_THROW(read_height_map("no/such/file.x3p"), DataError);
     EXPECT_THROW(read_height_map("file.unknown"), InvalidArgument);
-    EXPECT_THROW(encode_height_map(make_height_map(2, 2, 1, 1), HeightFormat::gwy),
+    EXPECT_THROW(encode_height_map(make_height_map(2, 2, 1, 1), HeightFormat::Gwy),
                  InvalidArgument);
 }
 

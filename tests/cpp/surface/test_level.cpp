@@ -40,19 +40,19 @@ double row_lines(double x, double y) { return 2.0 * y + (0.1 + 0.01 * y) * x; }
 TEST(SurfaceLevel, RemovesExactBackgrounds) {
     HeightMap zero = make_height_map(20, 15, 0.5, 0.75);
     zero.at(3, 4) = kNaN;
-    EXPECT_LT(max_abs(level(plus(zero, tilt), Leveling::plane)), 1e-12);
-    EXPECT_LT(max_abs(level(plus(zero, cubic), Leveling::polynomial, 3)), 1e-12);
-    EXPECT_GT(max_abs(level(plus(zero, cubic), Leveling::polynomial, 2)), 1e-4);
-    EXPECT_LT(max_abs(level(plus(zero, row_lines), Leveling::line)), 1e-12);
-    EXPECT_GT(max_abs(level(plus(zero, row_lines), Leveling::plane)), 1e-2);
-    const HeightMap shifted = level(plus(zero, tilt), Leveling::mean);
+    EXPECT_LT(max_abs(level(plus(zero, tilt), Leveling::Plane)), 1e-12);
+    EXPECT_LT(max_abs(level(plus(zero, cubic), Leveling::Polynomial, 3)), 1e-12);
+    EXPECT_GT(max_abs(level(plus(zero, cubic), Leveling::Polynomial, 2)), 1e-4);
+    EXPECT_LT(max_abs(level(plus(zero, row_lines), Leveling::Line)), 1e-12);
+    EXPECT_GT(max_abs(level(plus(zero, row_lines), Leveling::Plane)), 1e-2);
+    const HeightMap shifted = level(plus(zero, tilt), Leveling::Mean);
     EXPECT_GT(max_abs(shifted), 1.0);  // the tilt stays
     double sum = 0;
     for (double z : shifted.heights_um)
         if (!std::isnan(z)) sum += z;
     EXPECT_NEAR(sum, 0.0, 1e-9);
-    EXPECT_TRUE(std::isnan(level(zero, Leveling::plane).at(3, 4)));
-    EXPECT_TRUE(bitwise_equal(level(plus(zero, tilt), Leveling::none), plus(zero, tilt)));
+    EXPECT_TRUE(std::isnan(level(zero, Leveling::Plane).at(3, 4)));
+    EXPECT_TRUE(bitwise_equal(level(plus(zero, tilt), Leveling::None), plus(zero, tilt)));
 }
 
 TEST(SurfaceLevel, ProfilePolynomialIgnoresY) {
@@ -61,8 +61,8 @@ TEST(SurfaceLevel, ProfilePolynomialIgnoresY) {
         const double x = 0.2 * static_cast<double>(k);
         p.heights_um[k] = 1 + x - 0.3 * x * x + 0.02 * x * x * x;
     }
-    EXPECT_LT(max_abs(level(p, Leveling::polynomial, 3)), 1e-11);
-    EXPECT_GT(max_abs(level(p, Leveling::plane)), 1e-2);
+    EXPECT_LT(max_abs(level(p, Leveling::Polynomial, 3)), 1e-11);
+    EXPECT_GT(max_abs(level(p, Leveling::Plane)), 1e-2);
 }
 
 void expect_same_statistics(const SurfaceStatistics& a, const SurfaceStatistics& b) {
@@ -91,7 +91,7 @@ TEST(SurfaceLevel, SigmaAndAcfInvariantUnderTiltAfterPlaneLevelling) {
         expect_same_statistics(a, b);
         // The check can fail: without levelling the tilt changes σ.
         StatisticsOptions mean;
-        mean.leveling = Leveling::mean;
+        mean.leveling = Leveling::Mean;
         EXPECT_GT(surface_statistics(plus(base, tilt), mean).sigma_um, 2 * a.sigma_um);
     }
 }
@@ -99,7 +99,7 @@ TEST(SurfaceLevel, SigmaAndAcfInvariantUnderTiltAfterPlaneLevelling) {
 TEST(SurfaceLevel, SigmaAndAcfInvariantUnderCubicAfterOrderThreeLevelling) {
     const HeightMap m = testdata::ar1_map(80, 60, 3.0, 72);
     StatisticsOptions o;
-    o.leveling = Leveling::polynomial;
+    o.leveling = Leveling::Polynomial;
     o.polynomial_order = 3;
     expect_same_statistics(surface_statistics(m, o), surface_statistics(plus(m, cubic), o));
     StatisticsOptions plane;
@@ -110,35 +110,35 @@ TEST(SurfaceLevel, SigmaAndAcfInvariantUnderCubicAfterOrderThreeLevelling) {
 
 TEST(SurfaceLevel, RejectsBadOrderAndTooFewPoints) {
     const HeightMap m = testdata::noise_map(10, 10, 73);
-    EXPECT_NO_THROW(level(m, Leveling::polynomial, 1));
-    EXPECT_THROW(level(m, Leveling::polynomial, 0), InvalidArgument);
-    EXPECT_THROW(level(m, Leveling::polynomial, 4), InvalidArgument);
-    EXPECT_NO_THROW(level(m, Leveling::plane, 99));  // the order is used by polynomial only
+    EXPECT_NO_THROW(level(m, Leveling::Polynomial, 1));
+    EXPECT_THROW(level(m, Leveling::Polynomial, 0), InvalidArgument);
+    EXPECT_THROW(level(m, Leveling::Polynomial, 4), InvalidArgument);
+    EXPECT_NO_THROW(level(m, Leveling::Plane, 99));  // the order is used by polynomial only
 
     HeightMap two = make_height_map(10, 10, 1, 1);
     two.heights_um.assign(100, kNaN);
     two.at(1, 1) = 1;
     two.at(5, 7) = 2;
-    EXPECT_NO_THROW(level(two, Leveling::mean));
-    EXPECT_THROW(level(two, Leveling::plane), InvalidArgument);  // 3 points needed
+    EXPECT_NO_THROW(level(two, Leveling::Mean));
+    EXPECT_THROW(level(two, Leveling::Plane), InvalidArgument);  // 3 points needed
 
     HeightMap one_row = make_height_map(10, 10, 1, 1);
     one_row.heights_um.assign(100, kNaN);
     for (std::size_t ix = 0; ix < 10; ++ix) one_row.at(ix, 4) = static_cast<double>(ix);
-    EXPECT_NO_THROW(level(one_row, Leveling::line));
-    EXPECT_THROW(level(one_row, Leveling::plane), InvalidArgument);  // collinear points
+    EXPECT_NO_THROW(level(one_row, Leveling::Line));
+    EXPECT_THROW(level(one_row, Leveling::Plane), InvalidArgument);  // collinear points
 
     HeightMap nine = testdata::noise_map(3, 3, 74);  // 9 points < 10 terms of a cubic
-    EXPECT_NO_THROW(level(nine, Leveling::polynomial, 2));
-    EXPECT_THROW(level(nine, Leveling::polynomial, 3), InvalidArgument);
+    EXPECT_NO_THROW(level(nine, Leveling::Polynomial, 2));
+    EXPECT_THROW(level(nine, Leveling::Polynomial, 3), InvalidArgument);
 
     HeightMap column = testdata::noise_map(1, 8, 75);  // every row has one point
-    EXPECT_NO_THROW(level(column, Leveling::mean));
-    EXPECT_THROW(level(column, Leveling::line), InvalidArgument);
+    EXPECT_NO_THROW(level(column, Leveling::Mean));
+    EXPECT_THROW(level(column, Leveling::Line), InvalidArgument);
 
     HeightMap bad = m;
     bad.dx_um = 0;
-    EXPECT_THROW(level(bad, Leveling::none), InvalidArgument);
+    EXPECT_THROW(level(bad, Leveling::None), InvalidArgument);
 }
 
 }  // namespace

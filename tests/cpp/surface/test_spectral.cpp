@@ -73,7 +73,7 @@ double brute_force_acf(const HeightMap& m, std::ptrdiff_t jx, std::ptrdiff_t jy,
         return kNaN;
     }
     const double sigma2 = square / static_cast<double>(valid);
-    return estimator == AcfEstimator::unbiased ? sum / static_cast<double>(pairs) / sigma2
+    return estimator == AcfEstimator::Unbiased ? sum / static_cast<double>(pairs) / sigma2
                                                : sum / static_cast<double>(valid) / sigma2;
 }
 
@@ -100,7 +100,7 @@ void expect_acf_matches_brute_force(const HeightMap& map, AcfEstimator estimator
 }
 
 TEST(Acf2d, MatchesBruteForceSumsOnCompleteMapsBothEstimators) {
-    for (const AcfEstimator e : {AcfEstimator::unbiased, AcfEstimator::biased}) {
+    for (const AcfEstimator e : {AcfEstimator::Unbiased, AcfEstimator::Biased}) {
         expect_acf_matches_brute_force(random_map(7, 5, 0.5, 2.0, 1), e);
         expect_acf_matches_brute_force(random_map(8, 6, 1.0, 1.0, 2), e);
         expect_acf_matches_brute_force(random_map(9, 1, 0.25, 1.0, 3), e);  // a profile
@@ -116,26 +116,26 @@ TEST(Acf2d, MatchesBruteForceSumsWithMissingPointsBothEstimators) {
     HeightMap profile = random_map(10, 1, 1.0, 1.0, 5);
     profile.at(9, 0) = kNaN;
     profile.at(2, 0) = kNaN;
-    for (const AcfEstimator e : {AcfEstimator::unbiased, AcfEstimator::biased}) {
+    for (const AcfEstimator e : {AcfEstimator::Unbiased, AcfEstimator::Biased}) {
         expect_acf_matches_brute_force(map, e);
         expect_acf_matches_brute_force(profile, e);
     }
-    EXPECT_TRUE(std::isnan(acf_2d(map, AcfEstimator::unbiased).at_lag(6, 4)));
+    EXPECT_TRUE(std::isnan(acf_2d(map, AcfEstimator::Unbiased).at_lag(6, 4)));
 }
 
 TEST(Acf2d, RejectsAFlatMapAndAMalformedOne) {
     HeightMap flat = make_height_map(4, 3, 1, 1);
-    expect_invalid([&] { (void)acf_2d(flat, AcfEstimator::unbiased); }, "σ = 0");
+    expect_invalid([&] { (void)acf_2d(flat, AcfEstimator::Unbiased); }, "σ = 0");
     flat.heights_um[1] = std::numeric_limits<double>::infinity();
-    EXPECT_THROW((void)acf_2d(flat, AcfEstimator::biased), InvalidArgument);
+    EXPECT_THROW((void)acf_2d(flat, AcfEstimator::Biased), InvalidArgument);
     flat.heights_um.pop_back();
-    EXPECT_THROW((void)acf_2d(flat, AcfEstimator::biased), InvalidArgument);
+    EXPECT_THROW((void)acf_2d(flat, AcfEstimator::Biased), InvalidArgument);
 }
 
 TEST(RadialAcf, IsTheRingAverageOfTheTwoDimensionalAcf) {
     HeightMap map = random_map(9, 7, 1.0, 1.5, 6);
     map.at(2, 3) = kNaN;
-    const Acf2d acf = acf_2d(map, AcfEstimator::unbiased);
+    const Acf2d acf = acf_2d(map, AcfEstimator::Unbiased);
     const Curve radial = radial_acf(acf);
     // Rings of width min(dx, dy) = 1 up to the shorter side of the lag grid, min(8, 6 × 1.5) = 8.
     ASSERT_EQ(radial.x.size(), 9U);
@@ -217,9 +217,9 @@ TEST(TextureParameters, GeneratedSurfaceRelabelledToTwiceTheYSpacingHasStrOneHal
     o.ny = 384;
     o.seed = 11;
     HeightMap map = generate_surface(o);
-    const TextureParameters iso = texture_parameters(acf_2d(map, AcfEstimator::unbiased));
+    const TextureParameters iso = texture_parameters(acf_2d(map, AcfEstimator::Unbiased));
     map.dy_um = 2 * map.dx_um;  // the same heights, stretched along y
-    const TextureParameters aniso = texture_parameters(acf_2d(map, AcfEstimator::unbiased));
+    const TextureParameters aniso = texture_parameters(acf_2d(map, AcfEstimator::Unbiased));
     ASSERT_TRUE(iso.Str && aniso.Str && iso.Sal_um && aniso.Sal_um);
     EXPECT_GT(*iso.Str, 0.85);
     EXPECT_NEAR(*aniso.Str, 0.5, 0.08);

@@ -38,7 +38,7 @@ std::vector<double> brute_acf(const HeightMap& m, bool along_y, AcfEstimator est
     for (std::size_t j = 0; j < n; ++j) {
         if (P[j] == 0) continue;
         lags_with_pairs->push_back(static_cast<double>(j) * (along_y ? m.dy_um : m.dx_um));
-        c.push_back(est == AcfEstimator::biased ? S[j] / S[0] : (S[j] / P[j]) / (S[0] / P[0]));
+        c.push_back(est == AcfEstimator::Biased ? S[j] / S[0] : (S[j] / P[j]) / (S[0] / P[0]));
     }
     return c;
 }
@@ -57,7 +57,7 @@ TEST(SurfaceAcf, RowsAndColumnsMatchBruteForceSumsWithMissingPoints) {
     HeightMap m = testdata::noise_map(37, 23, 11, 0.15);
     m.at(0, 3) = kNaN;  // a row with a missing first point
     for (std::size_t ix = 0; ix < m.nx; ++ix) m.at(ix, 5) = kNaN;  // a fully missing row
-    for (AcfEstimator est : {AcfEstimator::unbiased, AcfEstimator::biased}) {
+    for (AcfEstimator est : {AcfEstimator::Unbiased, AcfEstimator::Biased}) {
         for (bool along_y : {false, true}) {
             Curve expected;
             expected.y = brute_acf(m, along_y, est, &expected.x);
@@ -72,21 +72,21 @@ TEST(SurfaceAcf, RowsAndColumnsMatchBruteForceSumsWithMissingPoints) {
 TEST(SurfaceAcf, FullRowsAndAProfileMatchBruteForce) {
     const HeightMap map = testdata::noise_map(64, 9, 5);
     const HeightMap profile = testdata::noise_map(101, 1, 6, 0.1);
-    for (AcfEstimator est : {AcfEstimator::unbiased, AcfEstimator::biased}) {
+    for (AcfEstimator est : {AcfEstimator::Unbiased, AcfEstimator::Biased}) {
         Curve e1, e2;
         e1.y = brute_acf(map, false, est, &e1.x);
         e2.y = brute_acf(profile, false, est, &e2.x);
         expect_curves_near(acf_along_x(map, est), e1, 1e-12);
         expect_curves_near(acf_along_x(profile, est), e2, 1e-12);
     }
-    EXPECT_TRUE(acf_along_y(profile, AcfEstimator::unbiased).x.empty());
+    EXPECT_TRUE(acf_along_y(profile, AcfEstimator::Unbiased).x.empty());
 }
 
 TEST(SurfaceAcf, EstimatorsDifferByTheirNormalisation) {
     // Biased C_j = unbiased C_j · (N − j)/N for a full profile: the two must not coincide.
     const HeightMap p = testdata::noise_map(50, 1, 9);
-    const Curve u = acf_along_x(p, AcfEstimator::unbiased);
-    const Curve b = acf_along_x(p, AcfEstimator::biased);
+    const Curve u = acf_along_x(p, AcfEstimator::Unbiased);
+    const Curve b = acf_along_x(p, AcfEstimator::Biased);
     for (std::size_t j = 1; j < 50; ++j)
         EXPECT_NEAR(b.y[j], u.y[j] * static_cast<double>(50 - j) / 50.0, 1e-12);
 }
@@ -94,11 +94,11 @@ TEST(SurfaceAcf, EstimatorsDifferByTheirNormalisation) {
 TEST(SurfaceAcf, RejectsMalformedMaps) {
     HeightMap m = testdata::noise_map(8, 4, 1);
     m.heights_um.pop_back();
-    EXPECT_THROW(acf_along_x(m, AcfEstimator::unbiased), InvalidArgument);
-    EXPECT_THROW(acf_along_y(m, AcfEstimator::biased), InvalidArgument);
+    EXPECT_THROW(acf_along_x(m, AcfEstimator::Unbiased), InvalidArgument);
+    EXPECT_THROW(acf_along_y(m, AcfEstimator::Biased), InvalidArgument);
     HeightMap all_missing = make_height_map(4, 4, 1, 1);
     all_missing.heights_um.assign(16, kNaN);
-    EXPECT_THROW(acf_along_x(all_missing, AcfEstimator::unbiased), InvalidArgument);
+    EXPECT_THROW(acf_along_x(all_missing, AcfEstimator::Unbiased), InvalidArgument);
 }
 
 // ---- T by the 1/e crossing
@@ -123,7 +123,7 @@ TEST(SurfaceCorrelationLength, SinusoidProfileCrossesWhereItsCosineAcfDoes) {
             std::sin(2.0 * std::numbers::pi * static_cast<double>(k) / period_samples);
     const double expected =
         period_samples * 0.5 * std::acos(std::exp(-1.0)) / (2 * std::numbers::pi);
-    const auto T = correlation_length_1e(acf_along_x(p, AcfEstimator::unbiased));
+    const auto T = correlation_length_1e(acf_along_x(p, AcfEstimator::Unbiased));
     ASSERT_TRUE(T.has_value());
     EXPECT_NEAR(*T / expected, 1.0, 2e-3);
 }
@@ -169,7 +169,7 @@ TEST(SurfaceStatistics, ExponentialProfileIsNamedExponentialWithItsT) {
     const double T = 10.0;  // samples, dx = 0.5 µm → 5 µm
     HeightMap p = testdata::ar1_map(1 << 18, 1, T, 21, 0.5);
     StatisticsOptions o;
-    o.leveling = Leveling::line;
+    o.leveling = Leveling::Line;
     const SurfaceStatistics s = surface_statistics(p, o);
     ASSERT_TRUE(s.T_um && s.T_fit_exponential_um && s.correlation);
     EXPECT_EQ(*s.correlation, Correlation::Exponential);
@@ -188,8 +188,8 @@ TEST(SurfaceStatistics, GaussianProfileIsNamedGaussianAndSlopesAgree) {
     const double T = 14.0;  // samples, dx = 1 µm
     HeightMap p = testdata::gaussian_profile(1 << 18, T, 22);
     StatisticsOptions o;
-    o.leveling = Leveling::line;
-    o.acf_estimator = AcfEstimator::biased;
+    o.leveling = Leveling::Line;
+    o.acf_estimator = AcfEstimator::Biased;
     const SurfaceStatistics s = surface_statistics(p, o);
     ASSERT_TRUE(s.T_um && s.T_fit_gaussian_um && s.correlation);
     EXPECT_EQ(*s.correlation, Correlation::Gaussian);
@@ -209,7 +209,7 @@ TEST(SurfaceStatistics, ShortRowsWarnAndExtrapolationRemovesMostOfTheLengthBias)
     const double T = 10.0;
     HeightMap m = testdata::ar1_map(400, 1024, T, 31);
     StatisticsOptions o;
-    o.leveling = Leveling::line;
+    o.leveling = Leveling::Line;
     const SurfaceStatistics s = surface_statistics(m, o);
     ASSERT_TRUE(s.T_um && s.T_extrapolated_um);
     EXPECT_LT(*s.T_um / T, 0.9);
@@ -228,7 +228,7 @@ TEST(SurfaceStatistics, ExtrapolatedTIsWithinThreePercentAtLOverT160) {
     const double T = 10.0;
     HeightMap m = testdata::ar1_map(1600, 256, T, 32);
     StatisticsOptions o;
-    o.leveling = Leveling::line;
+    o.leveling = Leveling::Line;
     const SurfaceStatistics s = surface_statistics(m, o);
     ASSERT_TRUE(s.T_um && s.T_extrapolated_um);
     EXPECT_LT(*s.T_um / T, 0.985);
@@ -286,7 +286,7 @@ TEST(SurfaceMoments, MatchTheirDefinitions) {
 
     // surface_statistics without levelling reports the same.
     StatisticsOptions o;
-    o.leveling = Leveling::none;
+    o.leveling = Leveling::None;
     const SurfaceStatistics s = surface_statistics(r, o);
     EXPECT_EQ(s.points, g.points);
     EXPECT_DOUBLE_EQ(s.sigma_um, g.sigma_um);
@@ -336,7 +336,7 @@ TEST(SurfaceStatistics, CurvesAreKeptOnRequestAndMapsGetBothDirections) {
 TEST(SurfaceStatistics, RejectsBadOptions) {
     const HeightMap m = testdata::noise_map(32, 8, 61);
     StatisticsOptions ok;
-    ok.leveling = Leveling::polynomial;
+    ok.leveling = Leveling::Polynomial;
     ok.polynomial_order = 3;
     ok.cutoff_um = 8.0;
     EXPECT_NO_THROW(surface_statistics(m, ok));
@@ -354,14 +354,14 @@ TEST(SurfaceStatistics, RejectsBadOptions) {
 // ----------------------------------------------------------------------------------------
 TEST(SurfaceNames, RoundTripAndAliases) {
     for (Leveling l :
-         {Leveling::none, Leveling::mean, Leveling::line, Leveling::plane, Leveling::polynomial})
+         {Leveling::None, Leveling::Mean, Leveling::Line, Leveling::Plane, Leveling::Polynomial})
         EXPECT_EQ(parse_leveling(to_string(l)), l);
-    EXPECT_EQ(to_string(Leveling::line), "line");
-    EXPECT_EQ(parse_leveling(" Row "), Leveling::line);
-    EXPECT_EQ(parse_leveling("POLY"), Leveling::polynomial);
-    for (AcfEstimator e : {AcfEstimator::unbiased, AcfEstimator::biased})
+    EXPECT_EQ(to_string(Leveling::Line), "line");
+    EXPECT_EQ(parse_leveling(" Row "), Leveling::Line);
+    EXPECT_EQ(parse_leveling("POLY"), Leveling::Polynomial);
+    for (AcfEstimator e : {AcfEstimator::Unbiased, AcfEstimator::Biased})
         EXPECT_EQ(parse_acf_estimator(to_string(e)), e);
-    EXPECT_EQ(to_string(AcfEstimator::biased), "biased");
+    EXPECT_EQ(to_string(AcfEstimator::Biased), "biased");
 }
 
 TEST(SurfaceNames, UnknownNamesAreRejected) {
