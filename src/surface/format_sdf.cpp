@@ -126,9 +126,10 @@ struct TextLine {
     std::size_t number;
 };
 
-// `Key = value` / `Key value`: the key (letters and digits) and the value (trimmed).
+// `Key = value` / `Key value`: the key (a letter, then letters, digits, '_') and the value.
 bool split_key_value(std::string_view line, std::string_view& key, std::string_view& value) {
     const std::string_view t = trim_space(line);
+    if (t.empty() || std::isalpha(static_cast<unsigned char>(t.front())) == 0) return false;
     std::size_t i = 0;
     while (i < t.size() && (std::isalnum(static_cast<unsigned char>(t[i])) != 0 || t[i] == '_')) {
         ++i;
