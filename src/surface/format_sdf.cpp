@@ -256,10 +256,8 @@ HeightMap decode_binary(std::string_view bytes, const std::string& name) {
             break;
         default:
             if (factor == 1.0 && std::endian::native == std::endian::little) {
+                // Bit for bit; tab::finish turns infinities into NaN.
                 std::memcpy(heights.data(), data, n * sizeof(double));
-                for (double& z : heights) {
-                    if (std::isinf(z)) z = kNaN;
-                }
             } else {
                 convert(double{});
             }
