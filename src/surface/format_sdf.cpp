@@ -102,10 +102,15 @@ void check_header(const std::string& name, const SdfHeader& h, std::string_view 
     tab::check_grid_size(name, h.nx, h.ny, where);
 }
 
-// The µm spacing a scale in metres means; the trailer's exact value when it agrees.
+double metres_for(double um);
+
+// The µm spacing a scale in metres means; the trailer's exact value when it agrees (to 1e-9, or
+// the scale is exactly what the writer stores for it: subnormal scales lose digits).
 double spacing_um(double scale_m, const std::optional<double>& exact_um) {
     const double um = scale_m * 1e6;
-    if (exact_um && std::abs(*exact_um - um) <= 1e-9 * um) return *exact_um;
+    if (exact_um && (std::abs(*exact_um - um) <= 1e-9 * um || metres_for(*exact_um) == scale_m)) {
+        return *exact_um;
+    }
     return um;
 }
 

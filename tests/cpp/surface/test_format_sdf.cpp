@@ -126,6 +126,18 @@ TEST(FormatSdf, HandWrittenAscii) {
     EXPECT_TRUE(std::isnan(map.at(1, 1)));
 }
 
+TEST(FormatSdf, TrailerOffsetsAndExactSpacingsHeaderWinsOnDisagreement) {
+    const std::string head = binary_header(1, 1, 2e-6, 2e-6, 1e-6, 7) + le(1.0);
+    const HeightMap a =
+        sdf(head + "*\ndx_um = 2.0000000000000004\nx_offset_um = -7.5\ny_offset_um = 1e-3\n*\n");
+    EXPECT_EQ(a.dx_um, 2.0000000000000004);  // agrees with Xscale: the exact value
+    EXPECT_EQ(a.x_offset_um, -7.5);
+    EXPECT_EQ(a.y_offset_um, 1e-3);
+    const HeightMap b = sdf(head + "dx_um = 5\n");
+    EXPECT_DOUBLE_EQ(b.dx_um, 2.0);  // disagrees (file rescaled elsewhere): the header wins
+    EXPECT_EQ(b.x_offset_um, 0.0);
+}
+
 const std::string kAsciiHead =
     "aISO-1.0\nNumPoints = 2\nNumProfiles = 1\nXscale = 1e-6\nYscale = 1e-6\nZscale = 1e-6\n"
     "DataType = 7\n*\n";
