@@ -75,7 +75,7 @@ std::optional<double> missing_marker(int data_type) {
 }
 
 void check_header(const std::string& name, const SdfHeader& h, std::string_view where) {
-    auto fail = [&](std::string what) {
+    auto fail = [&](const std::string& what) {
         throw DataError(name + ": " + std::string(where) + ": " + what);
     };
     if (h.compression != 0) {
