@@ -11,6 +11,7 @@
 
 #include <gtest/gtest.h>
 
+#include "../io/test_files.hpp"
 #include "roughscope/core/errors.hpp"
 #include "roughscope/surface/formats.hpp"
 #include "roughscope/surface/height_map.hpp"
@@ -234,6 +235,17 @@ TEST(FormatSdf, WriterRefusesWhatBinaryCannotHold) {
     HeightWriteOptions ascii;
     ascii.sdf_binary = false;
     EXPECT_NO_THROW(formats::encode_sdf(wide, ascii));
+}
+
+TEST(FormatSdf, FilesOnDiskByExtension) {
+    const auto dir = testing::fresh_dir("surface_sdf_files");
+    const HeightMap map = sample_map();
+    for (const char* leaf : {"m.sdf", "m.csv", "m.xyz"}) {
+        write_height_map(map, dir / leaf);
+        EXPECT_TRUE(bitwise_equal(map, read_height_map(dir / leaf))) << leaf;
+    }
+    EXPECT_EQ(testing::slurp(dir / "m.sdf").substr(0, 8), "bISO-1.0");
+    std::filesystem::remove_all(dir);
 }
 
 }  // namespace
