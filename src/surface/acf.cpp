@@ -66,7 +66,7 @@ LineAcf::LineAcf(std::size_t length, AcfEstimator estimator, bool per_line)
       length_(length),
       estimator_(estimator),
       per_line_(per_line),
-      fft_(std::make_unique<RowFft>(fft_friendly_size(2 * length - 1))) {
+      fft_(std::make_unique<RowFft>(fft::good_size(2 * length - 1))) {
     if (per_line_) {
         line_sums_.assign(length, 0.0);
         line_pairs_.assign(length, 0.0);

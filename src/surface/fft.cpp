@@ -12,15 +12,15 @@ namespace roughscope::surface::fft {
 
 namespace {
 
+fftw_plan as_plan(void* p) { return static_cast<fftw_plan>(p); }
+
+}  // namespace
+
 // FFTW's planner and fftw_destroy_plan share global state: one lock for both.
 std::mutex& planner_mutex() {
     static std::mutex m;
     return m;
 }
-
-fftw_plan as_plan(void* p) { return static_cast<fftw_plan>(p); }
-
-}  // namespace
 
 std::size_t good_size(std::size_t minimum) {
     for (std::size_t n = minimum < 1 ? 1 : minimum;; ++n) {

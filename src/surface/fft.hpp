@@ -12,8 +12,12 @@
 
 #include <complex>
 #include <cstddef>
+#include <mutex>
 
 namespace roughscope::surface::fft {
+
+// The one lock around FFTW's planner and fftw_destroy_plan for every FFT of the library.
+std::mutex& planner_mutex();
 
 // The smallest n ≥ minimum whose prime factors are all 2, 3, 5 or 7 (a fast FFTW size).
 std::size_t good_size(std::size_t minimum);

@@ -8,24 +8,9 @@
 
 #include <fftw3.h>
 
+#include "fft.hpp"
+
 namespace roughscope::surface::detail {
-
-// FFTW's planner is not thread-safe: plans are created and destroyed under this lock.
-inline std::mutex& fft_rows_planner_mutex() {
-    static std::mutex mutex;
-    return mutex;
-}
-
-// Smallest n' ≥ n of the form 2^a 3^b 5^c (sizes FFTW transforms fastest).
-inline std::size_t fft_friendly_size(std::size_t n) {
-    if (n <= 1) return 1;
-    for (std::size_t m = n;; ++m) {
-        std::size_t r = m;
-        for (std::size_t p : {2U, 3U, 5U})
-            while (r % p == 0) r /= p;
-        if (r == 1) return m;
-    }
-}
 
 // A real buffer of nfft points, its half spectrum of nfft/2 + 1 points, and the forward (r2c)
 // and backward (c2r, unnormalised: a round trip multiplies by nfft) plans between them.
@@ -34,14 +19,14 @@ class RowFft {
     explicit RowFft(std::size_t nfft) : nfft_(nfft) {
         real_ = fftw_alloc_real(nfft_);
         spectrum_ = fftw_alloc_complex(nfft_ / 2 + 1);
-        const std::lock_guard<std::mutex> lock(fft_rows_planner_mutex());
+        const std::lock_guard<std::mutex> lock(fft::planner_mutex());
         const int n = static_cast<int>(nfft_);
         forward_ = fftw_plan_dft_r2c_1d(n, real_, spectrum_, FFTW_ESTIMATE);
         backward_ = fftw_plan_dft_c2r_1d(n, spectrum_, real_, FFTW_ESTIMATE);
     }
     ~RowFft() {
         {
-            const std::lock_guard<std::mutex> lock(fft_rows_planner_mutex());
+            const std::lock_guard<std::mutex> lock(fft::planner_mutex());
             fftw_destroy_plan(forward_);
             fftw_destroy_plan(backward_);
         }
