@@ -17,8 +17,8 @@
 // in this baseline. n = 4096 is the size to quote; 512 keeps bench_smoke quick.
 #include <algorithm>
 #include <cmath>
-#include <cstdint>
 #include <cstddef>
+#include <cstdint>
 #include <map>
 #include <vector>
 

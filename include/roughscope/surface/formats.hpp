@@ -18,15 +18,15 @@
 namespace roughscope::surface {
 
 enum class HeightFormat {
-    CsvMatrix,   // CSV/ASCII matrix: one row of heights per line (.csv, .txt, .asc)
-    Xyz,         // x y z triples on a regular grid (.xyz)
-    Sdf,         // ISO 25178-71 SDF, ASCII (aISO-1.0) or binary (bISO-1.0) (.sdf)
-    X3p,         // ISO 25178-72 / ISO 5436-2 XML in a zip (.x3p)
-    Gwy,         // Gwyddion native GWYP (.gwy), read only
-    Gsf,         // Gwyddion simple field (.gsf)
-    Png,         // 16-bit (or 8-bit) grey PNG, heights = z_scale_um × count (.png)
-    Tiff,        // 16-bit integer or 32/64-bit float grey TIFF (.tif, .tiff)
-    Raw,         // headerless float32/float64, dimensions given (.raw, .bin, .f32, .f64)
+    CsvMatrix,  // CSV/ASCII matrix: one row of heights per line (.csv, .txt, .asc)
+    Xyz,        // x y z triples on a regular grid (.xyz)
+    Sdf,        // ISO 25178-71 SDF, ASCII (aISO-1.0) or binary (bISO-1.0) (.sdf)
+    X3p,        // ISO 25178-72 / ISO 5436-2 XML in a zip (.x3p)
+    Gwy,        // Gwyddion native GWYP (.gwy), read only
+    Gsf,        // Gwyddion simple field (.gsf)
+    Png,        // 16-bit (or 8-bit) grey PNG, heights = z_scale_um × count (.png)
+    Tiff,       // 16-bit integer or 32/64-bit float grey TIFF (.tif, .tiff)
+    Raw,        // headerless float32/float64, dimensions given (.raw, .bin, .f32, .f64)
 };
 
 // "x3p", "gsf", ... (core/names.hpp table; any case).
