@@ -14,7 +14,15 @@ REPORT_DIR ?= out/report
 # Warnings as errors: ON in CI (.ci/run exports ROUGHSCOPE_WERROR=ON), OFF by default.
 ROUGHSCOPE_WERROR ?= OFF
 
-CONFIGURE_FLAGS = -G Ninja \
+# ccache (installed by scripts/install-deps) makes rebuilds of unchanged sources cheap, also from
+# another clone on the same machine (paths are taken relative to the clone).
+CCACHE := $(shell command -v ccache 2>/dev/null)
+ifneq ($(CCACHE),)
+export CCACHE_BASEDIR ?= $(CURDIR)
+LAUNCHER_FLAGS = -DCMAKE_CXX_COMPILER_LAUNCHER=$(CCACHE)
+endif
+
+CONFIGURE_FLAGS = -G Ninja $(LAUNCHER_FLAGS) \
 	-DCMAKE_BUILD_TYPE=Release \
 	-DROUGHSCOPE_BUILD_TESTS=ON \
 	-DROUGHSCOPE_BUILD_PYTHON=ON \
@@ -24,7 +32,7 @@ CONFIGURE_FLAGS = -G Ninja \
 	-DROUGHSCOPE_WERROR=$(ROUGHSCOPE_WERROR) \
 	-DPython3_EXECUTABLE=$(PYTHON)
 
-ASAN_CONFIGURE_FLAGS = -G Ninja \
+ASAN_CONFIGURE_FLAGS = -G Ninja $(LAUNCHER_FLAGS) \
 	-DCMAKE_BUILD_TYPE=RelWithDebInfo \
 	-DROUGHSCOPE_BUILD_TESTS=ON \
 	-DROUGHSCOPE_BUILD_PYTHON=OFF \
@@ -35,7 +43,7 @@ ASAN_CONFIGURE_FLAGS = -G Ninja \
 
 # libFuzzer build (clang): every object instrumented for coverage + ASan + UBSan, asserts on.
 # Warnings are not errors here (clang-only warnings in code built with GCC elsewhere).
-FUZZ_CONFIGURE_FLAGS = -G Ninja \
+FUZZ_CONFIGURE_FLAGS = -G Ninja $(LAUNCHER_FLAGS) \
 	-DCMAKE_CXX_COMPILER=clang++ \
 	-DCMAKE_BUILD_TYPE=RelWithDebInfo \
 	"-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -gline-tables-only" \
