@@ -799,13 +799,16 @@ LeastSquaresResult solve_least_squares(const LeastSquaresProblem& P, const Least
     // Starts, then one Ceres run per start; the lowest final cost wins.
     SolverLogCapture solver_log;
     const std::vector<std::vector<double>> starts = grid_starts(e, P, O, O.num_starts);
-    std::vector<double> r(e.size());
+    // The residuals at the solution; allocated after the solves (N can be 1e6: not beside
+    // Ceres' working set).
+    std::vector<double> r;
     bool have_run = false;
     Run best;
     for (std::vector<double> x : starts) {
         if (mode == GainMode::Free) {
             double K = 1.0;
-            if (!e.residuals(x.data(), GainMode::Profiled, false, r.data(), &K)) K = 1.0;
+            std::vector<double> r_start(e.size());
+            if (!e.residuals(x.data(), GainMode::Profiled, false, r_start.data(), &K)) K = 1.0;
             x.push_back(K);
         }
         Run run = solve_from(e, O, std::move(x));
@@ -837,6 +840,7 @@ LeastSquaresResult solve_least_squares(const LeastSquaresProblem& P, const Least
 
     // The solution: model, gain, residuals (unrobustified).
     const std::vector<double>& x = best.x;
+    r.resize(e.size());
     std::vector<double> M;
     double K = 1.0;
     bool finite = e.model(x.data(), M);
