@@ -343,7 +343,12 @@ class EngineCost final : public ceres::CostFunction {
         }
         if (J == nullptr || J[0] == nullptr) return true;
         std::vector<double> xv(x[0], x[0] + size);
-        if (size <= 2) return jacobian_in_place(xv, r, J[0]);
+        if (size <= 2) {
+            // last_r_ (the residuals at x, as r) is the scratch column, then restored from r.
+            const bool ok = jacobian_in_place(xv, r, J[0], last_r_);
+            last_r_.assign(r, r + N);
+            return ok;
+        }
         // last_r_ holds the residuals r at x (no copy of N values).
         const std::vector<double>& r0 = last_r_;
         std::vector<double> d;
@@ -363,12 +368,13 @@ class EngineCost final : public ceres::CostFunction {
 
   private:
     // The Jacobian (row-major N × size, size 1 or 2) by the differences of bounded_difference,
-    // with Ceres' own Jacobian block as the scratch space of the perturbed residuals and one
-    // N-sized buffer beside it (N can be 1e6). r0: the residuals at x.
-    bool jacobian_in_place(std::vector<double>& x, const double* r0, double* J) const {
+    // with Ceres' own Jacobian block as the scratch space of the perturbed residuals and
+    // `column0` (N values) beside it (N can be 1e6). r0: the residuals at x.
+    bool jacobian_in_place(std::vector<double>& x, const double* r0, double* J,
+                           std::vector<double>& column0) const {
         const std::size_t N = e_.size();
         const auto size = x.size();
-        std::vector<double> column0(N);
+        column0.resize(N);
         auto f = [this](const double* xx, double* out) {
             return e_.residuals(xx, e_.gain(), true, out);
         };
