@@ -447,8 +447,8 @@ void fit_oren_nayar(Prepared& p, ModelResult& r, double sigma_max) {
         Sums S;
         for (std::size_t j = 0; j < n; ++j) {
             const double w = p.w[j];
-            const double A = p.oren_nayar.A(j, coefficients);
-            const double B = p.oren_nayar.B(j, coefficients);
+            const double A = p.oren_nayar.term_a(j, coefficients);
+            const double B = p.oren_nayar.term_b(j, coefficients);
             S.ad += w * A * p.d[j];
             S.bd += w * B * p.d[j];
             S.aa += w * A * A;
@@ -509,17 +509,17 @@ void fit_oren_nayar(Prepared& p, ModelResult& r, double sigma_max) {
         sigma_spec.initial = sigma0;
         rho_spec.initial = rho0;
     }
-    run_fit(p, r,
-            fit_problem(p, {sigma_spec, rho_spec},
-                        [&p](std::span<const double> theta, std::span<double> out) {
-                            const OrenNayarTerms::Coefficients c =
-                                OrenNayarTerms::coefficients(theta[0]);
-                            const double rho = theta[1];
-                            for (std::size_t j = 0; j < p.size(); ++j) {
-                                const double A = p.oren_nayar.A(j, c), B = p.oren_nayar.B(j, c);
-                                out[j] = rho * A + rho * rho * B;
-                            }
-                        }));
+    run_fit(
+        p, r,
+        fit_problem(
+            p, {sigma_spec, rho_spec}, [&p](std::span<const double> theta, std::span<double> out) {
+                const OrenNayarTerms::Coefficients c = OrenNayarTerms::coefficients(theta[0]);
+                const double rho = theta[1];
+                for (std::size_t j = 0; j < p.size(); ++j) {
+                    const double A = p.oren_nayar.term_a(j, c), B = p.oren_nayar.term_b(j, c);
+                    out[j] = rho * A + rho * rho * B;
+                }
+            }));
     r.evaluations += evaluations;
 }
 

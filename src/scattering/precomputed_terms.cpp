@@ -97,8 +97,8 @@ void OrenNayarTerms::components(double sigma_rad, std::span<double> A, std::span
     const Coefficients c = coefficients(sigma_rad);
     assert(A.size() == size() && B.size() == size());
     for (std::size_t k = 0; k < size(); ++k) {
-        A[k] = this->A(k, c);
-        B[k] = this->B(k, c);
+        A[k] = term_a(k, c);
+        B[k] = term_b(k, c);
     }
 }
 
