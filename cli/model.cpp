@@ -625,14 +625,11 @@ void append_csv_cell(std::string& out, const Record::Value& v) {
     using Kind = Record::Value::Kind;
     if (v.kind == Kind::Number && std::isfinite(v.number)) {
         // format_result's "%.10g" (no "-0"), without a temporary string.
-        std::array<char, 64> buf{};
-        const auto [end, ec] =
-            std::to_chars(buf.data(), buf.data() + buf.size(), v.number == 0.0 ? 0.0 : v.number,
-                          std::chars_format::general, kPrintDigits);
-        if (ec == std::errc()) {
-            out.append(buf.data(), static_cast<std::size_t>(end - buf.data()));
-            return;
-        }
+        std::array<char, roughscope::kSignificantBufferSize> buf{};
+        const char* end = roughscope::write_significant(
+            buf.data(), v.number == 0.0 ? 0.0 : v.number, kPrintDigits);
+        out.append(buf.data(), static_cast<std::size_t>(end - buf.data()));
+        return;
     }
     if (v.kind == Kind::Null) return;  // cell_text: ""
     if (v.kind == Kind::Text && plain_text(v.text)) {

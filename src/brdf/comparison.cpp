@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <array>
 #include <atomic>
+#include <cassert>
 #include <cmath>
 #include <cstdint>
 #include <exception>
@@ -61,6 +62,10 @@ const ModelInfo& info(ComparisonModel m) {
 // ---------------------------------------------------------------------------------------------
 // The used measurements with everything the model evaluations need, computed once per table.
 
+//
+// The geometry-only terms of one model family at a time (N can be 1e6): each is built before the
+// family's models are evaluated and released after them (prepare_*, release_*), so that at most
+// one family's terms coexist with a fit's working set.
 struct Prepared {
     std::span<const Geometry> geom;  // the comparison's (not copied: N can be 1e6)
     std::vector<double> d;           // data brightness normalised by its maximum
@@ -70,17 +75,19 @@ struct Prepared {
     double sum_wdd = 0.0;
     Radiometry radiometry = Radiometry::Radiance;  // §3.3 interpretation of the B–K models
     std::vector<double> cos_i, log_cos_i_cos_s;    // Lafortune diffuse lobe
-    VeryRoughTerms beckmann, vernold_harvey;       // Eq. 4/5 with F_Beck, F_VH (§3.2)
+    GeometricFactor factor = GeometricFactor::Beckmann;
+    VeryRoughTerms very_rough_terms;  // Eq. 4/5 with `factor` (F_Beck or F_VH, §3.2)
     OrenNayarTerms oren_nayar;
 
     std::size_t size() const { return geom.size(); }
-    const VeryRoughTerms& very_rough(GeometricFactor factor) const {
-        return factor == GeometricFactor::Beckmann ? beckmann : vernold_harvey;
+    const VeryRoughTerms& very_rough(GeometricFactor f) const {
+        assert(f == factor && very_rough_terms.size() == size());
+        (void)f;
+        return very_rough_terms;
     }
 };
 
-// The geometry-only terms of every model, computed once per table (the geometries of a BrdfTable
-// are valid: check::geometry holds).
+// The data of every model (the geometries of a BrdfTable are valid: check::geometry holds).
 Prepared prepare(const std::vector<Geometry>& geom, std::vector<double> d_normalised,
                  const std::vector<double>& w, Radiometry radiometry) {
     Prepared p;
@@ -89,19 +96,33 @@ Prepared prepare(const std::vector<Geometry>& geom, std::vector<double> d_normal
     p.w = w;
     const std::size_t n = geom.size();
     p.radiometry = radiometry;
-    p.cos_i.resize(n);
-    p.log_cos_i_cos_s.resize(n);
     for (std::size_t j = 0; j < n; ++j) {
-        const Geometry& g = geom[j];
-        p.cos_i[j] = std::cos(g.theta_i_rad);
-        p.log_cos_i_cos_s[j] = std::log(p.cos_i[j] * std::cos(g.theta_s_rad));
         p.sum_w += w[j];
         p.sum_wdd += w[j] * p.d[j] * p.d[j];
     }
-    p.beckmann = VeryRoughTerms(geom, GeometricFactor::Beckmann, radiometry);
-    p.vernold_harvey = VeryRoughTerms(geom, GeometricFactor::VernoldHarvey, radiometry);
-    p.oren_nayar = OrenNayarTerms(geom);
     return p;
+}
+
+void prepare_lafortune(Prepared& p) {
+    const std::size_t n = p.size();
+    p.cos_i.resize(n);
+    p.log_cos_i_cos_s.resize(n);
+    for (std::size_t j = 0; j < n; ++j) {
+        const Geometry& g = p.geom[j];
+        p.cos_i[j] = std::cos(g.theta_i_rad);
+        p.log_cos_i_cos_s[j] = std::log(p.cos_i[j] * std::cos(g.theta_s_rad));
+    }
+}
+
+void release_lafortune(Prepared& p) {
+    std::vector<double>().swap(p.cos_i);
+    std::vector<double>().swap(p.log_cos_i_cos_s);
+}
+
+void prepare_very_rough(Prepared& p, GeometricFactor factor) {
+    p.very_rough_terms = VeryRoughTerms();  // the previous family's terms first
+    p.factor = factor;
+    p.very_rough_terms = VeryRoughTerms(p.geom, factor, p.radiometry);
 }
 
 // Very-rough brightness, Eq. 4 (Gaussian) / Eq. 5 (exponential) as published with F_Beck or F_VH,
@@ -242,12 +263,12 @@ void set_errors(const Prepared& p, ModelResult& r) {
 
 using Prediction = std::function<void(std::span<const double> theta, std::span<double> out)>;
 
-// The engine's problem for one model family over the used measurements.
+// The engine's problem for one model family over the used measurements; its data are lent by
+// run_fit (p.d, not copied: N can be 1e6).
 LeastSquaresProblem fit_problem(const Prepared& p, std::vector<ParameterSpec> parameters,
                                 Prediction predict) {
     LeastSquaresProblem P;
     P.parameters = std::move(parameters);
-    P.data = p.d;
     // All weights 1 (every table without a weight column) is the engine's default: no copy.
     if (std::any_of(p.w.begin(), p.w.end(), [](double v) { return v != 1.0; }))
         P.weights.assign(p.w.begin(), p.w.end());
@@ -273,10 +294,25 @@ ParameterSpec fit_parameter(const char* name, double lower, double upper, Transf
 
 // Solves and fills the model's result: parameters (gain last) with standard errors (none for a
 // parameter on a bound), status, covariance, prediction M(θ) at the solution and its errors.
-void run_fit(const Prepared& p, ModelResult& r, const LeastSquaresProblem& problem) {
+void run_fit(Prepared& p, ModelResult& r, LeastSquaresProblem problem) {
     LeastSquaresOptions options;
     options.function_tolerance = 1e-15;  // flat minima: converge the parameters, not only the SSE
-    const LeastSquaresResult lsq = solve_least_squares(problem, options);
+    // The data are lent to the problem for the solve and given back (also on an exception).
+    struct Lend {
+        std::vector<double>& owner;
+        std::vector<double>& borrower;
+        Lend(std::vector<double>& o, std::vector<double>& b) : owner(o), borrower(b) {
+            borrower = std::move(owner);
+        }
+        ~Lend() { owner = std::move(borrower); }
+        Lend(const Lend&) = delete;
+        Lend& operator=(const Lend&) = delete;
+    };
+    LeastSquaresResult lsq;
+    {
+        const Lend lend(p.d, problem.data);
+        lsq = solve_least_squares(problem, options);
+    }
     r.evaluations = lsq.evaluations;
     r.fit_status = lsq.status;
     r.fit_message = lsq.message;
@@ -308,7 +344,7 @@ void run_fit(const Prepared& p, ModelResult& r, const LeastSquaresProblem& probl
 }
 
 // σ/T (B–K or V–H, Gaussian or exponential): 41 log-spaced starts over the bounds.
-void fit_very_rough(const Prepared& p, ModelResult& r, GeometricFactor factor, Correlation c,
+void fit_very_rough(Prepared& p, ModelResult& r, GeometricFactor factor, Correlation c,
                     double lower, double upper) {
     run_fit(p, r,
             fit_problem(p, {fit_parameter("sigma_over_T", lower, upper, Transform::Log, 41)},
@@ -319,7 +355,7 @@ void fit_very_rough(const Prepared& p, ModelResult& r, GeometricFactor factor, C
 }
 
 // Lafortune exponent n: 41 log-spaced starts over the bounds.
-void fit_lafortune(const Prepared& p, ModelResult& r, double lower, double upper) {
+void fit_lafortune(Prepared& p, ModelResult& r, double lower, double upper) {
     run_fit(p, r,
             fit_problem(p, {fit_parameter("n", lower, upper, Transform::Log, 41)},
                         [&p](std::span<const double> theta, std::span<double> out) {
@@ -396,27 +432,28 @@ void finish_at_lambert(const Prepared& p, ModelResult& r, double rho, double sig
 // on ρ there: the fit ends at the start, with the engine's NotIdentifiable verdict (albedo and gain
 // trade off exactly; σ on its bound), without a solver run that would only creep along the flat
 // direction.
-void fit_oren_nayar(const Prepared& p, ModelResult& r, double sigma_max) {
+void fit_oren_nayar(Prepared& p, ModelResult& r, double sigma_max) {
     constexpr double kRhoMin = 1e-3;
     constexpr int kSigmaPoints = 16, kRhoPoints = 21;
     const std::size_t n = p.size();
-    std::vector<double> A(n), B(n);
     int evaluations = 0;
     // Weighted sums of σ's components; false when the profiled SSE is undefined at every ρ.
     struct Sums {
         double ad = 0, bd = 0, aa = 0, ab = 0, bb = 0;
     };
     auto sums = [&](double sigma) {
-        p.oren_nayar.components(sigma, A, B);
+        const OrenNayarTerms::Coefficients coefficients = OrenNayarTerms::coefficients(sigma);
         ++evaluations;
         Sums S;
         for (std::size_t j = 0; j < n; ++j) {
             const double w = p.w[j];
-            S.ad += w * A[j] * p.d[j];
-            S.bd += w * B[j] * p.d[j];
-            S.aa += w * A[j] * A[j];
-            S.ab += w * A[j] * B[j];
-            S.bb += w * B[j] * B[j];
+            const double A = p.oren_nayar.term_a(j, coefficients);
+            const double B = p.oren_nayar.term_b(j, coefficients);
+            S.ad += w * A * p.d[j];
+            S.bd += w * B * p.d[j];
+            S.aa += w * A * A;
+            S.ab += w * A * B;
+            S.bb += w * B * B;
         }
         return S;
     };
@@ -463,28 +500,8 @@ void fit_oren_nayar(const Prepared& p, ModelResult& r, double sigma_max) {
         return;
     }
 
-    // L = ρ A(σ) + ρ² B(σ), A and B cached for the last few σ (the Jacobian perturbs σ and ρ in
-    // turn), so that a change of ρ alone costs no evaluation of the components.
-    struct Components {
-        double sigma = -1.0;
-        std::vector<double> A, B;
-    };
-    struct Cache {
-        std::array<Components, 4> entries;
-        std::size_t next = 0;
-    };
-    auto cache = std::make_shared<Cache>();
-    auto components = [&p, cache](double sigma) -> const Components& {
-        for (const Components& c : cache->entries)
-            if (c.sigma == sigma) return c;
-        Components& c = cache->entries[cache->next];
-        cache->next = (cache->next + 1) % cache->entries.size();
-        c.A.resize(p.size());
-        c.B.resize(p.size());
-        p.oren_nayar.components(sigma, c.A, c.B);
-        c.sigma = sigma;
-        return c;
-    };
+    // L = ρ A(σ) + ρ² B(σ), A and B computed per geometry from the σ-only coefficients (a few
+    // multiplications: no N-sized buffer of components).
     ParameterSpec sigma_spec = fit_parameter("sigma_rad", 0.0, sigma_max, Transform::Linear, 16);
     ParameterSpec rho_spec = fit_parameter("albedo", kRhoMin, 1.0, Transform::Linear, 21);
     // At σ = 0 the grid's ρ values tie up to rounding (the start there is the engine's own grid).
@@ -492,14 +509,17 @@ void fit_oren_nayar(const Prepared& p, ModelResult& r, double sigma_max) {
         sigma_spec.initial = sigma0;
         rho_spec.initial = rho0;
     }
-    run_fit(p, r,
-            fit_problem(p, {sigma_spec, rho_spec},
-                        [&p, components](std::span<const double> theta, std::span<double> out) {
-                            const Components& c = components(theta[0]);
-                            const double rho = theta[1];
-                            for (std::size_t j = 0; j < p.size(); ++j)
-                                out[j] = rho * c.A[j] + rho * rho * c.B[j];
-                        }));
+    run_fit(
+        p, r,
+        fit_problem(
+            p, {sigma_spec, rho_spec}, [&p](std::span<const double> theta, std::span<double> out) {
+                const OrenNayarTerms::Coefficients c = OrenNayarTerms::coefficients(theta[0]);
+                const double rho = theta[1];
+                for (std::size_t j = 0; j < p.size(); ++j) {
+                    const double A = p.oren_nayar.term_a(j, c), B = p.oren_nayar.term_b(j, c);
+                    out[j] = rho * A + rho * rho * B;
+                }
+            }));
     r.evaluations += evaluations;
 }
 
@@ -814,6 +834,9 @@ Comparison compare(const BrdfTable& table, const ComparisonOptions& o, BrdfTable
     Prepared p = prepare(c.geometry, std::move(d), c.weight, o.radiometry);
     p.keep_predictions = o.keep_predictions;
 
+    // One model family at a time (Prepared): its terms, its paper method, its fit. Each model's
+    // result depends on its own computation only, so the order does not change any number.
+    p.oren_nayar = OrenNayarTerms(p.geom);
     // Oren–Nayar with given parameters.
     {
         ModelResult& r = result(ComparisonModel::OrenNayar);
@@ -838,6 +861,14 @@ Comparison compare(const BrdfTable& table, const ComparisonOptions& o, BrdfTable
                 "oren_nayar_fit";
         }
     }
+    if (o.fits) {
+        ModelResult& r = result(ComparisonModel::OrenNayarFit);
+        r.method = "least squares over sigma_rad, albedo and the gain";
+        fit_oren_nayar(p, r, o.fit_oren_nayar_sigma_max_rad);
+    }
+    p.oren_nayar = OrenNayarTerms();
+
+    prepare_lafortune(p);
     // Lafortune: the paper's exhaustive search for the lowest Table-4 error.
     {
         ModelResult& r = result(ComparisonModel::Lafortune);
@@ -883,6 +914,13 @@ Comparison compare(const BrdfTable& table, const ComparisonOptions& o, BrdfTable
         lafortune_prediction(p, best_n, r.prediction);
         set_errors(p, r);
     }
+    if (o.fits) {
+        ModelResult& r = result(ComparisonModel::LafortuneFit);
+        r.method = "least squares over n and the gain";
+        fit_lafortune(p, r, o.fit_lafortune_n_min, o.fit_lafortune_n_max);
+    }
+    release_lafortune(p);
+
     // B–K (F_Beck) and V–H (F_VH) at the two-point estimate.
     struct VeryRoughVariant {
         ComparisonModel model, fit;
@@ -899,7 +937,7 @@ Comparison compare(const BrdfTable& table, const ComparisonOptions& o, BrdfTable
         {ComparisonModel::VhExponential, ComparisonModel::VhExponentialFit,
          GeometricFactor::VernoldHarvey, Correlation::Exponential},
     };
-    for (const VeryRoughVariant& v : variants) {
+    auto two_point_model = [&](const VeryRoughVariant& v) {
         ModelResult& r = result(v.model);
         const bool gaussian = v.correlation == Correlation::Gaussian;
         const std::optional<double> sigma_over_T =
@@ -909,7 +947,7 @@ Comparison compare(const BrdfTable& table, const ComparisonOptions& o, BrdfTable
                        (!c.two_point.available ? c.two_point.reason
                                                : (gaussian ? c.two_point.gaussian_reason
                                                            : c.two_point.exponential_reason));
-            continue;
+            return;
         }
         r.available = true;
         r.method = std::string("two-point estimate of sigma/T (") +
@@ -922,20 +960,16 @@ Comparison compare(const BrdfTable& table, const ComparisonOptions& o, BrdfTable
         r.evaluations = 1;
         very_rough_prediction(p, v.factor, v.correlation, *sigma_over_T, r.prediction);
         set_errors(p, r);
-    }
-
-    if (o.fits) {
-        {
-            ModelResult& r = result(ComparisonModel::OrenNayarFit);
-            r.method = "least squares over sigma_rad, albedo and the gain";
-            fit_oren_nayar(p, r, o.fit_oren_nayar_sigma_max_rad);
-        }
-        {
-            ModelResult& r = result(ComparisonModel::LafortuneFit);
-            r.method = "least squares over n and the gain";
-            fit_lafortune(p, r, o.fit_lafortune_n_min, o.fit_lafortune_n_max);
-        }
+    };
+    // Per factor (F_Beck, then F_VH): its terms, the two-point models, the fits.
+    for (const GeometricFactor factor :
+         {GeometricFactor::Beckmann, GeometricFactor::VernoldHarvey}) {
+        prepare_very_rough(p, factor);
+        for (const VeryRoughVariant& v : variants)
+            if (v.factor == factor) two_point_model(v);
+        if (!o.fits) continue;
         for (const VeryRoughVariant& v : variants) {
+            if (v.factor != factor) continue;
             ModelResult& r = result(v.fit);
             r.method = std::string("least squares over sigma/T and the gain; ") +
                        (v.correlation == Correlation::Gaussian ? "Eq. 4" : "Eq. 5") + " with " +
@@ -944,10 +978,11 @@ Comparison compare(const BrdfTable& table, const ComparisonOptions& o, BrdfTable
             fit_very_rough(p, r, v.factor, v.correlation, o.fit_sigma_over_T_min,
                            o.fit_sigma_over_T_max);
         }
-    } else {
+    }
+    p.very_rough_terms = VeryRoughTerms();
+    if (!o.fits)
         for (ModelResult& r : c.models)
             if (is_fit(r.model)) r.reason = "fits not requested";
-    }
     pick_winners(c);
     return c;
 }

@@ -1,10 +1,12 @@
 // The strict number parser and the formatter family (numbers.hpp).
 #include "roughscope/core/numbers.hpp"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <limits>
 #include <system_error>
 
 #include "roughscope/core/errors.hpp"
@@ -18,17 +20,20 @@ namespace {
                 " is not a finite number; refusing to print it");
 }
 
-// printf's "%.*g" in the C locale: std::to_chars with a precision is specified to give the
-// same characters, without printf's format parsing and multi-precision arithmetic.
+// printf's "%.*g" in the C locale (write_significant).
 std::string printf_g(double value, int digits) {
-    char buf[64];
+    char buf[kSignificantBufferSize];
+    return std::string(buf, write_significant(buf, value, digits));
+}
+
+// "%.*g" by std::to_chars with a precision, specified to give printf's characters without its
+// format parsing (snprintf if it ever refused).
+char* write_significant_exact(char* out, double value, int digits) {
     const auto [end, ec] =
-        std::to_chars(buf, buf + sizeof buf, value, std::chars_format::general, digits);
-    if (ec != std::errc()) {
-        std::snprintf(buf, sizeof buf, "%.*g", digits, value);
-        return buf;
-    }
-    return std::string(buf, end);
+        std::to_chars(out, out + kSignificantBufferSize, value, std::chars_format::general, digits);
+    if (ec == std::errc()) return end;
+    const int n = std::snprintf(out, kSignificantBufferSize, "%.*g", digits, value);
+    return out + std::max(0, std::min(n, static_cast<int>(kSignificantBufferSize) - 1));
 }
 
 // Relative differences this small are floating-point noise, not information, in a message.
@@ -151,6 +156,79 @@ std::string format_roundtrip(double value, std::string_view name) {
     char buf[64];
     const auto res = std::to_chars(buf, buf + sizeof buf, value);
     return std::string(buf, res.ptr);
+}
+
+char* write_significant(char* out, double value, int digits) {
+    // Shortest round-trip digits S of a normal double v are within half an ulp (relative
+    // 2^-53) of v, far less than half a unit of the 15th significant digit (relative ≥ 5e-16):
+    // with k ≤ digits ≤ 15 digits, S is the correctly rounded value, and with more, S rounds to
+    // the same `digits` digits as v unless a rounding boundary lies between them, which the
+    // shortest (and, among the shortest, closest) digits exclude; S ending on an exact tie
+    // ("…5" right after the kept digits) goes to the exact path.
+    const double magnitude = std::abs(value);
+    if (digits < 1 || digits > 15 || !(magnitude >= std::numeric_limits<double>::min()) ||
+        !std::isfinite(value))
+        return write_significant_exact(out, value, digits);
+    char sci[kSignificantBufferSize];
+    const auto printed = std::to_chars(sci, sci + sizeof sci, value, std::chars_format::scientific);
+    if (printed.ec != std::errc()) return write_significant_exact(out, value, digits);
+    const char* p = sci;
+    const bool negative = *p == '-';
+    if (negative) ++p;
+    char dig[24];
+    int k = 0;
+    for (; p < printed.ptr && *p != 'e'; ++p)
+        if (*p != '.') dig[k++] = *p;
+    if (p == printed.ptr) return write_significant_exact(out, value, digits);
+    ++p;  // 'e'
+    const bool negative_exponent = *p == '-';
+    if (*p == '-' || *p == '+') ++p;
+    int exponent = 0;
+    for (; p < printed.ptr; ++p) exponent = exponent * 10 + (*p - '0');
+    if (negative_exponent) exponent = -exponent;
+    if (k > digits) {
+        if (k == digits + 1 && dig[digits] == '5')
+            return write_significant_exact(out, value, digits);
+        const bool up = dig[digits] >= '5';
+        k = digits;
+        if (up) {
+            int i = k - 1;
+            while (i >= 0 && dig[i] == '9') dig[i--] = '0';
+            if (i < 0) {
+                dig[0] = '1';
+                ++exponent;
+            } else {
+                ++dig[i];
+            }
+        }
+    }
+    while (k > 1 && dig[k - 1] == '0') --k;  // %g drops trailing zeros
+    char* o = out;
+    if (negative) *o++ = '-';
+    if (exponent < -4 || exponent >= digits) {  // style e
+        *o++ = dig[0];
+        if (k > 1) {
+            *o++ = '.';
+            for (int i = 1; i < k; ++i) *o++ = dig[i];
+        }
+        *o++ = 'e';
+        *o++ = exponent < 0 ? '-' : '+';
+        const int e = std::abs(exponent);
+        if (e < 10) *o++ = '0';
+        o = std::to_chars(o, o + 4, e).ptr;
+    } else if (exponent >= 0) {  // style f, integer part of exponent + 1 digits
+        for (int i = 0; i <= exponent; ++i) *o++ = i < k ? dig[i] : '0';
+        if (k > exponent + 1) {
+            *o++ = '.';
+            for (int i = exponent + 1; i < k; ++i) *o++ = dig[i];
+        }
+    } else {  // style f, 0.000ddd
+        *o++ = '0';
+        *o++ = '.';
+        for (int i = 0; i < -exponent - 1; ++i) *o++ = '0';
+        for (int i = 0; i < k; ++i) *o++ = dig[i];
+    }
+    return o;
 }
 
 std::string format_significant(double value, int digits, std::string_view name) {

@@ -203,7 +203,6 @@ class Evaluator {
             }
         }
         theta_.resize(static_cast<std::size_t>(n_));
-        M_.resize(N);
         for (const ParameterSpec& s : P.parameters) {
             const bool has_lower = s.transform == Transform::Linear || s.lower > 0.0;
             lower_.push_back(has_lower ? to_u(s.transform, s.lower) : -kInf);
@@ -229,15 +228,14 @@ class Evaluator {
     double sqrt_weight(std::size_t i) const { return sw_.empty() ? 1.0 : sw_[i]; }
     int evaluations() const { return evaluations_; }
 
-    // M(θ(u)) into M; false when the model fails or gives a non-finite value.
-    bool model(const double* u, std::vector<double>& M) const {
+    // M(θ(u)) into M (size()); false when the model fails or gives a non-finite value.
+    bool model(const double* u, std::span<double> M) const {
         for (int j = 0; j < n_; ++j)
             theta_[static_cast<std::size_t>(j)] =
                 to_theta(P_.parameters[static_cast<std::size_t>(j)].transform, u[j]);
-        M.resize(size());
         ++evaluations_;
         try {
-            if (!P_.model(std::span<const double>(theta_), std::span<double>(M))) return false;
+            if (!P_.model(std::span<const double>(theta_), M)) return false;
         } catch (const std::exception&) {
             return false;  // an exception must not cross Ceres: the point is unusable
         }
@@ -245,21 +243,28 @@ class Evaluator {
             if (!std::isfinite(m)) return false;
         return true;
     }
+    bool model(const double* u, std::vector<double>& M) const {
+        M.resize(size());
+        return model(u, std::span<double>(M));
+    }
 
     // Residuals r_i = √w_i residual(K M_i, y_i) at x = [u..., (K if `mode` is Free)], the gain
     // profiled out (mode Profiled), explicit (Free) or 1 (None); robust: r̃ = sign(r) √ρ(r²), so
     // that Σ r̃² = Σ ρ(r²) is the robust cost. K through `gain` when given.
+    // The model values are computed into r itself and replaced by the residuals (no N-sized
+    // buffer of model values beside r).
     bool residuals(const double* x, GainMode mode, bool robust, double* r,
                    double* gain = nullptr) const {
-        if (!model(x, M_)) return false;
+        const std::span<const double> M(r, size());
+        if (!model(x, std::span<double>(r, size()))) return false;
         double K = 1.0;
         if (mode == GainMode::Profiled)
-            K = optimal_gain(M_, P_.data, w_, P_.residual);
+            K = optimal_gain(M, P_.data, w_, P_.residual);
         else if (mode == GainMode::Free)
             K = x[n_];
         if (!std::isfinite(K)) return false;
         for (std::size_t i = 0; i < size(); ++i) {
-            const double KM = K * M_[i];
+            const double KM = K * M[i];  // read before r[i] (the same element) is written
             if (P_.residual == ResidualType::Log && !(KM > 0.0)) {
                 if (weight(i) == 0.0) {
                     r[i] = 0.0;
@@ -286,7 +291,7 @@ class Evaluator {
     int n_;
     std::unique_ptr<ceres::LossFunction> loss_;
     std::vector<double> sw_, w_, lower_, upper_;
-    mutable std::vector<double> theta_, M_;
+    mutable std::vector<double> theta_;
     mutable int evaluations_ = 0;
 };
 
@@ -337,9 +342,16 @@ class EngineCost final : public ceres::CostFunction {
             last_r_.assign(r, r + N);
         }
         if (J == nullptr || J[0] == nullptr) return true;
+        std::vector<double> xv(x[0], x[0] + size);
+        if (size <= 2) {
+            // last_r_ (the residuals at x, as r) is the scratch column, then restored from r.
+            const bool ok = jacobian_in_place(xv, r, J[0], last_r_);
+            last_r_.assign(r, r + N);
+            return ok;
+        }
         // last_r_ holds the residuals r at x (no copy of N values).
         const std::vector<double>& r0 = last_r_;
-        std::vector<double> xv(x[0], x[0] + size), d;
+        std::vector<double> d;
         auto f = [this, N](const double* xx, std::vector<double>& out) {
             out.resize(N);
             return e_.residuals(xx, e_.gain(), true, out.data());
@@ -355,6 +367,49 @@ class EngineCost final : public ceres::CostFunction {
     }
 
   private:
+    // The Jacobian (row-major N × size, size 1 or 2) by the differences of bounded_difference,
+    // with Ceres' own Jacobian block as the scratch space of the perturbed residuals and
+    // `column0` (N values) beside it (N can be 1e6). r0: the residuals at x.
+    bool jacobian_in_place(std::vector<double>& x, const double* r0, double* J,
+                           std::vector<double>& column0) const {
+        const std::size_t N = e_.size();
+        const auto size = x.size();
+        column0.resize(N);
+        auto f = [this](const double* xx, double* out) {
+            return e_.residuals(xx, e_.gain(), true, out);
+        };
+        // Column j: f(b) into fb, f(a) into fa, the difference into fb.
+        auto column = [&](std::size_t j, double* fb, double* fa) {
+            const double xj = x[j];
+            const double h = 1e-6 * std::max(1.0, std::abs(xj));
+            const auto jj = static_cast<int>(j);
+            double a = std::max(e_.lower(jj), xj - h), b = std::min(e_.upper(jj), xj + h);
+            x[j] = b;
+            const bool okb = b > xj && f(x.data(), fb);
+            x[j] = a;
+            const bool oka = a < xj && f(x.data(), fa);
+            x[j] = xj;
+            if (!okb) b = xj;
+            if (!oka) a = xj;
+            if (!(b > a)) return false;
+            const double* up = okb ? fb : r0;
+            const double* dn = oka ? fa : r0;
+            for (std::size_t i = 0; i < N; ++i) fb[i] = (up[i] - dn[i]) / (b - a);
+            return true;
+        };
+        if (size == 1) return column(0, J, column0.data());
+        // Two columns: the first into column0 (f(a) in J's second half), the second into J's
+        // second half (f(b) in its first half), then interleaved into rows: row i's second
+        // value is read before rows ≤ i are written, and rows < i never overwrite it.
+        if (!column(0, column0.data(), J + N) || !column(1, J + N, J)) return false;
+        for (std::size_t i = 0; i < N; ++i) {
+            const double second = J[N + i];
+            J[2 * i] = column0[i];
+            J[2 * i + 1] = second;
+        }
+        return true;
+    }
+
     const Evaluator& e_;
     mutable std::vector<double> last_x_, last_r_;
 };
@@ -799,13 +854,16 @@ LeastSquaresResult solve_least_squares(const LeastSquaresProblem& P, const Least
     // Starts, then one Ceres run per start; the lowest final cost wins.
     SolverLogCapture solver_log;
     const std::vector<std::vector<double>> starts = grid_starts(e, P, O, O.num_starts);
-    std::vector<double> r(e.size());
+    // The residuals at the solution; allocated after the solves (N can be 1e6: not beside
+    // Ceres' working set).
+    std::vector<double> r;
     bool have_run = false;
     Run best;
     for (std::vector<double> x : starts) {
         if (mode == GainMode::Free) {
             double K = 1.0;
-            if (!e.residuals(x.data(), GainMode::Profiled, false, r.data(), &K)) K = 1.0;
+            std::vector<double> r_start(e.size());
+            if (!e.residuals(x.data(), GainMode::Profiled, false, r_start.data(), &K)) K = 1.0;
             x.push_back(K);
         }
         Run run = solve_from(e, O, std::move(x));
@@ -837,6 +895,7 @@ LeastSquaresResult solve_least_squares(const LeastSquaresProblem& P, const Least
 
     // The solution: model, gain, residuals (unrobustified).
     const std::vector<double>& x = best.x;
+    r.resize(e.size());
     std::vector<double> M;
     double K = 1.0;
     bool finite = e.model(x.data(), M);

@@ -121,9 +121,12 @@ LeastSquaresProblem make_problem(const std::vector<Measurement>& ms, const FitOp
     LeastSquaresProblem P;
     P.residual = o.residual;
     P.gain = GainMode::Profiled;
-    for (const auto& m : ms) {
-        P.data.push_back(m.brightness);
-        P.weights.push_back(m.weight);
+    P.data.reserve(ms.size());
+    for (const auto& m : ms) P.data.push_back(m.brightness);
+    // All weights 1 is the engine's default (no weights): no N-sized copies of ones.
+    if (std::any_of(ms.begin(), ms.end(), [](const Measurement& m) { return m.weight != 1.0; })) {
+        P.weights.reserve(ms.size());
+        for (const auto& m : ms) P.weights.push_back(m.weight);
     }
     std::vector<Geometry> geoms;
     geoms.reserve(ms.size());

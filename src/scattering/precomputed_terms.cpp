@@ -82,17 +82,23 @@ OrenNayarTerms::OrenNayarTerms(std::span<const Geometry> geoms) {
     }
 }
 
-void OrenNayarTerms::components(double sigma_rad, std::span<double> A, std::span<double> B) const {
+OrenNayarTerms::Coefficients OrenNayarTerms::coefficients(double sigma_rad) {
     check::non_negative("oren_nayar sigma", sigma_rad, "rad");
-    assert(A.size() == size() && B.size() == size());
     const double s2 = sigma_rad * sigma_rad;
-    const double C1 = 1.0 - 0.5 * oren_nayar_saturation(s2, 0.33);
-    const double c2 = 0.45 * oren_nayar_saturation(s2, 0.09);
-    const double c3 = 0.125 * oren_nayar_saturation(s2, 0.09);
-    const double c4 = oren_nayar_saturation(s2, 0.13);
+    Coefficients c;
+    c.C1 = 1.0 - 0.5 * oren_nayar_saturation(s2, 0.33);
+    c.c2 = 0.45 * oren_nayar_saturation(s2, 0.09);
+    c.c3 = 0.125 * oren_nayar_saturation(s2, 0.09);
+    c.c4 = oren_nayar_saturation(s2, 0.13);
+    return c;
+}
+
+void OrenNayarTerms::components(double sigma_rad, std::span<double> A, std::span<double> B) const {
+    const Coefficients c = coefficients(sigma_rad);
+    assert(A.size() == size() && B.size() == size());
     for (std::size_t k = 0; k < size(); ++k) {
-        A[k] = p0_[k] * (C1 + c2 * g2_[k] + c3 * g3_[k]);
-        B[k] = c4 * g4_[k];
+        A[k] = term_a(k, c);
+        B[k] = term_b(k, c);
     }
 }
 

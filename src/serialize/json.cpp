@@ -7,6 +7,7 @@
 #include <cstdlib>
 #include <system_error>
 
+#include "roughscope/core/numbers.hpp"
 #include "roughscope/scattering/geometry.hpp"
 
 namespace roughscope::serialize {
@@ -18,16 +19,14 @@ Json number(const std::optional<double>& value) { return value ? number(*value) 
 Json degrees(double radians) {
     const double deg = rad_to_deg(radians);
     if (!std::isfinite(deg)) return nullptr;
-    char buf[40];
+    char buf[kSignificantBufferSize + 1];
     for (int digits = 1; digits <= 17; ++digits) {
-        // "%.*g" and strtod, without printf's format parsing (to_chars with a precision gives
-        // printf's characters; from_chars rounds as strtod).
-        const auto printed =
-            std::to_chars(buf, buf + sizeof buf, deg, std::chars_format::general, digits);
+        // "%.*g" and strtod, without printf's format parsing (write_significant gives printf's
+        // characters; from_chars rounds as strtod).
+        char* const end = write_significant(buf, deg, digits);
         double candidate = deg;
-        if (printed.ec != std::errc() ||
-            std::from_chars(buf, printed.ptr, candidate).ec != std::errc()) {
-            std::snprintf(buf, sizeof buf, "%.*g", digits, deg);
+        if (std::from_chars(buf, end, candidate).ec != std::errc()) {
+            *end = '\0';
             candidate = std::strtod(buf, nullptr);
         }
         if (deg_to_rad(candidate) == radians) return candidate;

@@ -64,6 +64,14 @@ std::string format_roundtrip(double value, std::string_view name = "value");
 // roughscope::Error naming `name` for NaN or infinity.
 std::string format_significant(double value, int digits, std::string_view name = "value");
 
+// Writes the "%.*g" text of a finite `value` (1 <= digits <= 17, C locale, "-0" kept: the bytes
+// std::snprintf writes) at `out`, which must have room for kSignificantBufferSize characters;
+// returns the end. Digits <= 15 of a normal number come from the shortest round-trip digits
+// (which are the correctly rounded ones at that precision, rounded once more unless they end on
+// an exact tie); everything else from std::to_chars with a precision.
+inline constexpr std::size_t kSignificantBufferSize = 32;
+char* write_significant(char* out, double value, int digits);
+
 // For error messages only: the shortest round-trip form, or `digits` significant digits when
 // digits > 0 — unless the rounded text has fewer significant digits than `digits` and differs
 // from the value by more than floating-point noise (relative 1e-14): 1.00000001 at 7 digits is

@@ -58,6 +58,16 @@ class OrenNayarTerms {
 
     std::size_t size() const { return p0_.size(); }
 
+    // The σ-only factors of A_k and B_k (file comment); σ ≥ 0 (checked).
+    struct Coefficients {
+        double C1 = 0.0, c2 = 0.0, c3 = 0.0, c4 = 0.0;
+    };
+    static Coefficients coefficients(double sigma_rad);
+    // A_k(σ) and B_k(σ) one geometry at a time (no N-sized buffer), the numbers components gives.
+    double term_a(std::size_t k, const Coefficients& c) const {
+        return p0_[k] * (c.C1 + c.c2 * g2_[k] + c.c3 * g3_[k]);
+    }
+    double term_b(std::size_t k, const Coefficients& c) const { return c.c4 * g4_[k]; }
     // A_k(σ) and B_k(σ) of the file comment (sizes size()); σ ≥ 0 (checked).
     void components(double sigma_rad, std::span<double> A, std::span<double> B) const;
     // out[k] = oren_nayar_radiance(geometry k, params); parameters checked as there.
