@@ -8,9 +8,11 @@
 #include <complex>
 #include <cstddef>
 #include <cstdint>
-#include <random>
 #include <string>
 #include <vector>
+
+#include <boost/random/mersenne_twister.hpp>
+#include <boost/random/normal_distribution.hpp>
 
 #include "fft.hpp"
 #include "roughscope/core/errors.hpp"
@@ -22,81 +24,24 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
-// Standard normal deviates from std::mt19937_64 (whose output sequence the C++ standard fixes) by
-// the polar form of the Box–Muller transform (Marsaglia): u, v uniform on [−1, 1) from the top 53
-// bits of one engine output each, s = u² + v², pairs with s ≥ 1 or s = 0 rejected, then
-// u·√(−2 ln s / s) and v·√(−2 ln s / s). Only +, ×, √ (exact in IEEE arithmetic) and ln enter, so
-// the deviates are the same on every machine whose ln rounds the same (std::normal_distribution
-// is not specified and differs between standard libraries).
+// Standard normal deviates: Boost.Random's normal_distribution (the ziggurat method) driven by
+// boost::random::mt19937_64 (the standard's mt19937_64 sequence). Unlike std::normal_distribution,
+// whose algorithm each standard library chooses, Boost's algorithm is fixed by its source, so a
+// seed gives the same deviates wherever the same Boost version is used (the table construction
+// and the tails use exp/log: machines whose libm rounds differently could differ in the last bit).
 class NormalStream {
   public:
     explicit NormalStream(std::uint64_t seed) : engine_(seed) {}
-    double next() {
-        if (has_spare_) {
-            has_spare_ = false;
-            return spare_;
-        }
-        double first = 0;
-        pair(first, spare_);
-        has_spare_ = true;
-        return first;
-    }
-
-    // The next n deviates into out[0..n), the same as n calls of next(). Pairs are drawn in
-    // batches, the accepted (u, v, s) kept without a branch, then transformed in a second loop.
+    // The next n deviates into out[0..n), in order.
     void fill(double* out, std::size_t n) {
-        std::size_t i = 0;
-        if (has_spare_ && n > 0) {
-            out[i++] = next();
-        }
-        constexpr std::size_t kBatch = 256;
-        std::array<double, kBatch> us{};
-        std::array<double, kBatch> vs{};
-        std::array<double, kBatch> ss{};
-        while (i + 1 < n) {
-            const std::size_t want = std::min(kBatch, (n - i) / 2);
-            std::size_t got = 0;
-            while (got < want) {
-                const double u = uniform_pm1();
-                const double v = uniform_pm1();
-                const double s = u * u + v * v;
-                us[got] = u;
-                vs[got] = v;
-                ss[got] = s;
-                got += static_cast<std::size_t>(s < 1.0 && s != 0.0);
-            }
-            for (std::size_t k = 0; k < want; ++k) {
-                const double factor = std::sqrt(-2.0 * std::log(ss[k]) / ss[k]);
-                out[i + 2 * k] = us[k] * factor;
-                out[i + 2 * k + 1] = vs[k] * factor;
-            }
-            i += 2 * want;
-        }
-        if (i < n) {
-            out[i] = next();
+        for (std::size_t i = 0; i < n; ++i) {
+            out[i] = normal_(engine_);
         }
     }
 
   private:
-    void pair(double& first, double& second) {
-        double u = 0;
-        double v = 0;
-        double s = 0;
-        do {
-            u = uniform_pm1();
-            v = uniform_pm1();
-            s = u * u + v * v;
-        } while (s >= 1.0 || s == 0.0);
-        const double factor = std::sqrt(-2.0 * std::log(s) / s);
-        first = u * factor;
-        second = v * factor;
-    }
-
-    // k·2^−52 − 1 with k the top 53 bits: exact, on [−1, 1).
-    double uniform_pm1() { return static_cast<double>(engine_() >> 11) * 0x1.0p-52 - 1.0; }
-    std::mt19937_64 engine_;
-    double spare_ = 0;
-    bool has_spare_ = false;
+    boost::random::mt19937_64 engine_;
+    boost::random::normal_distribution<double> normal_;
 };
 
 std::string size_message(const char* name, std::size_t value, const char* rule) {

@@ -132,26 +132,30 @@ TEST(Generate, SameSeedGivesTheSameBitsAndAnotherSeedAnotherSurface) {
 }
 
 TEST(Generate, PinnedValuesOfOneSeed) {
-    // The seed's noise stream (mt19937_64 + polar Box–Muller, row-major) and the filter, pinned:
-    // a change of either changes these values. Tolerance: FFT rounding on other machines.
+    // The seed's noise stream (mt19937_64 + Boost.Random's ziggurat normal_distribution, row-major)
+    // and the filter, pinned: a change of either changes these values. Tolerance: FFT rounding on
+    // other machines.
     const HeightMap m = generate_surface(options(Correlation::Exponential, 32, 16, 3, 2024));
-    const std::vector<std::pair<std::size_t, double>> pinned = {{0, 1.6103735394327587},
-                                                                {17, 0.62417543743131754},
-                                                                {300, -0.59949771843946709},
-                                                                {511, 0.37358736769728307}};
+    const std::vector<std::pair<std::size_t, double>> pinned = {{0, 0.39222810768880034},
+                                                                {17, -4.218513167400074},
+                                                                {300, -1.0896953039942694},
+                                                                {511, 1.5659781752686763}};
     for (const auto& [index, value] : pinned) {
         EXPECT_NEAR(m.heights_um[index], value, 1e-12) << "index " << index;
     }
 }
 
 void expect_ensemble_sigma_and_T(Correlation c) {
-    // 16 seeds of 256 × 256 points, T = 8 dx (L/T = 32).
-    constexpr std::size_t kSeeds = 16;
+    // Seeds 1..32 of 256 × 256 points, T = 8 dx (L/T = 32). The seed set is fixed, so the
+    // result is a fixed draw: with four comparisons at 3 standard errors a correct generator
+    // fails about 1 % of seed sets (seeds 100..131 give σ 3.0 standard errors high with the
+    // current noise stream, while seeds 100..499 give 1.5001 ± 0.0021).
+    constexpr std::size_t kSeeds = 32;
     const double T = 8;
     std::vector<double> sigmas;
     std::vector<double> lengths;
     for (std::size_t s = 0; s < kSeeds; ++s) {
-        const HeightMap m = generate_surface(options(c, 256, 256, T, 100 + s));
+        const HeightMap m = generate_surface(options(c, 256, 256, T, 1 + s));
         sigmas.push_back(rms(m));
         lengths.push_back(one_over_e_length(m));
     }
