@@ -1,14 +1,326 @@
-// Placeholder: implemented by the surface-generation work (see generate.hpp).
+// Random rough surfaces by Fourier filtering of white noise (generate.hpp). Method, and what is
+// exact and what is not: docs/surface-generation.md.
 #include "roughscope/surface/generate.hpp"
 
+#include <algorithm>
+#include <cmath>
+#include <complex>
+#include <cstddef>
+#include <cstdint>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "fft.hpp"
 #include "roughscope/core/errors.hpp"
+#include "roughscope/core/numbers.hpp"
 
 namespace roughscope::surface {
-HeightMap generate_surface(const GenerationOptions&) {
-    throw InvalidArgument("surface generation is not available yet");
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+// Standard normal deviates from std::mt19937_64 (whose output sequence the C++ standard fixes) by
+// the polar form of the Box–Muller transform (Marsaglia): u, v uniform on [−1, 1) from the top 53
+// bits of one engine output each, s = u² + v², pairs with s ≥ 1 or s = 0 rejected, then
+// u·√(−2 ln s / s) and v·√(−2 ln s / s). Only +, ×, √ (exact in IEEE arithmetic) and ln enter, so
+// the deviates are the same on every machine whose ln rounds the same (std::normal_distribution
+// is not specified and differs between standard libraries).
+class NormalStream {
+  public:
+    explicit NormalStream(std::uint64_t seed) : engine_(seed) {}
+    double next() {
+        if (has_spare_) {
+            has_spare_ = false;
+            return spare_;
+        }
+        double first = 0;
+        pair(first, spare_);
+        has_spare_ = true;
+        return first;
+    }
+
+    // The next n deviates into out[0..n).
+    void fill(double* out, std::size_t n) {
+        std::size_t i = 0;
+        if (has_spare_ && n > 0) {
+            out[i++] = next();
+        }
+        for (; i + 1 < n; i += 2) {
+            pair(out[i], out[i + 1]);
+        }
+        if (i < n) {
+            out[i] = next();
+        }
+    }
+
+  private:
+    void pair(double& first, double& second) {
+        double u = 0;
+        double v = 0;
+        double s = 0;
+        do {
+            u = uniform_pm1();
+            v = uniform_pm1();
+            s = u * u + v * v;
+        } while (s >= 1.0 || s == 0.0);
+        const double factor = std::sqrt(-2.0 * std::log(s) / s);
+        first = u * factor;
+        second = v * factor;
+    }
+
+    // k·2^−52 − 1 with k the top 53 bits: exact, on [−1, 1).
+    double uniform_pm1() { return static_cast<double>(engine_() >> 11) * 0x1.0p-52 - 1.0; }
+    std::mt19937_64 engine_;
+    double spare_ = 0;
+    bool has_spare_ = false;
+};
+
+std::string size_message(const char* name, std::size_t value, const char* rule) {
+    std::string message = "generation option ";
+    message.append(name).append(" = ").append(std::to_string(value)).append(" is invalid: ");
+    message.append(rule);
+    return message;
 }
-HeightMap generate_surface_from_psd(const std::function<double(double)>&,
-                                    const GenerationOptions&) {
-    throw InvalidArgument("surface generation is not available yet");
+
+// Everything but the correlation and T (which the PSD route does not use).
+void check_grid_options(const GenerationOptions& o) {
+    check::positive("generation option sigma_um", o.sigma_um, "um");
+    check::positive("generation option dx_um", o.dx_um, "um");
+    check::positive("generation option dy_um", o.dy_um, "um");
+    if (o.nx < 2 || o.nx > kMaxHeightMapPoints) {
+        throw InvalidArgument(size_message("nx", o.nx, "it must be an integer in [2, 2^28]"));
+    }
+    if (o.ny < 1 || o.ny > kMaxHeightMapPoints / o.nx) {
+        throw InvalidArgument(
+            size_message("ny", o.ny, "it must be >= 1 (1 = a profile) with nx·ny <= 2^28 points"));
+    }
 }
+
+void check_options(const GenerationOptions& o) {
+    if (o.correlation != Correlation::Gaussian && o.correlation != Correlation::Exponential) {
+        throw InvalidArgument(
+            "generation option correlation is invalid: it must be gaussian or "
+            "exponential");
+    }
+    check::positive("generation option T_um", o.T_um, "um");
+    check_grid_options(o);
+}
+
+HeightMap empty_map(const GenerationOptions& o) {
+    HeightMap map;
+    map.nx = o.nx;
+    map.ny = o.ny;
+    map.dx_um = o.dx_um;
+    map.dy_um = o.dy_um;
+    map.heights_um.resize(o.nx * o.ny);
+    return map;
+}
+
+// Signed frequency (or minimal-image lag) index of j on a circle of n points: j or j − n.
+double signed_index(std::size_t j, std::size_t n) {
+    return j <= n / 2 ? static_cast<double>(j) : static_cast<double>(j) - static_cast<double>(n);
+}
+
+// Offsets u + m·period (m integer) within r_max of 0: the periodic images of lag u that matter.
+std::vector<double> images_within(double u, double period, double r_max, bool periodic) {
+    std::vector<double> out;
+    if (!periodic) {
+        out.push_back(u);
+        return out;
+    }
+    const auto first = static_cast<long>(std::ceil((-r_max - u) / period));
+    const auto last = static_cast<long>(std::floor((r_max - u) / period));
+    for (long m = first; m <= last; ++m) {
+        out.push_back(u + static_cast<double>(m) * period);
+    }
+    return out;
+}
+
+// Fills f's real array with the target ACF C(τ) sampled on the lattice and periodised with the
+// map's periods Lx = nx dx, Ly = ny dy: C_p(τ) = Σ_{m,n} C(τ + (m Lx, n Ly)), normalised to
+// C_p(0) = 1 (it exceeds 1 by the images' overlap, e.g. by 2e^{−L/T} for an exponential ACF).
+// Images farther than r_max, where C < 1e−18, are left out.
+void fill_periodised_acf(const GenerationOptions& o, fft::RealToComplex& f) {
+    const bool gaussian = o.correlation == Correlation::Gaussian;
+    const double T = o.T_um;
+    constexpr double kCutoff = 41.5;  // e^{−41.5} ≈ 1e−18
+    const double r_max = gaussian ? T * std::sqrt(kCutoff) : T * kCutoff;
+    const double lx = static_cast<double>(o.nx) * o.dx_um;
+    const double ly = static_cast<double>(o.ny) * o.dy_um;
+    const bool profile = o.ny == 1;
+    // C_p depends on |x| and |y| only: compute the quadrant jx ≤ nx/2, jy ≤ ny/2 and mirror it.
+    const std::size_t hx = o.nx / 2;
+    const std::size_t hy = o.ny / 2;
+    std::vector<std::vector<double>> x_images(hx + 1);
+    for (std::size_t jx = 0; jx <= hx; ++jx) {
+        x_images[jx] = images_within(static_cast<double>(jx) * o.dx_um, lx, r_max, true);
+    }
+    if (gaussian) {
+        // exp(−(x² + y²)/T²) = exp(−x²/T²) exp(−y²/T²): C_p is the product of the 1-D sums.
+        const auto periodised_1d = [&](const std::vector<double>& images) {
+            double sum = 0;
+            for (const double u : images) {
+                sum += std::exp(-u * u / (T * T));
+            }
+            return sum;
+        };
+        std::vector<double> gx(hx + 1);
+        for (std::size_t jx = 0; jx <= hx; ++jx) {
+            gx[jx] = periodised_1d(x_images[jx]);
+        }
+        for (std::size_t jy = 0; jy <= hy; ++jy) {
+            const double gy = periodised_1d(
+                images_within(static_cast<double>(jy) * o.dy_um, ly, r_max, !profile));
+            double* row = f.real_row(jy);
+            for (std::size_t jx = 0; jx <= hx; ++jx) {
+                row[jx] = gx[jx] * gy;
+            }
+        }
+    } else {
+        for (std::size_t jy = 0; jy <= hy; ++jy) {
+            const std::vector<double> y_images =
+                images_within(static_cast<double>(jy) * o.dy_um, ly, r_max, !profile);
+            double* row = f.real_row(jy);
+            for (std::size_t jx = 0; jx <= hx; ++jx) {
+                double sum = 0;
+                for (const double xm : x_images[jx]) {
+                    for (const double yn : y_images) {
+                        const double r2 = xm * xm + yn * yn;
+                        if (r2 <= r_max * r_max) {
+                            sum += std::exp(-std::sqrt(r2) / T);
+                        }
+                    }
+                }
+                row[jx] = sum;
+            }
+        }
+    }
+    const double c0 = f.real_row(0)[0];
+    for (std::size_t jy = 0; jy <= hy; ++jy) {
+        double* row = f.real_row(jy);
+        for (std::size_t jx = 0; jx <= hx; ++jx) {
+            row[jx] /= c0;
+        }
+        for (std::size_t jx = hx + 1; jx < o.nx; ++jx) {
+            row[jx] = row[o.nx - jx];
+        }
+    }
+    for (std::size_t jy = hy + 1; jy < o.ny; ++jy) {
+        std::copy_n(f.real_row(o.ny - jy), o.nx, f.real_row(jy));
+    }
+}
+
+// Filters white noise with the half-spectrum `gain` (ny × (nx/2 + 1), the DFT gain including the
+// 1/(nx ny) of the inverse transform): z = IDFT(gain · DFT(w)), w i.i.d. N(0, 1) drawn in
+// row-major order from the seed.
+HeightMap filter_noise(const GenerationOptions& o, const std::vector<double>& gain,
+                       fft::RealToComplex& f) {
+    NormalStream normal(o.seed);
+    for (std::size_t iy = 0; iy < o.ny; ++iy) {
+        normal.fill(f.real_row(iy), o.nx);
+    }
+    f.forward();
+    const std::size_t cols = f.spectrum_cols();
+    for (std::size_t r = 0; r < o.ny; ++r) {
+        std::complex<double>* row = f.spectrum_row(r);
+        const double* g = gain.data() + r * cols;
+        for (std::size_t k = 0; k < cols; ++k) {
+            row[k] *= g[k];
+        }
+    }
+    f.backward();
+    HeightMap map = empty_map(o);
+    for (std::size_t iy = 0; iy < o.ny; ++iy) {
+        std::copy_n(f.real_row(iy), o.nx, map.heights_um.data() + iy * o.nx);
+    }
+    return map;
+}
+
+}  // namespace
+
+HeightMap generate_surface(const GenerationOptions& options) {
+    check_options(options);
+    const GenerationOptions& o = options;
+    fft::RealToComplex f(o.ny, o.nx, fft::Layout::plane);
+    // S = DFT(C_p) is real (C_p is even) and ≥ 0 up to rounding (C_p is positive definite), so the
+    // gain σ√S/(nx ny) gives the periodic surface the ensemble ACF σ² C_p on the lattice.
+    fill_periodised_acf(o, f);
+    f.forward();
+    const std::size_t cols = f.spectrum_cols();
+    const double points = static_cast<double>(o.nx) * static_cast<double>(o.ny);
+    std::vector<double> gain(o.ny * cols);
+    for (std::size_t r = 0; r < o.ny; ++r) {
+        const std::complex<double>* row = f.spectrum_row(r);
+        for (std::size_t k = 0; k < cols; ++k) {
+            gain[r * cols + k] = o.sigma_um * std::sqrt(std::max(row[k].real(), 0.0)) / points;
+        }
+    }
+    HeightMap map = filter_noise(o, gain, f);
+    map.title = "roughscope generated surface (";
+    map.title.append(to_string(o.correlation))
+        .append(" correlation, sigma_um = ")
+        .append(format_message(o.sigma_um))
+        .append(", T_um = ")
+        .append(format_message(o.T_um))
+        .append(", seed = ")
+        .append(std::to_string(o.seed))
+        .append(")");
+    return map;
+}
+
+HeightMap generate_surface_from_psd(const std::function<double(double k_rad_per_um)>& psd,
+                                    const GenerationOptions& options) {
+    if (!psd) {
+        throw InvalidArgument("generation from a PSD: the PSD function is empty");
+    }
+    check_grid_options(options);
+    const GenerationOptions& o = options;
+    fft::RealToComplex f(o.ny, o.nx, fft::Layout::plane);
+    const std::size_t cols = f.spectrum_cols();
+    const double dkx = 2 * kPi / (static_cast<double>(o.nx) * o.dx_um);
+    const double dky = 2 * kPi / (static_cast<double>(o.ny) * o.dy_um);
+    // W at the lattice frequencies of the half spectrum; the total Σ W over the full spectrum
+    // (the half counted twice except at kx = 0 and the Nyquist column).
+    std::vector<double> gain(o.ny * cols);
+    double total = 0;
+    for (std::size_t r = 0; r < o.ny; ++r) {
+        const double ky = signed_index(r, o.ny) * dky;
+        for (std::size_t k = 0; k < cols; ++k) {
+            const double kabs = std::hypot(static_cast<double>(k) * dkx, ky);
+            const double w = psd(kabs);
+            if (!(std::isfinite(w) && w >= 0)) {
+                std::string message = "generation from a PSD: W(k) = ";
+                message.append(format_message(w))
+                    .append(" at k = ")
+                    .append(format_message(kabs))
+                    .append(
+                        " rad/um is invalid: the PSD must be finite and >= 0 at every "
+                        "lattice frequency");
+                throw InvalidArgument(message);
+            }
+            gain[r * cols + k] = w;
+            total += (k != 0 && 2 * k != o.nx) ? 2 * w : w;
+        }
+    }
+    if (!(total > 0) || !std::isfinite(total)) {
+        throw InvalidArgument(
+            "generation from a PSD: W(k) is 0 at every lattice frequency, so "
+            "no surface of RMS height sigma_um > 0 has it");
+    }
+    // Ensemble variance (1/N) Σ |gain·N|² = σ²: gain = σ √(W / Σ W) · √N / N.
+    const double points = static_cast<double>(o.nx) * static_cast<double>(o.ny);
+    for (double& g : gain) {
+        g = o.sigma_um * std::sqrt(g / total) / std::sqrt(points);
+    }
+    HeightMap map = filter_noise(o, gain, f);
+    map.title = "roughscope generated surface (given PSD, sigma_um = ";
+    map.title.append(format_message(o.sigma_um))
+        .append(", seed = ")
+        .append(std::to_string(o.seed))
+        .append(")");
+    return map;
+}
+
 }  // namespace roughscope::surface

@@ -94,8 +94,45 @@ struct SurfaceStatistics {
     // Curves for the report (empty unless StatisticsOptions::keep_curves).
     Curve acf_x, acf_y, acf_radial;
     Curve psd_x, psd_radial;
+
+    // Areal RMS gradient Sdq = sqrt(<(∂z/∂x)²> + <(∂z/∂y)²>) by finite differences (maps only;
+    // for an isotropic Gaussian surface Sdq = √2 · m, while rms_slope, along x, equals m).
+    std::optional<double> Sdq;
 };
 
 SurfaceStatistics surface_statistics(const HeightMap& map, const StatisticsOptions& options = {});
+
+// ---- The pieces of surface_statistics, for callers that need one of them -----------------------
+// The height moments above in one pass over the map (no levelling): Sq, Sa, Ssk, Sku, Sp, Sv, Sz.
+// InvalidArgument when the map has no valid point.
+struct HeightMoments {
+    std::size_t points = 0;
+    double sigma_um = 0, Sa_um = 0, Ssk = 0, Sku = 0, Sp_um = 0, Sv_um = 0, Sz_um = 0;
+};
+HeightMoments height_moments(const HeightMap& map);
+
+// Normalised ACF along x (rows) or along y (columns), the sums pooled over every row (column):
+// C_j = (S_j / n_j) / (S_0 / n_0) (unbiased) or S_j / S_0 (biased), S_j = Σ z_k z_{k+j} over the
+// n_j pairs of valid points j samples apart. x = j·dx (dy) for the lags with at least one pair.
+// Empty when S_0 = 0 (every valid height is zero). acf_along_y of a profile is empty.
+Curve acf_along_x(const HeightMap& levelled, AcfEstimator estimator);
+Curve acf_along_y(const HeightMap& levelled, AcfEstimator estimator);
+
+// The lag where the ACF first falls to 1/e, interpolated linearly between the two lags around
+// the crossing; none when the curve never falls to 1/e.
+std::optional<double> correlation_length_1e(const Curve& acf);
+
+// Least-squares fits of C = exp(−τ²/T²) and C = exp(−|τ|/T) to the points of `acf` with
+// τ ≤ max_lag_um; AIC = n ln(RSS/n) + 2k (k = 1 for both) names the better model. A fit needs 3
+// points; InvalidArgument when max_lag_um is not > 0 or x and y differ in size.
+struct AcfModelFit {
+    std::size_t points = 0;
+    std::optional<double> T_gaussian_um;
+    std::optional<double> T_exponential_um;
+    double aic_gaussian = 0;
+    double aic_exponential = 0;
+    std::optional<Correlation> better;
+};
+AcfModelFit fit_acf_models(const Curve& acf, double max_lag_um);
 
 }  // namespace roughscope::surface

@@ -1,0 +1,79 @@
+// Internal: autocorrelation sums of many lines (rows, columns, sub-profiles) of a height map,
+// by zero-padded FFT (fft_rows.hpp), pooled over the lines and optionally kept per line; shared
+// by acf.cpp and statistics.cpp.
+#pragma once
+
+#include <cstddef>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "roughscope/surface/statistics.hpp"
+
+namespace roughscope::surface::detail {
+
+// Concatenation by append (avoids GCC 12's false -Wrestrict on "literal" + std::string).
+template <class... Parts>
+std::string cat(const Parts&... parts) {
+    std::string s;
+    ((s += parts), ...);
+    return s;
+}
+
+class RowFft;
+
+// The normalised C_j from the sums S_j and pair counts n_j (C_0 = 1); NaN where n_j = 0.
+double acf_value(const std::vector<double>& sums, const std::vector<double>& pairs, std::size_t j,
+                 AcfEstimator estimator);
+
+// The 1/e crossing in samples from the sums (linear interpolation between lags), or none.
+// `pairs` null: every pair present (n_j = n − j).
+std::optional<double> crossing_1e_samples(const double* sums, const double* pairs, std::size_t n,
+                                          AcfEstimator estimator);
+std::optional<double> crossing_1e_samples(const std::vector<double>& sums,
+                                          const std::vector<double>& pairs, AcfEstimator estimator);
+
+// Adds lines of `length` samples (NaN = missing) one at a time:
+//   sums[j]  = Σ_lines Σ_k z_k z_{k+j}     over valid pairs,
+//   pairs[j] = Σ_lines (number of valid pairs j apart),
+// and, when per_line is set, each line's rms height and 1/e crossing (samples).
+class LineAcf {
+  public:
+    LineAcf(std::size_t length, AcfEstimator estimator, bool per_line);
+    ~LineAcf();
+    LineAcf(const LineAcf&) = delete;
+    LineAcf& operator=(const LineAcf&) = delete;
+    LineAcf(LineAcf&&) = delete;
+    LineAcf& operator=(LineAcf&&) = delete;
+
+    void add(const double* z);
+    // Pooled sums (call once, after the last add).
+    void finish();
+
+    std::size_t length() const { return length_; }
+    std::vector<double> sums;
+    std::vector<double> pairs;
+    std::vector<double> line_rms_um;         // lines with a valid point
+    std::vector<double> line_crossing;       // lines whose ACF crosses 1/e (samples)
+    std::size_t lines_without_crossing = 0;  // lines with data whose ACF never reaches 1/e
+
+  private:
+    void record_line(double sum_sq, std::size_t valid, const double* line_sums,
+                     const double* line_pairs);
+    std::size_t length_;
+    AcfEstimator estimator_;
+    bool per_line_;
+    std::size_t full_lines_ = 0;  // lines without a missing point: pairs = length − j
+    std::unique_ptr<RowFft> fft_;
+    std::vector<double> line_sums_, line_pairs_;
+};
+
+// Row (x) and column (y) sums of a map.
+void accumulate_rows(const HeightMap& map, LineAcf& acc);
+void accumulate_columns(const HeightMap& map, LineAcf& acc);
+
+// The curve C(j·spacing) for the lags with pairs; empty when S_0 = 0.
+Curve acf_curve(const LineAcf& acc, AcfEstimator estimator, double spacing_um);
+
+}  // namespace roughscope::surface::detail

@@ -1,0 +1,102 @@
+// Internal FFTW3 helper (fft.hpp).
+#include "fft.hpp"
+
+#include <cassert>
+#include <cstring>
+#include <mutex>
+#include <new>
+
+#include <fftw3.h>
+
+namespace roughscope::surface::fft {
+
+namespace {
+
+// FFTW's planner and fftw_destroy_plan share global state: one lock for both.
+std::mutex& planner_mutex() {
+    static std::mutex m;
+    return m;
+}
+
+fftw_plan as_plan(void* p) { return static_cast<fftw_plan>(p); }
+
+}  // namespace
+
+std::size_t good_size(std::size_t minimum) {
+    for (std::size_t n = minimum < 1 ? 1 : minimum;; ++n) {
+        std::size_t m = n;
+        for (const std::size_t p : {2U, 3U, 5U, 7U}) {
+            while (m % p == 0) {
+                m /= p;
+            }
+        }
+        if (m == 1) {
+            return n;
+        }
+    }
+}
+
+RealToComplex::RealToComplex(std::size_t rows, std::size_t cols, Layout layout)
+    : rows_(rows), cols_(cols) {
+    assert(rows >= 1 && cols >= 1);
+    const std::size_t doubles = rows * 2 * spectrum_cols();
+    data_ = static_cast<double*>(fftw_malloc(doubles * sizeof(double)));
+    if (data_ == nullptr) {
+        throw std::bad_alloc();
+    }
+    auto* spectrum = reinterpret_cast<fftw_complex*>(data_);
+    const int n_rows = static_cast<int>(rows);
+    const int n_cols = static_cast<int>(cols);
+    const unsigned flags = FFTW_ESTIMATE;
+    const std::lock_guard<std::mutex> lock(planner_mutex());
+    if (layout == Layout::plane) {
+        forward_plan_ = fftw_plan_dft_r2c_2d(n_rows, n_cols, data_, spectrum, flags);
+        backward_plan_ = fftw_plan_dft_c2r_2d(n_rows, n_cols, spectrum, data_, flags);
+    } else {
+        const int real_stride = 2 * static_cast<int>(spectrum_cols());
+        const int complex_stride = static_cast<int>(spectrum_cols());
+        forward_plan_ = fftw_plan_many_dft_r2c(1, &n_cols, n_rows, data_, nullptr, 1, real_stride,
+                                               spectrum, nullptr, 1, complex_stride, flags);
+        backward_plan_ =
+            fftw_plan_many_dft_c2r(1, &n_cols, n_rows, spectrum, nullptr, 1, complex_stride, data_,
+                                   nullptr, 1, real_stride, flags);
+    }
+    if (forward_plan_ == nullptr || backward_plan_ == nullptr) {
+        if (forward_plan_ != nullptr) {
+            fftw_destroy_plan(as_plan(forward_plan_));
+        }
+        if (backward_plan_ != nullptr) {
+            fftw_destroy_plan(as_plan(backward_plan_));
+        }
+        fftw_free(data_);
+        throw std::bad_alloc();
+    }
+}
+
+RealToComplex::~RealToComplex() {
+    {
+        const std::lock_guard<std::mutex> lock(planner_mutex());
+        fftw_destroy_plan(as_plan(forward_plan_));
+        fftw_destroy_plan(as_plan(backward_plan_));
+    }
+    fftw_free(data_);
+}
+
+std::complex<double>* RealToComplex::spectrum_row(std::size_t r) {
+    // FFTW guarantees fftw_complex and std::complex<double> share their layout.
+    return reinterpret_cast<std::complex<double>*>(data_) + r * spectrum_cols();
+}
+
+const std::complex<double>* RealToComplex::spectrum_row(std::size_t r) const {
+    return reinterpret_cast<const std::complex<double>*>(data_) + r * spectrum_cols();
+}
+
+void RealToComplex::fill_zero() {
+    std::memset(data_, 0, rows_ * 2 * spectrum_cols() * sizeof(double));
+}
+
+void RealToComplex::forward() { fftw_execute(as_plan(forward_plan_)); }
+
+void RealToComplex::backward() { fftw_execute(as_plan(backward_plan_)); }
+
+}  // namespace roughscope::surface::fft
