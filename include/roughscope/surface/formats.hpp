@@ -55,6 +55,9 @@ struct HeightReadOptions {
     std::optional<std::size_t> ny;
     RawSampleType raw_type = RawSampleType::float64;
     bool raw_big_endian = false;
+    // x3p: verify the MD5 checksums a file states (point data, validity bitmap, main.xml); false
+    // reads a file whose checksums are stale. An absent checksum is never an error.
+    bool x3p_verify_checksums = true;
 };
 
 struct HeightWriteOptions {

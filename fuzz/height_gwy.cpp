@@ -1,0 +1,14 @@
+// Fuzz target: the gwy height-map reader (formats::decode_gwy), exactly as read_height_map()
+// drives it with a file's bytes. Seeds: fuzz/corpus/height_gwy/ (fuzz/make_height_seeds_x3p.py).
+#include <string>
+
+#include "fuzz_target.hpp"
+#include "roughscope/surface/formats.hpp"
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+    roughscope::fuzz::expect_only_roughscope_errors([&] {
+        (void)roughscope::surface::formats::decode_gwy(roughscope::fuzz::as_text(data, size),
+                                                       "fuzz.gwy", {});
+    });
+    return 0;
+}
