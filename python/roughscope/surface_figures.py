@@ -105,6 +105,10 @@ def stats_figure(doc, path):
         if doc.get("T_um"):
             ax.axvline(doc["T_um"], color="C2", ls=":", lw=1,
                        label=f"T (1/e) = {doc['T_um']:.4g} µm")
+        # The ACF at lags near the map's length rests on few pairs (noisy): show ~6 T.
+        scale = max([v for v in (doc.get("T_um"), tg, te) if v] or [0.0])
+        if scale > 0 and tau.size and 6 * scale < np.nanmax(tau):
+            ax.set_xlim(0.0, 6 * scale)
         ax.set_xlabel("lag τ (µm)")
         ax.set_ylabel("C(τ)")
         ax.set_title("autocorrelation")
