@@ -74,14 +74,15 @@ void subtract_row_lines(HeightMap& map) {
 void subtract_polynomial(HeightMap& map, int order) {
     const bool profile = map.is_profile();
     struct Term {
-        int i, j;
+        std::size_t i, j;  // powers of u and v
     };
     std::vector<Term> terms;
-    for (int total = 0; total <= order; ++total)
-        for (int j = 0; j <= (profile ? 0 : total); ++j) terms.push_back({total - j, j});
+    const auto max_order = static_cast<std::size_t>(order);
+    for (std::size_t total = 0; total <= max_order; ++total)
+        for (std::size_t j = 0; j <= (profile ? 0 : total); ++j) terms.push_back({total - j, j});
     const auto nt = static_cast<Eigen::Index>(terms.size());
 
-    const int max_pow = 2 * order;
+    const std::size_t max_pow = 2 * max_order;
     Eigen::MatrixXd normal = Eigen::MatrixXd::Zero(nt, nt);
     Eigen::VectorXd rhs = Eigen::VectorXd::Zero(nt);
     std::size_t count = 0;
@@ -100,9 +101,9 @@ void subtract_polynomial(HeightMap& map, int order) {
             ++count;
             const double u = u_of[ix];
             double p = 1;
-            for (int a = 0; a <= max_pow; ++a) {
-                pu[static_cast<std::size_t>(a)] += p;
-                if (a <= order) puz[static_cast<std::size_t>(a)] += p * z;
+            for (std::size_t a = 0; a <= max_pow; ++a) {
+                pu[a] += p;
+                if (a <= max_order) puz[a] += p * z;
                 p *= u;
             }
         }
@@ -112,11 +113,10 @@ void subtract_polynomial(HeightMap& map, int order) {
         for (std::size_t b = 1; b < vpow.size(); ++b) vpow[b] = vpow[b - 1] * v;
         for (Eigen::Index r = 0; r < nt; ++r) {
             const Term tr = terms[static_cast<std::size_t>(r)];
-            rhs(r) += vpow[static_cast<std::size_t>(tr.j)] * puz[static_cast<std::size_t>(tr.i)];
+            rhs(r) += vpow[tr.j] * puz[tr.i];
             for (Eigen::Index c = 0; c < nt; ++c) {
                 const Term tc = terms[static_cast<std::size_t>(c)];
-                normal(r, c) += vpow[static_cast<std::size_t>(tr.j + tc.j)] *
-                                pu[static_cast<std::size_t>(tr.i + tc.i)];
+                normal(r, c) += vpow[tr.j + tc.j] * pu[tr.i + tc.i];
             }
         }
     }
@@ -140,7 +140,7 @@ void subtract_polynomial(HeightMap& map, int order) {
         row_coef.fill(0);
         for (Eigen::Index t = 0; t < nt; ++t) {
             const Term term = terms[static_cast<std::size_t>(t)];
-            row_coef[static_cast<std::size_t>(term.i)] += c(t) * std::pow(v, term.j);
+            row_coef[term.i] += c(t) * std::pow(v, static_cast<double>(term.j));
         }
         double* row = &map.heights_um[iy * map.nx];
         for (std::size_t ix = 0; ix < map.nx; ++ix) {
