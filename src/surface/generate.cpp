@@ -3,6 +3,7 @@
 #include "roughscope/surface/generate.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <complex>
 #include <cstddef>
@@ -41,14 +42,35 @@ class NormalStream {
         return first;
     }
 
-    // The next n deviates into out[0..n).
+    // The next n deviates into out[0..n), the same as n calls of next(). Pairs are drawn in
+    // batches, the accepted (u, v, s) kept without a branch, then transformed in a second loop.
     void fill(double* out, std::size_t n) {
         std::size_t i = 0;
         if (has_spare_ && n > 0) {
             out[i++] = next();
         }
-        for (; i + 1 < n; i += 2) {
-            pair(out[i], out[i + 1]);
+        constexpr std::size_t kBatch = 256;
+        std::array<double, kBatch> us{};
+        std::array<double, kBatch> vs{};
+        std::array<double, kBatch> ss{};
+        while (i + 1 < n) {
+            const std::size_t want = std::min(kBatch, (n - i) / 2);
+            std::size_t got = 0;
+            while (got < want) {
+                const double u = uniform_pm1();
+                const double v = uniform_pm1();
+                const double s = u * u + v * v;
+                us[got] = u;
+                vs[got] = v;
+                ss[got] = s;
+                got += static_cast<std::size_t>(s < 1.0 && s != 0.0);
+            }
+            for (std::size_t k = 0; k < want; ++k) {
+                const double factor = std::sqrt(-2.0 * std::log(ss[k]) / ss[k]);
+                out[i + 2 * k] = us[k] * factor;
+                out[i + 2 * k + 1] = vs[k] * factor;
+            }
+            i += 2 * want;
         }
         if (i < n) {
             out[i] = next();

@@ -76,8 +76,10 @@ void check_acf(const Acf2d& acf) {
 
 // C at fractional lag (ux, uy) in lag units (bilinear); NaN outside the lag grid.
 double acf_bilinear(const Acf2d& acf, double ux, double uy) {
-    const auto half_x = static_cast<double>(acf.nx / 2);
-    const auto half_y = static_cast<double>(acf.ny / 2);
+    const std::size_t centre_x = acf.nx / 2;  // index of lag 0
+    const std::size_t centre_y = acf.ny / 2;
+    const auto half_x = static_cast<double>(centre_x);
+    const auto half_y = static_cast<double>(centre_y);
     const double gx = ux + half_x;
     const double gy = uy + half_y;
     if (gx < 0 || gy < 0 || gx > static_cast<double>(acf.nx - 1) ||
@@ -309,8 +311,10 @@ Curve psd_radial(const HeightMap& levelled) {
     const double dfx = 1.0 / levelled.length_x_um();
     const double dfy = 1.0 / levelled.length_y_um();
     const double width = std::min(dfx, dfy);
+    const std::size_t nyquist_x = nx / 2;  // largest |frequency index| along x and y
+    const std::size_t nyquist_y = ny / 2;
     const double f_max =
-        std::hypot(static_cast<double>(nx / 2) * dfx, static_cast<double>(ny / 2) * dfy);
+        std::hypot(static_cast<double>(nyquist_x) * dfx, static_cast<double>(nyquist_y) * dfy);
     const auto rings = static_cast<std::size_t>(std::floor(f_max / width + 0.5)) + 1;
     std::vector<double> sum(rings, 0.0);
     std::vector<double> count(rings, 0.0);

@@ -1,8 +1,9 @@
 // Random rough surfaces of known statistics (paper §3.1): Gaussian height distribution with
 // Gaussian C(τ) = exp(−τ²/T²) or exponential C(τ) = exp(−|τ|/T) correlation (or any given
 // isotropic PSD), made by filtering white noise in the Fourier domain (FFTW3). The surfaces are
-// periodic; the ensemble ACF equals the target on the lattice; a seed gives the same surface on
-// every run and machine. Method and its exactness: docs/surface.md.
+// periodic; the ensemble ACF equals the target (periodised) on the lattice; a seed gives the same
+// surface bit for bit on every run, and to FFT rounding (~1e−15) on other machines. Method and what
+// is exact: docs/surface-generation.md.
 #pragma once
 
 #include <cstddef>

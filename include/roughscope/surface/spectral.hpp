@@ -2,7 +2,7 @@
 // wrap-around), its radial average, the ISO 25178-2 texture parameters Sal and Str, and the 1-D
 // and radially averaged 2-D power spectral density. Inputs are levelled maps (statistics.hpp);
 // missing points count as absent (their products are left out and the normalisation counts only
-// valid pairs). Definitions: docs/surface.md.
+// valid pairs). Definitions: docs/surface-generation.md.
 #pragma once
 
 #include <cstddef>
@@ -27,6 +27,8 @@ struct Acf2d {
     }
 };
 
+// C = NaN at a lag without any pair of valid points. InvalidArgument for a malformed map or one
+// whose heights are all 0 (σ = 0: no ACF).
 Acf2d acf_2d(const HeightMap& levelled, AcfEstimator estimator);
 // Average of C over rings of width min(dx, dy); x = τ (µm).
 Curve radial_acf(const Acf2d& acf);
@@ -38,7 +40,9 @@ struct TextureParameters {
 TextureParameters texture_parameters(const Acf2d& acf, double s = 0.2);
 
 // One-sided PSD along x averaged over rows, and the radially averaged 2-D PSD; x = spatial
-// frequency (1/µm), normalised so that the integral of the PSD over frequency is σ².
+// frequency (1/µm), normalised so that the integral of the PSD over frequency is σ²
+// (σ² = (1/N_valid) Σ z²): Σ_k W(f_k) Δf for psd_x, ∫ W(f) 2πf df over the frequency plane for
+// psd_radial. Missing points are zero-filled. psd_radial throws InvalidArgument for a profile.
 Curve psd_x(const HeightMap& levelled);
 Curve psd_radial(const HeightMap& levelled);
 

@@ -253,6 +253,24 @@ TEST(Generate, EnsembleAveragedPeriodicAcfIsThePeriodisedTargetOnTheLattice) {
     expect_periodic_ensemble_acf(Correlation::Exponential, 24, 1, 0.5, 1.0, 6.0);
 }
 
+TEST(Generate, FittedCorrelationTypeIsTheTrueOneInNinetyPercentOfSeedsAtLOverT128) {
+    // surface_statistics (plane levelling, unbiased ACF) names the better of the Gaussian and
+    // exponential fits by AIC; 1024 × 64 points with T = 8 dx give L/T = 128 along the rows.
+    constexpr int kSeeds = 20;
+    for (const Correlation truth : {Correlation::Gaussian, Correlation::Exponential}) {
+        int right = 0;
+        for (int s = 0; s < kSeeds; ++s) {
+            const HeightMap m =
+                generate_surface(options(truth, 1024, 64, 8, 500 + static_cast<std::uint64_t>(s)));
+            StatisticsOptions so;
+            so.keep_curves = false;
+            const SurfaceStatistics st = surface_statistics(m, so);
+            right += st.correlation == truth ? 1 : 0;
+        }
+        EXPECT_GE(right, 18) << "of " << kSeeds << " seeds, true correlation " << to_string(truth);
+    }
+}
+
 TEST(Generate, FromTheGaussianPsdGivesTheGaussianCorrelationSurface) {
     // The 2-D spectrum of exp(−r²/T²) is ∝ exp(−k²T²/4); with T = 6 dx its aliases and the
     // periodic images are below 1e−15, so both routes filter the same noise by the same gain, up to
