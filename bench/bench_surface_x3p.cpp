@@ -8,8 +8,13 @@
 //        x3p/raw_memcpy/<n>        baseline: memcpy of the 8·n² data bytes into a new buffer
 //        x3p/raw_md5/<n>           baseline: one MD5 pass over the 8·n² bytes (the checksum
 //                                  ISO 5436-2 requires a reader to verify)
+//        x3p/decode_deflated/<n>   the same file with data.bin deflated (as instruments write
+//                                  it); its counter time_vs_inflate is the ratio to
+//        x3p/raw_inflate/<n>       baseline: libzip's decompression of that data.bin alone
 // The counters time_vs_memcpy and time_vs_md5 of x3p/decode are its ratios to the baselines,
-// timed in the same run. n = 4096 by default; n = 256 is registered for the smoke run.
+// timed in the same run. n = 4096 and 256 for the stored file; the deflated variant runs at
+// n = 1024 and 256 (deflating 128 MiB to build its input would dominate the smoke run, and the
+// ratio to inflate does not depend on n).
 #include <chrono>
 #include <cmath>
 #include <cstring>
@@ -18,6 +23,7 @@
 
 #include <benchmark/benchmark.h>
 #include <openssl/evp.h>
+#include <zip.h>
 
 #include "roughscope/surface/formats.hpp"
 #include "roughscope/surface/height_map.hpp"
@@ -39,6 +45,69 @@ const std::string& x3p_bytes(std::size_t n) {
         cached_n = n;
     }
     return cached;
+}
+
+// `stored` (an x3p of encode_x3p) with every member deflated, by plain libzip calls.
+std::string deflated_copy(const std::string& stored) {
+    zip_error_t error;
+    zip_error_init(&error);
+    zip_t* in = zip_open_from_source(
+        zip_source_buffer_create(stored.data(), stored.size(), 0, &error), ZIP_RDONLY, &error);
+    zip_source_t* buffer = zip_source_buffer_create(nullptr, 0, 0, &error);
+    zip_source_keep(buffer);
+    zip_t* out = zip_open_from_source(buffer, ZIP_TRUNCATE, &error);
+    std::vector<std::string> contents;
+    contents.reserve(8);
+    for (zip_int64_t i = 0; i < zip_get_num_entries(in, 0); ++i) {
+        const auto index = static_cast<zip_uint64_t>(i);
+        zip_stat_t st;
+        zip_stat_index(in, index, 0, &st);
+        std::string& data = contents.emplace_back(st.size, '\0');
+        zip_file_t* f = zip_fopen_index(in, index, 0);
+        zip_fread(f, data.data(), data.size());
+        zip_fclose(f);
+        const zip_int64_t added =
+            zip_file_add(out, st.name, zip_source_buffer(out, data.data(), data.size(), 0), 0);
+        zip_set_file_compression(out, static_cast<zip_uint64_t>(added), ZIP_CM_DEFLATE, 1);
+    }
+    zip_close(out);
+    zip_discard(in);
+    zip_stat_t st;
+    zip_source_stat(buffer, &st);
+    zip_source_open(buffer);
+    std::string bytes(st.size, '\0');
+    zip_source_read(buffer, bytes.data(), bytes.size());
+    zip_source_close(buffer);
+    zip_source_free(buffer);
+    zip_error_fini(&error);
+    return bytes;
+}
+
+const std::string& deflated_bytes(std::size_t n) {
+    static std::size_t cached_n = 0;
+    static std::string cached;
+    if (cached_n != n) {
+        cached = deflated_copy(x3p_bytes(n));
+        cached_n = n;
+    }
+    return cached;
+}
+
+// Decompresses bindata/data.bin of `bytes` into `out` (libzip only: no XML, no checksum).
+void raw_inflate(const std::string& bytes, std::vector<char>& out) {
+    zip_error_t error;
+    zip_error_init(&error);
+    zip_t* z = zip_open_from_source(zip_source_buffer_create(bytes.data(), bytes.size(), 0, &error),
+                                    ZIP_RDONLY, &error);
+    zip_stat_t st;
+    zip_stat(z, "bindata/data.bin", 0, &st);
+    out.resize(st.size);
+    zip_file_t* f = zip_fopen(z, "bindata/data.bin", 0);
+    zip_fread(f, out.data(), out.size());
+    zip_fclose(f);
+    zip_discard(z);
+    zip_error_fini(&error);
+    benchmark::DoNotOptimize(out.data());
 }
 
 double seconds_of(auto&& body, int repeats) {
@@ -94,8 +163,43 @@ void BM_x3p_raw_md5(benchmark::State& state) {
     state.SetBytesProcessed(static_cast<std::int64_t>(state.iterations() * n * n * sizeof(double)));
 }
 
+void BM_x3p_decode_deflated(benchmark::State& state) {
+    const auto n = static_cast<std::size_t>(state.range(0));
+    const std::string& bytes = deflated_bytes(n);
+    for (auto _ : state) {
+        HeightMap map = formats::decode_x3p(bytes, "bench.x3p", {});
+        benchmark::DoNotOptimize(map.heights_um.data());
+    }
+    std::vector<char> out;
+    const double t_decode =
+        seconds_of([&] { (void)formats::decode_x3p(bytes, "bench.x3p", {}); }, 1);
+    const double t_inflate = seconds_of([&] { raw_inflate(bytes, out); }, 1);
+    state.counters["time_vs_inflate"] = t_decode / t_inflate;
+    state.SetBytesProcessed(static_cast<std::int64_t>(state.iterations() * n * n * sizeof(double)));
+}
+
+void BM_x3p_raw_inflate(benchmark::State& state) {
+    const auto n = static_cast<std::size_t>(state.range(0));
+    const std::string& bytes = deflated_bytes(n);
+    std::vector<char> out;
+    for (auto _ : state) raw_inflate(bytes, out);
+    state.SetBytesProcessed(static_cast<std::int64_t>(state.iterations() * n * n * sizeof(double)));
+}
+
 }  // namespace
 
+BENCHMARK(BM_x3p_decode_deflated)
+    ->Name("x3p/decode_deflated")
+    ->Arg(256)
+    ->Arg(1024)
+    ->Unit(benchmark::kMillisecond)
+    ->Iterations(1);
+BENCHMARK(BM_x3p_raw_inflate)
+    ->Name("x3p/raw_inflate")
+    ->Arg(256)
+    ->Arg(1024)
+    ->Unit(benchmark::kMillisecond)
+    ->Iterations(1);
 BENCHMARK(BM_x3p_decode)
     ->Name("x3p/decode")
     ->Arg(256)

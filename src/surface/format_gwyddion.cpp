@@ -318,7 +318,10 @@ HeightMap decode_gwy(std::string_view bytes, const std::string& name, const Heig
     // The channels /N/data, in increasing N; the first whose units are lengths is the height map.
     std::map<long long, const GwyObject*> channels;
     for (const auto& [key, value] : root->items) {
-        if (!key.starts_with("/") || !key.ends_with("/data") || value.type != 'o') continue;
+        if (key.size() < 7 || !key.starts_with("/") || !key.ends_with("/data") ||
+            value.type != 'o') {
+            continue;
+        }
         const std::string_view digits(key.data() + 1, key.size() - 6);
         long long n = 0;
         const auto [ptr, ec] = std::from_chars(digits.data(), digits.data() + digits.size(), n);

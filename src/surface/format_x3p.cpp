@@ -361,16 +361,16 @@ const tinyxml2::XMLElement* require(const tinyxml2::XMLElement* parent, const ch
     return e;
 }
 
-enum class SampleType { int16, int32, float32, float64 };
+enum class SampleType { Int16, Int32, Float32, Float64 };
 
 std::size_t sample_bytes(SampleType t) {
     switch (t) {
-        case SampleType::int16:
+        case SampleType::Int16:
             return 2;
-        case SampleType::int32:
-        case SampleType::float32:
+        case SampleType::Int32:
+        case SampleType::Float32:
             return 4;
-        case SampleType::float64:
+        case SampleType::Float64:
             return 8;
     }
     return 8;
@@ -378,7 +378,7 @@ std::size_t sample_bytes(SampleType t) {
 
 struct Axis {
     bool incremental = false;
-    SampleType type = SampleType::float64;
+    SampleType type = SampleType::Float64;
     bool has_increment = false;
     double increment_um = 1e6;  // 1 m: the default of an axis without <Increment>
     double offset_um = 0.0;
@@ -398,13 +398,13 @@ Axis read_axis(const tinyxml2::XMLElement* axes, const char* tag, const std::str
     if (const auto* dt = child(e, "DataType")) {
         const std::string_view d = trim(text_of(dt));
         if (d == "I") {
-            axis.type = SampleType::int16;
+            axis.type = SampleType::Int16;
         } else if (d == "L") {
-            axis.type = SampleType::int32;
+            axis.type = SampleType::Int32;
         } else if (d == "F") {
-            axis.type = SampleType::float32;
+            axis.type = SampleType::Float32;
         } else if (d == "D") {
-            axis.type = SampleType::float64;
+            axis.type = SampleType::Float64;
         } else {
             fail(name, path + "/DataType must be I, L, F or D, not " + quote_input(d));
         }
@@ -442,13 +442,13 @@ T load(const char* p) {
 
 double sample_value(SampleType type, const char* p) {
     switch (type) {
-        case SampleType::int16:
+        case SampleType::Int16:
             return load<std::int16_t>(p);
-        case SampleType::int32:
+        case SampleType::Int32:
             return load<std::int32_t>(p);
-        case SampleType::float32:
+        case SampleType::Float32:
             return static_cast<double>(load<float>(p));
-        case SampleType::float64:
+        case SampleType::Float64:
             return load<double>(p);
     }
     return 0.0;
@@ -509,7 +509,7 @@ void read_binary_heights(const ZipArchive& zip, const std::string& name, const s
         zip.read_exact(file.get(), entry, buffer.data(), n * bytes_per_point);
         if (verify) md5.update(buffer.data(), n * bytes_per_point);
         double* out = heights.data() + done;
-        if (type == SampleType::float64 && scale.factor_um == 1.0 && scale.offset_um == 0.0) {
+        if (type == SampleType::Float64 && scale.factor_um == 1.0 && scale.offset_um == 0.0) {
             std::memcpy(out, buffer.data(), n * sizeof(double));
             for (std::size_t i = 0; i < n; ++i) {
                 if (!std::isfinite(out[i])) out[i] = std::numeric_limits<double>::quiet_NaN();
@@ -672,7 +672,7 @@ HeightMap decode_x3p(std::string_view bytes, const std::string& name,
     if (cy.incremental && !cy.has_increment)
         fail(name, "main.xml has no <Record1/Axes/CY/Increment>");
     for (const Axis* a : {&cx, &cy}) {
-        if (!a->incremental && (a->type == SampleType::float32 || a->type == SampleType::float64)) {
+        if (!a->incremental && (a->type == SampleType::Float32 || a->type == SampleType::Float64)) {
             fail(name,
                  "absolute floating-point CX/CY coordinates make a point cloud, which is not "
                  "supported (a height map needs incremental or integer-coded axes)");

@@ -124,6 +124,10 @@ TEST(GwyFormat, MalformedInputIsADataErrorNamingTheFileAndOffset) {
                                comp_object("/0/data", data_field(4, 4, 1, 1, "m", "m", {1, 2}))),
            "data holds 2 values");
     expect("GWYP" + gwy_object("GwyContainer", comp_int("/0/x", 1)), "no channel");
+    // A key "/data" (no channel number) is not a channel (and must not be cut before its start).
+    expect("GWYP" + gwy_object("GwyContainer",
+                               comp_object("/data", data_field(1, 1, 1, 1, "m", "m", {1}))),
+           "no channel");
     expect("GWYP" + gwy_object("GwyContainer",
                                comp_object("/0/data", data_field(1, 1, 1, 1, "m", "A", {1}))),
            "length units");
