@@ -127,8 +127,7 @@ TEST(SurfacePredict, SlightlyRoughLimitGivesEq3) {
     // Eq. 2's second term over its first: (g/4) exp(a/2), a = T² v_xy²/4.
     const double second_over_first = gg / 4.0 * std::exp(T * T * v.vxy2() / 8.0);
     ASSERT_LT(second_over_first, 1e-2);
-    EXPECT_NEAR(p.points[0].power.diffuse / eq3, 1.0 + second_over_first,
-                0.01 * second_over_first);
+    EXPECT_NEAR(p.points[0].power.diffuse / eq3, 1.0 + second_over_first, 0.01 * second_over_first);
 }
 
 TEST(SurfacePredict, CaronThetaKFlagsAndWarns) {
