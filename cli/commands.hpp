@@ -10,5 +10,6 @@ void register_model(CLI::App& app);     // cli/model.cpp    — evaluate models 
 void register_estimate(CLI::App& app);  // cli/estimate.cpp — roughness estimation (§4)
 void register_paper(CLI::App& app);     // cli/paper.cpp    — paper tables recomputed
 void register_curet(CLI::App& app);     // cli/curet.cpp    — CUReT comparison (§5.3)
+void register_surface(CLI::App& app);   // cli/surface.cpp  — height data (§3.1)
 
 }  // namespace roughscope::cli

@@ -14,6 +14,7 @@ namespace roughscope::python {
 void bind_core(pybind11::module_& m);        // python/bind_core.cpp: models, geometry (§2–3)
 void bind_estimation(pybind11::module_& m);  // python/bind_estimation.cpp: §4 estimators, fits
 void bind_curet(pybind11::module_& m);       // python/bind_curet.cpp: CUReT / BRDF tables
+void bind_surface(pybind11::module_& m);     // python/bind_surface.cpp: height data (§3.1)
 
 // Results cross into Python as real objects, built from the library's serializer
 // (roughscope/serialize): objects → dict (key order kept), arrays → list, numbers → int/float,

@@ -236,4 +236,5 @@ PYBIND11_MODULE(_core, m) {
     roughscope::python::bind_core(m);
     roughscope::python::bind_estimation(m);
     roughscope::python::bind_curet(m);
+    roughscope::python::bind_surface(m);
 }

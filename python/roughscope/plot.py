@@ -21,7 +21,7 @@ import json
 import os
 import sys
 
-__all__ = ["curet", "main"]
+__all__ = ["curet", "surface", "main"]
 
 
 def curet(document, out):
@@ -49,12 +49,27 @@ def curet(document, out):
     return curet_figures.fig10(document, out)
 
 
+def surface(document, out):
+    """Draw the height-data figure (height image, ACF with the fitted curves and the 1/e line,
+    PSD) from a statistics document with 'curves' and 'image' (``roughscope surface stats FILE
+    --plot OUT.png``). Returns the path written; ValueError for a document of the wrong shape."""
+    from . import surface_figures
+
+    out = os.fspath(out)
+    directory = os.path.dirname(os.path.abspath(out))
+    if not os.path.isdir(directory):
+        raise FileNotFoundError(f"cannot write {out}: directory {directory} does not exist")
+    return surface_figures.stats_figure(document, out)
+
+
 def main(argv=None, stdin=None):
     parser = argparse.ArgumentParser(prog="python3 -m roughscope.plot",
                                      description="Draw a figure from a result document on "
                                                  "standard input (JSON).")
     sub = parser.add_subparsers(dest="kind", required=True)
     p = sub.add_parser("curet", help="CUReT comparison: Fig. 10 (one sample) or the summary")
+    p.add_argument("--out", required=True, help="PNG file to write")
+    p = sub.add_parser("surface", help="height data: image, ACF with fits and 1/e line, PSD")
     p.add_argument("--out", required=True, help="PNG file to write")
     args = parser.parse_args(argv)
     stream = sys.stdin if stdin is None else stdin
@@ -63,7 +78,7 @@ def main(argv=None, stdin=None):
             document = json.load(stream)
         except json.JSONDecodeError as e:
             raise ValueError(f"standard input is not a JSON document ({e})") from None
-        curet(document, args.out)
+        (surface if args.kind == "surface" else curet)(document, args.out)
     except Exception as e:  # one line for the caller (the CLI shows it)
         message = " ".join(str(e).split()) or type(e).__name__
         print(f"roughscope.plot: error: {message}", file=sys.stderr)

@@ -39,6 +39,10 @@ _CSV.write("theta_i,phi_i,theta_s,phi_s,value\n"
                      zip(TI, PI, TS, (PS + PI + 180.0) % 360.0, BRIGHTNESS / np.cos(np.radians(TI)))))
 _CSV.close()
 TABLE_CSV = _CSV.name
+HEIGHTS = np.random.default_rng(1).normal(size=(16, 16))
+_HEIGHT_DIR = tempfile.mkdtemp(prefix="roughscope-inputs-")
+HEIGHT_FILE = _HEIGHT_DIR + "/h.x3p"
+rs.write_height_map(HEIGHTS, 1.0, 1.0, HEIGHT_FILE)
 LOBES = Lobes([{"Cx": -1.0, "Cy": -1.0, "Cz": 1.0, "n": 10.0, "albedo": 0.5}])
 COMPARISON_OPTIONS = dict(theta1_deg=20.0, theta2_deg=50.0, pair=(1, 2), on_sigma_rad=0.2,
                           on_albedo=0.5, fits=False)
@@ -91,6 +95,8 @@ GOOD_CALLS = {
                             initial_sigma_over_T=0.5, sigma_over_T_bounds=(0.01, 10.0),
                             max_iterations=50))],
     "gaussian_series_sum": [((2.0, 0.5), {})],
+    "generate_surface": [((), dict(sigma_um=1.0, T_um=4.0, nx=32, ny=16, dx_um=1.0, dy_um=0.5,
+                                   seed=2))],
     "geometric_factor_beckmann": [((TI, TS, PS), {})],
     "geometric_factor_squared": [(("vh", TI, TS, PS), {})],
     "geometry_from_two_azimuths": [((TI, PI, TS, PS), {})],
@@ -105,7 +111,9 @@ GOOD_CALLS = {
     "oren_nayar_qualitative_radiance": [((TI, TS, PS, 0.3), dict(albedo=0.8))],
     "oren_nayar_radiance": [((TI, TS, PS, 0.3), dict(albedo=0.8))],
     "paper_tables_path": [((), {})],
+    "predict_brightness": [((TI, TS, PS), dict(sigma_um=0.1, T_um=2.0, wavelength_um=0.555))],
     "rad_to_deg": [((0.5,), {})],
+    "read_height_map": [((HEIGHT_FILE,), dict(dx_um=1.0, dy_um=1.0, z_scale_um=1.0))],
     "ratio_range_correlation_length": [((0.05, 10.0, 40.0), dict(wavelength_um=0.555))],
     "ratio_range_exponential": [((10.0, 40.0), {})],
     "ratio_range_gaussian": [((10.0, 40.0), {})],
@@ -128,7 +136,9 @@ GOOD_CALLS = {
     "sigma_over_T_two_geometries": [((1.5, 10.0, 0.0, 0.0, 40.0, 0.0, 0.0), {})],
     "specular_amplitude_rho0": [((0.01, 0.02), dict(patch_x_um=500.0, patch_y_um=500.0))],
     "specular_reflectance_from_brightness": [((2.0, 1.0), {})],
+    "surface_statistics": [((HEIGHTS, 1.0, 1.0), dict(cutoff_um=8.0))],
     "very_rough_brightness": [((TI, TS, PS, 0.4), {})],
+    "write_height_map": [((HEIGHTS, 1.0, 1.0, _HEIGHT_DIR + "/w.x3p"), dict(z_scale_um=1.0))],
     "CuretDatabase.compare": [((25,), dict(theta1_deg=45.0, theta2_deg=67.5, pair=(81, 112),
                                            on_sigma_rad=0.2, on_albedo=0.5, max_overflow=1.0,
                                            fits=False, series=False))],
