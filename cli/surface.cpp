@@ -44,14 +44,14 @@ struct ReadArgs {
     double dx_um = 1.0, dy_um = 1.0, z_scale_um = 1.0;
     std::string unit;
     std::size_t nx = 0, ny = 0;
-    surface::RawSampleType raw_type = surface::RawSampleType::float64;
+    surface::RawSampleType raw_type = surface::RawSampleType::Float64;
     bool big_endian = false;
     CLI::Option *o_dx{}, *o_dy{}, *o_unit{}, *o_z{}, *o_nx{}, *o_ny{};
 };
 
 surface::RawSampleType parse_raw_type(std::string_view name) {
-    if (name == "float32" || name == "f32") return surface::RawSampleType::float32;
-    if (name == "float64" || name == "f64") return surface::RawSampleType::float64;
+    if (name == "float32" || name == "f32") return surface::RawSampleType::Float32;
+    if (name == "float64" || name == "f64") return surface::RawSampleType::Float64;
     throw InvalidArgument("raw sample type '" + std::string(name) +
                           "' is not recognised; valid values: float32, float64");
 }
@@ -150,7 +150,7 @@ void add_stats_options(CLI::App& cmd, StatsArgs& s) {
 surface::StatisticsOptions stats_options(const StatsArgs& s, bool keep_curves) {
     surface::StatisticsOptions o = s.options;
     if (given(s.o_order)) {
-        if (o.leveling != surface::Leveling::polynomial)
+        if (o.leveling != surface::Leveling::Polynomial)
             throw UsageError(
                 "--order needs --level polynomial (it is the order of the "
                 "polynomial background, 1..3)");

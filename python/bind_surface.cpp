@@ -70,8 +70,8 @@ surface::HeightMap height_map_from(py::handle heights, py::handle dx, py::handle
 
 surface::RawSampleType raw_type_of(const std::string& name) {
     const std::string n = normalize_name(name);
-    if (n == "float32" || n == "f32") return surface::RawSampleType::float32;
-    if (n == "float64" || n == "f64") return surface::RawSampleType::float64;
+    if (n == "float32" || n == "f32") return surface::RawSampleType::Float32;
+    if (n == "float64" || n == "f64") return surface::RawSampleType::Float64;
     throw InvalidArgument("raw_type '" + name +
                           "' is not recognised; valid values: float32, "
                           "float64");
@@ -84,7 +84,7 @@ surface::StatisticsOptions statistics_options(const std::string& level, py::hand
     o.leveling = surface::parse_leveling(normalize_name(level));
     if (!order.is_none()) {
         const long long n = integer_scalar("order", order);
-        if (o.leveling != surface::Leveling::polynomial)
+        if (o.leveling != surface::Leveling::Polynomial)
             throw InvalidArgument(
                 "order needs level='polynomial' (the order of the polynomial "
                 "background, 1..3)");

@@ -83,7 +83,7 @@ Json to_json(const StatisticsInput& input, const surface::SurfaceStatistics& s, 
     j["dy_um"] = number(input.dy_um);
     j["leveling"] = surface::to_string(o.leveling);
     j["polynomial_order"] =
-        o.leveling == surface::Leveling::polynomial ? Json(o.polynomial_order) : Json(nullptr);
+        o.leveling == surface::Leveling::Polynomial ? Json(o.polynomial_order) : Json(nullptr);
     j["cutoff_um"] = number(o.cutoff_um);
     j["acf_estimator"] = surface::to_string(o.acf_estimator);
     j["points"] = s.points;

@@ -7,6 +7,7 @@
 
 #include "roughscope/core/errors.hpp"
 #include "roughscope/core/numbers.hpp"
+#include "roughscope/scattering/beckmann.hpp"
 
 namespace roughscope::surface {
 
@@ -39,11 +40,15 @@ void check_dimensions(const std::string& what, std::size_t nx, std::size_t ny) {
 }
 
 void check_spacing(const std::string& what, const char* name, double value_um) {
-    if (!(std::isfinite(value_um) && value_um > 0.0)) {
+    if (!(value_um >= kMinLengthUm && value_um <= kMaxLengthUm)) {
         std::string message = what;
         message.append(": ")
             .append(name)
-            .append(" must be a finite spacing > 0 um (got ")
+            .append(" must be a spacing in [")
+            .append(format_message(kMinLengthUm))
+            .append(", ")
+            .append(format_message(kMaxLengthUm))
+            .append("] um (got ")
             .append(format_message(value_um))
             .append(")");
         throw InvalidArgument(message);
@@ -69,8 +74,12 @@ void validate(const HeightMap& map, const std::string& what) {
     check_dimensions(what, map.nx, map.ny);
     check_spacing(what, "dx_um", map.dx_um);
     check_spacing(what, "dy_um", map.dy_um);
-    if (!std::isfinite(map.x_offset_um) || !std::isfinite(map.y_offset_um)) {
-        throw InvalidArgument(what + ": the grid offsets must be finite");
+    if (!(std::abs(map.x_offset_um) <= kMaxLengthUm && std::abs(map.y_offset_um) <= kMaxLengthUm)) {
+        std::string message = what;
+        message.append(": the grid offsets must lie within +-")
+            .append(format_message(kMaxLengthUm))
+            .append(" um");
+        throw InvalidArgument(message);
     }
     if (map.heights_um.size() != map.nx * map.ny) {
         std::string message = what;
@@ -85,8 +94,14 @@ void validate(const HeightMap& map, const std::string& what) {
     }
     bool any_valid = false;
     for (const double z : map.heights_um) {
-        if (std::isinf(z)) {
-            throw InvalidArgument(what + ": heights must be finite or NaN (missing), not infinite");
+        if (std::abs(z) > kMaxLengthUm) {  // also ±inf (NaN compares false: missing)
+            std::string message = what;
+            message.append(": heights must be NaN (missing) or within +-")
+                .append(format_message(kMaxLengthUm))
+                .append(" um (got ")
+                .append(format_message(z))
+                .append(")");
+            throw InvalidArgument(message);
         }
         any_valid = any_valid || !std::isnan(z);
     }

@@ -103,16 +103,25 @@ double acf_bilinear(const Acf2d& acf, double ux, double uy) {
 // of a quarter of the finer spacing and interpolating linearly; none if the ray leaves the lag
 // grid or meets a lag without valid pairs first.
 std::optional<double> first_crossing(const Acf2d& acf, double cx, double cy, double s) {
-    const double step = (acf.ny == 1 ? acf.dx_um : std::min(acf.dx_um, acf.dy_um)) / 4;
+    // The ray's direction in lag-index units, (cx/dx, cy/dy), scaled so that one step moves a
+    // quarter of a lag along the faster index: the walk leaves the lag grid after at most
+    // 4·max(nx, ny) steps whatever the spacings (computed as (cx·dy, cy·dx), which cannot
+    // overflow or underflow to 0 for spacings in the HeightMap's range).
+    const double a = cx * acf.dy_um;
+    const double b = acf.ny == 1 ? 0.0 : cy * acf.dx_um;
+    const double longest = std::max(std::abs(a), std::abs(b));
+    const double ux = a / longest / 4;
+    const double uy = b / longest / 4;
+    const double step_um = std::hypot(ux * acf.dx_um, uy * acf.dy_um);
     double previous = 1.0;
     for (std::size_t i = 1;; ++i) {
-        const double r = static_cast<double>(i) * step;
-        const double c = acf_bilinear(acf, r * cx / acf.dx_um, r * cy / acf.dy_um);
+        const double t = static_cast<double>(i);
+        const double c = acf_bilinear(acf, t * ux, t * uy);
         if (std::isnan(c)) {
             return std::nullopt;
         }
         if (c <= s) {
-            return r - step + step * (previous - s) / (previous - c);
+            return (t - 1 + (previous - s) / (previous - c)) * step_um;
         }
         previous = c;
     }

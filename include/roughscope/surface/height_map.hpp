@@ -44,10 +44,12 @@ struct HeightMap {
 };
 
 // A map of nx × ny points with the given spacings, every height 0. Throws InvalidArgument unless
-// nx, ny ≥ 1, nx·ny ≤ kMaxHeightMapPoints and the spacings are finite and > 0.
+// nx, ny ≥ 1, nx·ny ≤ kMaxHeightMapPoints and the spacings lie in [1e-30, 1e30] µm.
 HeightMap make_height_map(std::size_t nx, std::size_t ny, double dx_um, double dy_um);
 
-// Checks the invariants above (sizes, spacings, heights finite or NaN, at least one valid point);
+// Checks the invariants above (sizes; spacings in [kMinLengthUm, kMaxLengthUm] = [1e-30, 1e30] µm
+// like every length of the library; heights NaN or within ±1e30 µm; offsets within ±1e30 µm; at
+// least one valid point);
 // throws InvalidArgument naming `what` (a file name, "heights") and the broken rule. Readers call
 // it on what they built, so a HeightMap that leaves the library is always well formed.
 void validate(const HeightMap& map, const std::string& what);
