@@ -354,5 +354,21 @@ TEST(Psd, RejectsAProfileForTheRadialPsdAndMalformedMaps) {
     EXPECT_THROW((void)psd_radial(bad), InvalidArgument);
 }
 
+TEST(TextureParameters, ExtremeSpacingRatiosTerminateWithFiniteLengths) {
+    // The rays walk in lag-index steps: spacings 60 orders of magnitude apart (the ends of the
+    // library's length range) neither hang the walk nor overflow the lengths.
+    for (const auto& [dx, dy] : {std::pair{1e-30, 1e30}, std::pair{1e30, 1e-30},
+                                 std::pair{1e30, 1e30}, std::pair{1e-30, 1e-30}}) {
+        const Acf2d acf = acf_2d(random_map(24, 20, dx, dy, 7), AcfEstimator::Biased);
+        const TextureParameters t = texture_parameters(acf);
+        ASSERT_TRUE(t.Sal_um.has_value()) << dx << " " << dy;
+        EXPECT_TRUE(std::isfinite(*t.Sal_um));
+        EXPECT_GE(*t.Sal_um, std::min(dx, dy) * 0.1);
+        if (t.Str) {
+            EXPECT_TRUE(*t.Str >= 0 && *t.Str <= 1);
+        }
+    }
+}
+
 }  // namespace
 }  // namespace roughscope::surface
