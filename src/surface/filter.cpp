@@ -20,9 +20,12 @@ namespace {
 const double kAlpha = std::sqrt(std::numbers::ln2 / std::numbers::pi);
 
 // Weights w_k = exp(−π (k·spacing / (α λc))²) for k = 0..K, truncated at |x| ≤ λc (where the
-// weight is 7e−7 of the centre's).
-std::vector<double> gaussian_weights(double cutoff_um, double spacing_um) {
-    const auto half = static_cast<std::size_t>(std::floor(cutoff_um / spacing_um));
+// weight is 7e−7 of the centre's) and at the longest lag of a line of n samples (weights beyond
+// it never meet a sample).
+std::vector<double> gaussian_weights(double cutoff_um, double spacing_um, std::size_t n) {
+    const double max_lag = static_cast<double>(n > 0 ? n - 1 : 0);
+    const auto half =
+        static_cast<std::size_t>(std::min(std::floor(cutoff_um / spacing_um), max_lag));
     std::vector<double> w(half + 1);
     for (std::size_t k = 0; k <= half; ++k) {
         const double x = static_cast<double>(k) * spacing_um / (kAlpha * cutoff_um);
@@ -90,11 +93,11 @@ FilteredHeights gaussian_filter(const HeightMap& map, double cutoff_um) {
         valid[i] = ok ? 1.0 : 0.0;
     }
     std::vector<double> num(n), den(n);
-    const std::vector<double> wx = gaussian_weights(cutoff_um, map.dx_um);
+    const std::vector<double> wx = gaussian_weights(cutoff_um, map.dx_um, map.nx);
     convolve_rows(weighted, num, map.nx, map.ny, wx);
     convolve_rows(valid, den, map.nx, map.ny, wx);
     if (!profile) {
-        const std::vector<double> wy = gaussian_weights(cutoff_um, map.dy_um);
+        const std::vector<double> wy = gaussian_weights(cutoff_um, map.dy_um, map.ny);
         convolve_columns(num, weighted, map.nx, map.ny, wy);
         convolve_columns(den, valid, map.nx, map.ny, wy);
         num.swap(weighted);

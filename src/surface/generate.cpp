@@ -52,10 +52,27 @@ std::string size_message(const char* name, std::size_t value, const char* rule) 
 }
 
 // Everything but the correlation and T (which the PSD route does not use).
+void check_in_range(const char* name, double value, double lo, double hi) {
+    if (!(value >= lo && value <= hi)) {
+        std::string message = "generation option ";
+        message.append(name)
+            .append(" = ")
+            .append(format_message(value))
+            .append(" is out of range: it must be in [")
+            .append(format_message(lo))
+            .append(", ")
+            .append(format_message(hi))
+            .append("] um");
+        throw InvalidArgument(message);
+    }
+}
+
 void check_grid_options(const GenerationOptions& o) {
-    check::positive("generation option sigma_um", o.sigma_um, "um");
-    check::positive("generation option dx_um", o.dx_um, "um");
-    check::positive("generation option dy_um", o.dy_um, "um");
+    // σ at most 1e-2 of the longest length: a Gaussian height beyond 100σ does not occur, so
+    // every height stays within the HeightMap's ±1e30 µm.
+    check_in_range("sigma_um", o.sigma_um, kMinLengthUm, kMaxLengthUm * 1e-2);
+    check_in_range("dx_um", o.dx_um, kMinLengthUm, kMaxLengthUm);
+    check_in_range("dy_um", o.dy_um, kMinLengthUm, kMaxLengthUm);
     if (o.nx < 2 || o.nx > kMaxHeightMapPoints) {
         throw InvalidArgument(size_message("nx", o.nx, "it must be an integer in [2, 2^28]"));
     }
@@ -71,8 +88,23 @@ void check_options(const GenerationOptions& o) {
             "generation option correlation is invalid: it must be gaussian or "
             "exponential");
     }
-    check::positive("generation option T_um", o.T_um, "um");
+    check_in_range("T_um", o.T_um, kMinLengthUm, kMaxLengthUm);
     check_grid_options(o);
+    // The periodised target sums the ACF over the images of the map within the distance where
+    // it falls below 1e-18 (fill_periodised_acf): T far beyond the map's size would need
+    // millions of images per lag. T up to the map's shorter side is allowed (a surface with
+    // T > L is a random tilt and offset at the map's scale, not a rough surface).
+    const double lx = static_cast<double>(o.nx) * o.dx_um;
+    const double l_min = o.ny == 1 ? lx : std::min(lx, static_cast<double>(o.ny) * o.dy_um);
+    if (!(o.T_um <= l_min)) {
+        std::string message = "generation option T_um = ";
+        message.append(format_message(o.T_um))
+            .append(" is out of range: it must not exceed the map's ")
+            .append(o.ny == 1 ? "length nx·dx_um = " : "shorter side min(nx·dx_um, ny·dy_um) = ")
+            .append(format_message(l_min))
+            .append(" um");
+        throw InvalidArgument(message);
+    }
 }
 
 HeightMap empty_map(const GenerationOptions& o) {
@@ -179,8 +211,8 @@ void fill_periodised_acf(const GenerationOptions& o, fft::RealToComplex& f) {
     }
 }
 
-// Filters white noise with the half-spectrum `gain` (ny × (nx/2 + 1), the DFT gain including the
-// 1/(nx ny) of the inverse transform): z = IDFT(gain · DFT(w)), w i.i.d. N(0, 1) drawn in
+// Filters white noise with the half-spectrum `gain` (ny × (nx/2 + 1), the DFT gain including
+// the 1/(nx ny) of the inverse transform): z = IDFT(gain · DFT(w)), w i.i.d. N(0, 1) drawn in
 // row-major order from the seed.
 HeightMap filter_noise(const GenerationOptions& o, const std::vector<double>& gain,
                        fft::RealToComplex& f) {

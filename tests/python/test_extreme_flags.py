@@ -67,6 +67,7 @@ QUANTITY_NAMES = {
     "--initial-sigma-over-T": ["initial sigma/T"], "--initial-sigma": ["initial sigma"],
     "--initial-T": ["initial T"], "--sigma-over-T": ["sigma_over_T", "sigma/T"],
     "--on-sigma": ["oren_nayar sigma"], "--on-albedo": ["albedo"], "--pair": ["measurement"],
+    "--sigma-um": ["sigma ="], "--T-um": ["T ="],
 }
 
 
@@ -200,3 +201,33 @@ def test_curet_table_flags_at_the_extremes(measurement_files):
         ["--table", str(table), "--pair", "1", "2", "--on-sigma", "0.2", "--on-albedo", "0.5",
          "--no-fits"],
     ]) > 50
+
+
+@pytest.fixture(scope="module")
+def height_file(tmp_path_factory):
+    """A 32 × 24 generated height map as CSV (heights in µm, spacings in its header)."""
+    path = tmp_path_factory.mktemp("surface") / "map.csv"
+    subprocess.run([cli_path(), "surface", "generate", "--correlation", "gaussian",
+                    "--sigma-um", "0.5", "--T-um", "4", "--nx", "32", "--ny", "24",
+                    "--dx-um", "1", "--seed", "3", "--out", str(path)],
+                   check=True, capture_output=True, timeout=60)
+    return path
+
+
+def test_surface_flags_at_the_extremes(height_file, tmp_path):
+    out = tmp_path / "generated.gsf"
+    runs = sweep(["surface", "stats"], [
+        [str(height_file), "--json"],
+        [str(height_file), "--level", "polynomial", "--order", "2", "--cutoff-um", "8"],
+    ])
+    runs += sweep(["surface", "generate"], [
+        ["--correlation", "exponential", "--sigma-um", "0.5", "--T-um", "4", "--nx", "16",
+         "--ny", "8", "--dx-um", "1", "--seed", "1", "--out", str(out)],
+    ])
+    runs += sweep(["surface", "predict"], [
+        ["--sigma-um", "0.5", "--T-um", "4", "--correlation", "gaussian", "--theta-i", "30",
+         "--theta-s", "20", "--phi-s", "45", "--json"],
+        [str(height_file), "--theta-i", "30", "--theta-s", "20", "--phi-s", "45",
+         "--wavelength-um", "0.5"],
+    ])
+    assert runs > 100

@@ -133,5 +133,21 @@ TEST(SurfaceGaussianFilter, RejectsBadCutoffAndMaps) {
     EXPECT_THROW(gaussian_filter(bad, 5.0), InvalidArgument);
 }
 
+TEST(SurfaceGaussianFilter, CutoffsFarBeyondTheMapGiveTheMapMinusItsMean) {
+    // A cutoff of 1e30 µm on a 40 × 30 µm map: the kernel is truncated at the map (its weights
+    // are 1 to rounding there), so the roughness is the heights minus their mean. The kernel's
+    // length in samples must not be computed from λc/dx alone (1e30 samples).
+    HeightMap map = sinusoid(40, 30, 7.0, 0.3);
+    double mean = 0;
+    for (const double z : map.heights_um) mean += z;
+    mean /= static_cast<double>(map.size());
+    for (const double cutoff : {1e12, 1e30}) {
+        const FilteredHeights f = gaussian_filter(map, cutoff);
+        for (std::size_t i = 0; i < map.size(); ++i) {
+            ASSERT_NEAR(f.roughness.heights_um[i], map.heights_um[i] - mean, 1e-9) << cutoff;
+        }
+    }
+}
+
 }  // namespace
 }  // namespace roughscope::surface
