@@ -9,12 +9,14 @@
 //        surface_stats/fftw_baseline/<n>   the real FFTs that call makes (same sizes, FFTW_ESTIMATE
 //                                          plans): r2c + c2r of each zero-padded row and column,
 //                                          and of the sub-profiles (L, L/2, L/4) of the 256 rows
-//                                          the length extrapolation uses; planning excluded
+//                                          the length extrapolation uses; the 2-D r2c + c2r of the
+//                                          zero-padded map (acf_2d), the forward 2-D transform
+//                                          (psd_radial) and the row transforms (psd_x); planning
+//                                          excluded
 //        surface_stats/moments/<n>         height_moments (Sq, Sa, Ssk, Sku, Sp, Sv, Sz)
 //        surface_stats/memory_read/<n>     the sum of the map's heights (one plain pass)
-// Ratio = statistics / fftw_baseline and moments / memory_read at the same n. The 2-D ACF,
-// Sal/Str and PSD (spectral.hpp) are timed with the statistics call; their own transforms are not
-// in this baseline. n = 4096 is the size to quote; 512 keeps bench_smoke quick.
+// Ratio = statistics / fftw_baseline and moments / memory_read at the same n. n = 4096 is the
+// size to quote; 512 keeps bench_smoke quick.
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
@@ -95,6 +97,35 @@ struct LineTransforms {
     }
 };
 
+// One 2-D r2c (and, when `inverse`, c2r) transform of a rows × cols array (out of place).
+struct PlaneTransforms {
+    double* real;
+    fftw_complex* spec;
+    fftw_plan fwd, bwd;
+    bool inverse;
+    PlaneTransforms(std::size_t rows, std::size_t cols, bool with_inverse) : inverse(with_inverse) {
+        real = fftw_alloc_real(rows * cols);
+        spec = fftw_alloc_complex(rows * (cols / 2 + 1));
+        fwd = fftw_plan_dft_r2c_2d(static_cast<int>(rows), static_cast<int>(cols), real, spec,
+                                   FFTW_ESTIMATE);
+        bwd = fftw_plan_dft_c2r_2d(static_cast<int>(rows), static_cast<int>(cols), spec, real,
+                                   FFTW_ESTIMATE);
+        for (std::size_t k = 0; k < rows * cols; ++k) real[k] = 0;
+    }
+    ~PlaneTransforms() {
+        fftw_destroy_plan(fwd);
+        fftw_destroy_plan(bwd);
+        fftw_free(real);
+        fftw_free(spec);
+    }
+    PlaneTransforms(const PlaneTransforms&) = delete;
+    PlaneTransforms& operator=(const PlaneTransforms&) = delete;
+    void run() {
+        fftw_execute(fwd);
+        if (inverse) fftw_execute(bwd);
+    }
+};
+
 void BM_Statistics(benchmark::State& state) {
     const HeightMap& map = test_map(static_cast<std::size_t>(state.range(0)));
     for (auto _ : state) {
@@ -108,7 +139,14 @@ void BM_FftwBaseline(benchmark::State& state) {
     const auto n = static_cast<std::size_t>(state.range(0));
     LineTransforms full(n), half(n / 2), quarter(n / 4);
     const std::size_t extrapolation_rows = std::min<std::size_t>(n, 256);
+    const std::size_t padded = friendly(2 * n - 1);
+    PlaneTransforms acf_2d(padded, padded, true);  // spectral.hpp: acf_2d (no missing points)
+    PlaneTransforms psd_2d(n, n, false);           // psd_radial: one forward transform
+    PlaneTransforms psd_rows(1, n, false);         // psd_x: one forward transform per row
     for (auto _ : state) {
+        acf_2d.run();
+        psd_2d.run();
+        for (std::size_t r = 0; r < n; ++r) psd_rows.run();
         full.run(n);                          // rows
         full.run(n);                          // columns (square map)
         full.run(extrapolation_rows);         // sub-profiles of L
