@@ -72,7 +72,7 @@ def test_generate_writes_a_reproducible_surface(tmp_path):
 
 
 def test_generate_json_summary(tmp_path):
-    out = run("surface", "generate", "--nx", 16, "--ny", 8, "--dx-um", 0.5, "--out",
+    out = run("surface", "generate", "--nx", 16, "--ny", 8, "--dx-um", 0.5, "--T-um", 2, "--out",
               tmp_path / "s.gsf", "--json").stdout
     summary = json.loads(out)
     assert (summary["nx"], summary["ny"], summary["dx_um"], summary["dy_um"]) == (16, 8, 0.5, 0.5)
