@@ -264,9 +264,8 @@ double fit_T(const std::vector<double>& x, const std::vector<double>& y, Correla
 
 AcfModelFit fit_acf_models(const Curve& acf, double max_lag_um) {
     if (acf.x.size() != acf.y.size())
-        throw InvalidArgument(detail::cat("fit_acf_models: the ACF has ",
-                                          std::to_string(acf.x.size()), " lags but ",
-                                          std::to_string(acf.y.size()), " values"));
+        throw InvalidArgument(concat("fit_acf_models: the ACF has ", std::to_string(acf.x.size()),
+                                     " lags but ", std::to_string(acf.y.size()), " values"));
     check::positive("max_lag_um", max_lag_um, "µm");
     AcfModelFit fit;
     std::vector<double> x, y;

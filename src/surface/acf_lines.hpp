@@ -9,17 +9,10 @@
 #include <string>
 #include <vector>
 
+#include "roughscope/core/text.hpp"
 #include "roughscope/surface/statistics.hpp"
 
 namespace roughscope::surface::detail {
-
-// Concatenation by append (avoids GCC 12's false -Wrestrict on "literal" + std::string).
-template <class... Parts>
-std::string cat(const Parts&... parts) {
-    std::string s;
-    ((s += parts), ...);
-    return s;
-}
 
 class RowFft;
 

@@ -34,14 +34,6 @@ namespace {
 static_assert(std::endian::native == std::endian::little,
               "gwy and gsf data are little-endian; this reader assumes a little-endian host");
 
-// Concatenation by appending (GCC 12 warns falsely on "literal" + std::string).
-template <class... Parts>
-std::string cat(const Parts&... parts) {
-    std::string out;
-    (out.append(std::string_view(parts)), ...);
-    return out;
-}
-
 [[noreturn]] void fail(const std::string& name, std::string_view what) {
     std::string message = name;
     message.append(": ").append(what);
@@ -126,8 +118,8 @@ class GwyParser {
         const std::uint32_t size = u32(pos, end);
         if (size > end - pos) {
             fail_at(name_, pos,
-                    cat("object ", quote_input(obj->type_name), " claims ", std::to_string(size),
-                        " bytes, only ", std::to_string(end - pos), " remain"));
+                    concat("object ", quote_input(obj->type_name), " claims ", std::to_string(size),
+                           " bytes, only ", std::to_string(end - pos), " remain"));
         }
         const std::size_t stop = pos + size;
         while (pos < stop) {
@@ -178,8 +170,8 @@ class GwyParser {
                 const std::size_t item = v.type == 'C' ? 1 : v.type == 'I' ? 4 : 8;
                 if (count > (end - pos) / item) {
                     fail_at(name_, pos,
-                            cat("array of ", std::to_string(count),
-                                " items runs past the end of its object"));
+                            concat("array of ", std::to_string(count),
+                                   " items runs past the end of its object"));
                 }
                 v.array_offset = pos;
                 v.array_count = count;
@@ -261,13 +253,13 @@ GwyField read_field(const GwyObject& obj, const std::string& key, const std::str
     };
     if (obj.type_name != "GwyDataField") {
         fail_at(name, obj.offset,
-                where(cat("is a ", quote_input(obj.type_name), ", not a GwyDataField")));
+                where(concat("is a ", quote_input(obj.type_name), ", not a GwyDataField")));
     }
     GwyField f;
     auto integer = [&](const char* k) -> std::size_t {
         const GwyValue* v = obj.find(k);
         if (!v || v->type != 'i' || v->number < 1) {
-            fail_at(name, obj.offset, where(cat(std::string(k), " must be a positive int32")));
+            fail_at(name, obj.offset, where(concat(std::string(k), " must be a positive int32")));
         }
         return static_cast<std::size_t>(v->number);
     };
@@ -275,7 +267,7 @@ GwyField read_field(const GwyObject& obj, const std::string& key, const std::str
         const GwyValue* v = obj.find(k);
         if (!v) return fallback;
         if (v->type != 'd' || !std::isfinite(v->number)) {
-            fail_at(name, obj.offset, where(cat(std::string(k), " must be a finite double")));
+            fail_at(name, obj.offset, where(concat(std::string(k), " must be a finite double")));
         }
         return v->number;
     };
@@ -291,9 +283,9 @@ GwyField read_field(const GwyObject& obj, const std::string& key, const std::str
     if (!data || data->type != 'D') fail_at(name, obj.offset, where("has no double array 'data'"));
     if (f.xres > kMaxHeightMapPoints / f.yres || data->array_count != f.xres * f.yres) {
         fail_at(name, data->array_offset,
-                where(cat("data holds ", std::to_string(data->array_count),
-                          " values, xres x yres = ", std::to_string(f.xres), " x ",
-                          std::to_string(f.yres))));
+                where(concat("data holds ", std::to_string(data->array_count),
+                             " values, xres x yres = ", std::to_string(f.xres), " x ",
+                             std::to_string(f.yres))));
     }
     f.data_offset = data->array_offset;
     return f;
@@ -312,8 +304,9 @@ HeightMap decode_gwy(std::string_view bytes, const std::string& name, const Heig
     std::size_t pos = 4;
     const std::unique_ptr<GwyObject> root = parser.object(pos, bytes.size(), 0);
     if (root->type_name != "GwyContainer") {
-        fail_at(name, 4,
-                cat("the top object is a ", quote_input(root->type_name), ", not a GwyContainer"));
+        fail_at(
+            name, 4,
+            concat("the top object is a ", quote_input(root->type_name), ", not a GwyContainer"));
     }
     // The channels /N/data, in increasing N; the first whose units are lengths is the height map.
     std::map<long long, const GwyObject*> channels;
@@ -331,7 +324,7 @@ HeightMap decode_gwy(std::string_view bytes, const std::string& name, const Heig
     if (channels.empty()) fail(name, "the container holds no channel /N/data (no GwyDataField)");
     std::string rejected;
     for (const auto& [n, obj] : channels) {
-        const std::string key = cat("/", std::to_string(n), "/data");
+        const std::string key = concat("/", std::to_string(n), "/data");
         const GwyField f = read_field(*obj, key, name);
         const auto sxy = length_unit(f.unit_xy);
         const auto sz = length_unit(f.unit_z);
@@ -359,7 +352,7 @@ HeightMap decode_gwy(std::string_view bytes, const std::string& name, const Heig
             map.heights_um[i] = missing_if_not_finite(sz->apply(v));
         }
         // A mask marks the points Gwyddion flags (an import's invalid points): missing here.
-        const std::string mask_key = cat("/", std::to_string(n), "/mask");
+        const std::string mask_key = concat("/", std::to_string(n), "/mask");
         if (const GwyValue* m = root->find(mask_key); m && m->type == 'o' && m->object) {
             const GwyField mf = read_field(*m->object, mask_key, name);
             if (mf.xres != f.xres || mf.yres != f.yres) {
@@ -376,7 +369,7 @@ HeightMap decode_gwy(std::string_view bytes, const std::string& name, const Heig
         finish(map, name);
         return map;
     }
-    fail(name, cat("no channel has length units (lateral, height): ", rejected));
+    fail(name, concat("no channel has length units (lateral, height): ", rejected));
 }
 
 // ---- GSF ----------------------------------------------------------------------------------------
@@ -404,7 +397,8 @@ double gsf_number(const std::map<std::string, std::pair<std::string, std::size_t
     const auto [ptr, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
     if (text.empty() || ec != std::errc{} || ptr != text.data() + text.size() ||
         !std::isfinite(v)) {
-        fail_at(name, it->second.second, cat(key, " is not a finite number: ", quote_input(text)));
+        fail_at(name, it->second.second,
+                concat(key, " is not a finite number: ", quote_input(text)));
     }
     return v;
 }
@@ -432,7 +426,7 @@ HeightMap decode_gsf(std::string_view bytes, const std::string& name, const Heig
         if (!line.empty()) {
             const std::size_t eq = line.find('=');
             if (eq == std::string_view::npos) {
-                fail_at(name, pos, cat("header line without '=': ", quote_input(line)));
+                fail_at(name, pos, concat("header line without '=': ", quote_input(line)));
             }
             header.insert_or_assign(std::string(trim(line.substr(0, eq))),
                                     std::make_pair(std::string(trim(line.substr(eq + 1))), pos));
@@ -447,27 +441,27 @@ HeightMap decode_gsf(std::string_view bytes, const std::string& name, const Heig
     }
     auto count = [&](const char* key) -> std::size_t {
         const auto it = header.find(key);
-        if (it == header.end()) fail(name, cat("the header has no ", key));
+        if (it == header.end()) fail(name, concat("the header has no ", key));
         const std::string& text = it->second.first;
         std::size_t v = 0;
         const auto [ptr, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
         if (text.empty() || ec != std::errc{} || ptr != text.data() + text.size() || v < 1) {
             fail_at(name, it->second.second,
-                    cat(key, " must be a positive integer, not ", quote_input(text)));
+                    concat(key, " must be a positive integer, not ", quote_input(text)));
         }
         return v;
     };
     const std::size_t nx = count("XRes");
     const std::size_t ny = count("YRes");
     if (nx > kMaxHeightMapPoints / ny) {
-        fail(name, cat("XRes x YRes = ", std::to_string(nx), " x ", std::to_string(ny),
-                       " is more than ", std::to_string(kMaxHeightMapPoints), " points"));
+        fail(name, concat("XRes x YRes = ", std::to_string(nx), " x ", std::to_string(ny),
+                          " is more than ", std::to_string(kMaxHeightMapPoints), " points"));
     }
     const std::size_t need = nx * ny * 4;
     if (bytes.size() - data_start != need) {
         fail_at(name, data_start,
-                cat("the data hold ", std::to_string(bytes.size() - data_start),
-                    " bytes; XRes x YRes float32 values need ", std::to_string(need)));
+                concat("the data hold ", std::to_string(bytes.size() - data_start),
+                       " bytes; XRes x YRes float32 values need ", std::to_string(need)));
     }
     auto unit = [&](const char* key) -> UnitScale {
         const auto it = header.find(key);
@@ -475,7 +469,7 @@ HeightMap decode_gsf(std::string_view bytes, const std::string& name, const Heig
         const auto s = length_unit(text);
         if (!s) {
             fail_at(name, it->second.second,
-                    cat(key, " is not a length unit (m, mm, um, nm, pm): ", quote_input(text)));
+                    concat(key, " is not a length unit (m, mm, um, nm, pm): ", quote_input(text)));
         }
         return *s;
     };

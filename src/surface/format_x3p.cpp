@@ -32,14 +32,6 @@ namespace {
 static_assert(std::endian::native == std::endian::little,
               "the x3p binary data are little-endian; this reader assumes a little-endian host");
 
-// Concatenation by appending (GCC 12 warns falsely on "literal" + std::string).
-template <class... Parts>
-std::string cat(const Parts&... parts) {
-    std::string out;
-    (out.append(std::string_view(parts)), ...);
-    return out;
-}
-
 [[noreturn]] void fail(const std::string& name, std::string_view what) {
     std::string message = name;
     message.append(": ").append(what);
@@ -254,7 +246,7 @@ class ZipArchive {
         zip_stat_init(&st);
         if (zip_stat(archive_.get(), entry.c_str(), 0, &st) != 0 || !(st.valid & ZIP_STAT_SIZE) ||
             !(st.valid & ZIP_STAT_COMP_SIZE)) {
-            fail(name_, cat("cannot read the zip entry ", quote_input(entry)));
+            fail(name_, concat("cannot read the zip entry ", quote_input(entry)));
         }
         if (st.comp_size > input_size_ || st.size > (st.comp_size + 64) * kMaxInflateRatio) {
             std::string what = "the zip entry ";
@@ -305,7 +297,7 @@ class ZipArchive {
         read_exact(file.get(), entry, out.data(), out.size());
         char extra = 0;
         if (zip_fread(file.get(), &extra, 1) != 0) {
-            fail(name_, cat("the zip entry ", quote_input(entry), " is longer than it claims"));
+            fail(name_, concat("the zip entry ", quote_input(entry), " is longer than it claims"));
         }
         return out;
     }
@@ -409,7 +401,7 @@ Axis read_axis(const tinyxml2::XMLElement* axes, const char* tag, const std::str
             fail(name, path + "/DataType must be I, L, F or D, not " + quote_input(d));
         }
     } else if (!axis.incremental) {
-        fail(name, cat("main.xml has no <", path, "/DataType>"));
+        fail(name, concat("main.xml has no <", path, "/DataType>"));
     }
     if (const auto* inc = child(e, "Increment"); inc && !trim(text_of(inc)).empty()) {
         axis.has_increment = true;
@@ -485,7 +477,7 @@ void read_binary_heights(const ZipArchive& zip, const std::string& name, const s
                          std::optional<std::string_view> expected_md5, bool verify,
                          std::vector<double>& heights) {
     if (!zip.has(entry))
-        fail(name, cat("main.xml links ", quote_input(entry), ", absent from the zip"));
+        fail(name, concat("main.xml links ", quote_input(entry), ", absent from the zip"));
     const std::size_t bytes_per_point = sample_bytes(type);
     const std::uint64_t size = zip.size_of(entry);
     if (size != static_cast<std::uint64_t>(points) * bytes_per_point) {
@@ -531,7 +523,7 @@ void apply_validity(const ZipArchive& zip, const std::string& name, const std::s
                     std::optional<std::string_view> expected_md5, bool verify,
                     std::vector<double>& heights) {
     if (!zip.has(entry))
-        fail(name, cat("main.xml links ", quote_input(entry), ", absent from the zip"));
+        fail(name, concat("main.xml links ", quote_input(entry), ", absent from the zip"));
     const std::size_t need = (heights.size() + 7) / 8;
     if (zip.size_of(entry) != need) {
         std::string what = entry;
@@ -660,7 +652,8 @@ HeightMap decode_x3p(std::string_view bytes, const std::string& name,
              "grid, FeatureType SUR or PRF)");
     }
     if (feature != "SUR" && feature != "PRF") {
-        fail(name, cat("Record1/FeatureType must be SUR, PRF or PCL, not ", quote_input(feature)));
+        fail(name,
+             concat("Record1/FeatureType must be SUR, PRF or PCL, not ", quote_input(feature)));
     }
     const auto* axes = require(record1, "Axes", name, "Record1/Axes");
     const Axis cx = read_axis(axes, "CX", name);
@@ -691,12 +684,13 @@ HeightMap decode_x3p(std::string_view bytes, const std::string& name,
                                                               "MatrixDimension/SizeZ")
                                                 : 1;
     if (nx < 1 || ny < 1 || nx > kMaxHeightMapPoints / ny) {
-        fail(name, cat("MatrixDimension ", std::to_string(nx), " x ", std::to_string(ny),
-                       " is not a grid of 1 to ", std::to_string(kMaxHeightMapPoints), " points"));
+        fail(name,
+             concat("MatrixDimension ", std::to_string(nx), " x ", std::to_string(ny),
+                    " is not a grid of 1 to ", std::to_string(kMaxHeightMapPoints), " points"));
     }
     if (nz != 1)
-        fail(name, cat("MatrixDimension/SizeZ = ", std::to_string(nz),
-                       ": only one layer (1) is supported"));
+        fail(name, concat("MatrixDimension/SizeZ = ", std::to_string(nz),
+                          ": only one layer (1) is supported"));
     if (feature == "PRF" && ny != 1) fail(name, "FeatureType PRF needs MatrixDimension/SizeY = 1");
 
     HeightMap map;

@@ -23,7 +23,6 @@
 namespace roughscope::surface {
 namespace {
 
-using detail::cat;
 
 constexpr std::array<NameEntry<Leveling>, 7> kLevelingNames{{
     {"none", Leveling::None},
@@ -169,9 +168,9 @@ void length_warning(std::vector<std::string>& warnings, const char* direction, d
                     double T_um) {
     const double ratio = L_um / T_um;
     if (ratio < kMinLengthOverT)
-        warnings.push_back(cat("L/T = ", number(ratio), " along ", direction,
-                               " is below 50: the 1/e correlation length is biased low (see "
-                               "T_extrapolated_um)"));
+        warnings.push_back(concat("L/T = ", number(ratio), " along ", direction,
+                                  " is below 50: the 1/e correlation length is biased low (see "
+                                  "T_extrapolated_um)"));
 }
 
 }  // namespace
@@ -189,9 +188,9 @@ AcfEstimator parse_acf_estimator(std::string_view name) {
 
 HeightMoments height_moments(const HeightMap& map) {
     if (map.heights_um.size() != map.nx * map.ny)
-        throw InvalidArgument(cat("heights: ", std::to_string(map.heights_um.size()),
-                                  " values for a ", std::to_string(map.nx), " x ",
-                                  std::to_string(map.ny), " map"));
+        throw InvalidArgument(concat("heights: ", std::to_string(map.heights_um.size()),
+                                     " values for a ", std::to_string(map.nx), " x ",
+                                     std::to_string(map.ny), " map"));
     // One pass, no branches, two-wide vectors (GCC/Clang vector extension, SSE2 on x86-64)
     // and two of them per sum so the additions pipeline: Σ1, Σ|z|, Σz², Σz³, Σz⁴, max, min
     // over the valid points (z == z is false for NaN only).

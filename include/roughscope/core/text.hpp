@@ -30,6 +30,16 @@ inline std::string join(const std::vector<std::string>& items, std::string_view 
     return out;
 }
 
+// The parts (strings, string views, literals, chars) joined into one string by appending: the
+// one way to build a message from pieces (GCC 12 warns falsely with -Wrestrict on
+// "literal" + std::string).
+template <class... Parts>
+std::string concat(const Parts&... parts) {
+    std::string out;
+    ((out += parts), ...);
+    return out;
+}
+
 // Longest input quoted by quote_input (bytes of the original text, before escaping).
 inline constexpr std::size_t kQuoteMaxBytes = 64;
 // Longest message kept by printable_message (bytes of the original message).
