@@ -23,7 +23,6 @@
 namespace roughscope::surface {
 namespace {
 
-
 constexpr std::array<NameEntry<Leveling>, 7> kLevelingNames{{
     {"none", Leveling::None},
     {"mean", Leveling::Mean},
