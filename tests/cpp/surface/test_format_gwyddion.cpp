@@ -200,7 +200,7 @@ HeightMap float_map(std::size_t nx, std::size_t ny) {
         map.heights_um[i] =
             static_cast<double>(static_cast<float>(std::cos(0.3 * static_cast<double>(i)) * 17.0));
     }
-    map.heights_um[1] = -0.0;
+    if (map.size() > 1) map.heights_um[1] = -0.0;
     return map;
 }
 

@@ -105,7 +105,7 @@ HeightMap sample_map(std::size_t nx, std::size_t ny) {
         map.heights_um[i] =
             std::sin(0.37 * static_cast<double>(i)) * 1.2345e-3 + 1e-9 * static_cast<double>(i);
     }
-    map.heights_um[1] = -0.0;
+    if (map.size() > 1) map.heights_um[1] = -0.0;
     return map;
 }
 
