@@ -12,6 +12,7 @@
 #include <gtest/gtest.h>
 
 #include "../io/test_files.hpp"
+#include "expect_data_error.hpp"
 #include "roughscope/core/errors.hpp"
 #include "roughscope/surface/formats.hpp"
 #include "roughscope/surface/height_map.hpp"
@@ -21,18 +22,7 @@ namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
-template <class Body>
-void expect_data_error(Body&& body, std::initializer_list<const char*> parts) {
-    try {
-        body();
-        ADD_FAILURE() << "no DataError";
-    } catch (const DataError& e) {
-        for (const char* part : parts) {
-            EXPECT_NE(std::string(e.what()).find(part), std::string::npos)
-                << "'" << part << "' not in: " << e.what();
-        }
-    }
-}
+using roughscope::testing::expect_data_error;
 
 // Little-endian bytes of a value (the test machine's order is checked below).
 template <class T>

@@ -8,6 +8,7 @@
 
 #include <gtest/gtest.h>
 
+#include "expect_data_error.hpp"
 #include "roughscope/core/errors.hpp"
 #include "roughscope/surface/formats.hpp"
 #include "roughscope/surface/height_map.hpp"
@@ -18,18 +19,7 @@ namespace {
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 // Runs `body`, expects a DataError whose message contains every one of `parts`.
-template <class Body>
-void expect_data_error(Body&& body, std::initializer_list<const char*> parts) {
-    try {
-        body();
-        ADD_FAILURE() << "no DataError";
-    } catch (const DataError& e) {
-        for (const char* part : parts) {
-            EXPECT_NE(std::string(e.what()).find(part), std::string::npos)
-                << "'" << part << "' not in: " << e.what();
-        }
-    }
-}
+using roughscope::testing::expect_data_error;
 
 HeightMap csv(const std::string& text, const HeightReadOptions& options = {}) {
     return formats::decode_csv_matrix(text, "m.csv", options);
