@@ -11,5 +11,6 @@ void register_estimate(CLI::App& app);  // cli/estimate.cpp — roughness estima
 void register_paper(CLI::App& app);     // cli/paper.cpp    — paper tables recomputed
 void register_curet(CLI::App& app);     // cli/curet.cpp    — CUReT comparison (§5.3)
 void register_surface(CLI::App& app);   // cli/surface.cpp  — height data (§3.1)
+void register_simulate(CLI::App& app);  // cli/simulate.cpp — simulations (ground truth)
 
 }  // namespace roughscope::cli

@@ -27,6 +27,7 @@ int main(int argc, char** argv) {
     roughscope::cli::register_paper(app);
     roughscope::cli::register_curet(app);
     roughscope::cli::register_surface(app);
+    roughscope::cli::register_simulate(app);
 
     return roughscope::cli::run_app(app, argc, argv);
 }

@@ -43,6 +43,9 @@
 #include "roughscope/surface/spectral.hpp"
 #include "roughscope/surface/statistics.hpp"
 
+// simulation: numerical Kirchhoff scattering and synthetic camera captures (ground truth)
+#include "roughscope/simulation/kirchhoff.hpp"
+
 // serialize: every result type to JSON, CSV and Markdown
 #include "roughscope/serialize/comparison.hpp"
 #include "roughscope/serialize/estimation.hpp"

@@ -99,4 +99,32 @@ void RealToComplex::forward() { fftw_execute(as_plan(forward_plan_)); }
 
 void RealToComplex::backward() { fftw_execute(as_plan(backward_plan_)); }
 
+ComplexPlane::ComplexPlane(std::size_t rows, std::size_t cols) : rows_(rows), cols_(cols) {
+    assert(rows >= 1 && cols >= 1);
+    auto* buffer = static_cast<fftw_complex*>(fftw_malloc(rows * cols * sizeof(fftw_complex)));
+    if (buffer == nullptr) {
+        throw std::bad_alloc();
+    }
+    data_ = reinterpret_cast<std::complex<double>*>(buffer);
+    {
+        const std::lock_guard<std::mutex> lock(planner_mutex());
+        plan_ = fftw_plan_dft_2d(static_cast<int>(rows), static_cast<int>(cols), buffer, buffer,
+                                 FFTW_FORWARD, FFTW_ESTIMATE);
+    }
+    if (plan_ == nullptr) {
+        fftw_free(buffer);
+        throw std::bad_alloc();
+    }
+}
+
+ComplexPlane::~ComplexPlane() {
+    {
+        const std::lock_guard<std::mutex> lock(planner_mutex());
+        fftw_destroy_plan(as_plan(plan_));
+    }
+    fftw_free(data_);
+}
+
+void ComplexPlane::forward() { fftw_execute(as_plan(plan_)); }
+
 }  // namespace roughscope::surface::fft

@@ -62,4 +62,29 @@ class RealToComplex {
     void* backward_plan_ = nullptr;
 };
 
+// An in-place complex-to-complex 2-D transform of a rows × cols array (row-major), forward
+// (e^{−i…}, FFTW_FORWARD) only. Used by the Kirchhoff simulation (simulation topic), which
+// includes this internal header through the library's private include path.
+class ComplexPlane {
+  public:
+    ComplexPlane(std::size_t rows, std::size_t cols);  // std::bad_alloc when it cannot allocate
+    ~ComplexPlane();
+    ComplexPlane(const ComplexPlane&) = delete;
+    ComplexPlane& operator=(const ComplexPlane&) = delete;
+    ComplexPlane(ComplexPlane&&) = delete;
+    ComplexPlane& operator=(ComplexPlane&&) = delete;
+
+    std::size_t rows() const { return rows_; }
+    std::size_t cols() const { return cols_; }
+    std::complex<double>* data() { return data_; }
+    const std::complex<double>* data() const { return data_; }
+    void forward();  // in place, unnormalised
+
+  private:
+    std::size_t rows_;
+    std::size_t cols_;
+    std::complex<double>* data_ = nullptr;
+    void* plan_ = nullptr;
+};
+
 }  // namespace roughscope::surface::fft

@@ -1,0 +1,498 @@
+// Numerical Kirchhoff scattering on generated surfaces (kirchhoff.hpp; docs/simulation.md).
+#include "roughscope/simulation/kirchhoff.hpp"
+
+#include <algorithm>
+#include <array>
+#include <atomic>
+#include <cmath>
+#include <complex>
+#include <cstddef>
+#include <cstdint>
+#include <exception>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "roughscope/core/errors.hpp"
+#include "roughscope/core/names.hpp"
+#include "roughscope/core/numbers.hpp"
+#include "roughscope/core/text.hpp"
+#include "roughscope/surface/generate.hpp"
+#include "surface/fft.hpp"
+
+namespace roughscope::simulation {
+
+namespace {
+
+using cd = std::complex<double>;
+
+constexpr std::size_t kMinGridSide = 8;
+constexpr std::size_t kMaxGridSide = 4096;  // 2^24 points: 128 MB of heights
+constexpr std::size_t kMaxRealisations = 10'000'000;
+// The automatic spacing resolves the diffuse kernel until the nearest alias of its spectrum is
+// below kAliasTolerance of the value at v_xy (times ~9, the lattice sum Σ 1/|a|³ of all aliases
+// of an algebraic tail); the spacing never goes below 2π·T/kMaxKT. The automatic patch keeps the
+// periodic images' change of the kernel, ~4·g·C(L), below the same tolerance.
+constexpr double kAliasTolerance = 3e-3;
+constexpr double kAliasLatticeSum = 9.0;
+constexpr double kMaxKT = 2048.0;
+
+void check_grid_side(std::size_t n) {
+    if (n != 0 && (n < kMinGridSide || n > kMaxGridSide)) {
+        throw InvalidArgument(concat("simulation option n = ", std::to_string(n),
+                                     " is out of range: it must be 0 (chosen from the geometry) "
+                                     "or an integer in [8, 4096]"));
+    }
+}
+
+void check_map(const surface::HeightMap& map) {
+    surface::validate(map, "heights");
+    for (const double z : map.heights_um) {
+        if (!std::isfinite(z)) {
+            throw InvalidArgument(
+                "the scattering integral needs a complete height map: this one has missing "
+                "(NaN) points; fill or crop them first");
+        }
+    }
+}
+
+// SplitMix64's finaliser: the seed of realisation r of geometry k is h(h(h(seed) + k) + r).
+std::uint64_t mix(std::uint64_t x) {
+    x += 0x9e3779b97f4a7c15ULL;
+    x = (x ^ (x >> 30U)) * 0xbf58476d1ce4e5b9ULL;
+    x = (x ^ (x >> 27U)) * 0x94d049bb133111ebULL;
+    return x ^ (x >> 31U);
+}
+
+// exp(i·u·x_k) for the centred coordinates x_k = (k − (n−1)/2)·d, k = 0..n−1.
+std::vector<cd> centred_phases(std::size_t n, double u, double d) {
+    std::vector<cd> out(n);
+    const double c = 0.5 * static_cast<double>(n - 1);
+    for (std::size_t k = 0; k < n; ++k) {
+        const double x = (static_cast<double>(k) - c) * d;
+        out[k] = std::polar(1.0, u * x);
+    }
+    return out;
+}
+
+// The diffuse kernel's spectrum shape: the series sum without its prefactor.
+double series_shape(Correlation c, double g, double T2_vxy2) {
+    return c == Correlation::Gaussian ? gaussian_series_sum(g, T2_vxy2)
+                                      : exponential_series_sum(g, T2_vxy2);
+}
+
+double diffuse_series(Correlation c, double F2, double T_um, double area_um2, double g,
+                      double vxy2) {
+    return c == Correlation::Gaussian
+               ? diffuse_power_gaussian_series(F2, T_um, area_um2, g, vxy2)
+               : diffuse_power_exponential_series(F2, T_um, area_um2, g, vxy2);
+}
+
+// ρ0 of a sampled square patch: the Dirichlet kernel Π sin(n u d/2)/(n sin(u d/2)) (→ the
+// continuous sinc(u X) of §3.1 as d → 0 with n·d = 2X fixed).
+double dirichlet(double u, std::size_t n, double d) {
+    const double h = 0.5 * u * d;
+    const double s = std::sin(h);
+    if (std::abs(s) < 1e-300) {
+        return 1.0;  // on a multiple of the lattice's period: every sample in phase
+    }
+    return std::sin(static_cast<double>(n) * h) / (static_cast<double>(n) * s);
+}
+
+// What one geometry needs: the directions evaluated per realisation and the constants.
+struct Plan {
+    Geometry geometry;
+    ScatteringVector v;
+    double F = 0.0, F2 = 0.0;
+    std::size_t n = 0;
+    double dx_um = 0.0;
+    PatchLayout layout = PatchLayout::LatticeAligned;
+    long m = 0;
+    // Direction evaluation: kind 0 = v_xy = 0 (one direction); 1 = the four lattice directions
+    // (±m, 0), (0, ±m); 2 = one arbitrary (vx, vy) (Fixed).
+    int kind = 0;
+    std::vector<cd> ex, ey;  // centred phase tables along x and y
+    std::size_t directions() const { return kind == 1 ? 4 : 1; }
+};
+
+Plan make_plan(const Geometry& geom, const ScatterOptions& o) {
+    Plan p;
+    p.geometry = geom;
+    p.v = scattering_vector(geom, o.wavelength_um);
+    p.F2 = geometric_factor_squared(o.factor, geom);
+    p.F = std::sqrt(p.F2);
+    const ScatterGrid grid = choose_scatter_grid(geom, o);
+    p.n = grid.n;
+    p.dx_um = grid.dx_um;
+    const double w = std::sqrt(p.v.vxy2());
+    const double L = static_cast<double>(p.n) * p.dx_um;
+    if (w * p.dx_um >= kPi) {
+        throw InvalidArgument(concat(
+            "simulation spacing dx_um = ", format_message(p.dx_um),
+            " is too coarse for this direction: |v_xy| = ", format_message(w),
+            " rad/um lies beyond the grid's Nyquist frequency pi/dx; give dx_um below ",
+            format_message(kPi / w), " um (or 0 to choose it)"));
+    }
+    p.layout = o.layout;
+    if (w == 0.0) {
+        p.kind = 0;
+        p.layout = o.layout;
+    } else if (o.layout == PatchLayout::LatticeAligned) {
+        const double m_real = w * L / (2.0 * kPi);
+        p.m = std::lround(m_real);
+        if (p.m == 0) {
+            // Inside the first lattice cell: no lattice direction is near v_xy; evaluate exactly.
+            p.layout = PatchLayout::Fixed;
+        } else {
+            p.dx_um = 2.0 * kPi * static_cast<double>(p.m) / (static_cast<double>(p.n) * w);
+            p.kind = 1;
+            p.ex = centred_phases(p.n, w, p.dx_um);
+        }
+    }
+    if (w != 0.0 && p.layout == PatchLayout::Fixed) {
+        p.m = 0;
+        p.kind = 2;
+        p.ex = centred_phases(p.n, p.v.vx, p.dx_um);
+        p.ey = centred_phases(p.n, p.v.vy, p.dx_um);
+    }
+    return p;
+}
+
+// I at the plan's directions for one surface (heights z, n × n row-major), into out[0..J).
+void evaluate(const Plan& p, const double* z, cd* out) {
+    const std::size_t n = p.n;
+    const double vz = p.v.vz;
+    const double norm = 1.0 / (static_cast<double>(n) * static_cast<double>(n));
+    cd s0{}, s1{}, s2{}, s3{};
+    for (std::size_t iy = 0; iy < n; ++iy) {
+        const double* row = z + iy * n;
+        cd r0{}, rp{}, rm{};
+        for (std::size_t ix = 0; ix < n; ++ix) {
+            const double phase = vz * row[ix];
+            const cd e{std::cos(phase), std::sin(phase)};
+            if (p.kind == 0) {
+                r0 += e;
+            } else if (p.kind == 1) {
+                r0 += e;
+                rp += e * p.ex[ix];
+                rm += e * std::conj(p.ex[ix]);
+            } else {
+                rp += e * p.ex[ix];
+            }
+        }
+        if (p.kind == 0) {
+            s0 += r0;
+        } else if (p.kind == 1) {
+            s0 += rp;                       // (+m, 0)
+            s1 += rm;                       // (−m, 0)
+            s2 += r0 * p.ex[iy];            // (0, +m)
+            s3 += r0 * std::conj(p.ex[iy]);  // (0, −m)
+        } else {
+            s0 += rp * p.ey[iy];
+        }
+    }
+    out[0] = s0 * norm;
+    if (p.kind == 1) {
+        out[1] = s1 * norm;
+        out[2] = s2 * norm;
+        out[3] = s3 * norm;
+    }
+}
+
+ScatterResult summarise(const Plan& p, const ScatterOptions& o, const std::vector<cd>& fields) {
+    const std::size_t J = p.directions();
+    const std::size_t R = fields.size() / J;
+    const double Rd = static_cast<double>(R);
+    std::vector<cd> mean(J);
+    for (std::size_t r = 0; r < R; ++r) {
+        for (std::size_t j = 0; j < J; ++j) mean[j] += p.F * fields[r * J + j];
+    }
+    for (cd& m : mean) m /= Rd;
+    // Per-realisation diffuse samples d_r (the J directions averaged), unbiased for D.
+    double sum = 0.0, sum2 = 0.0;
+    std::vector<double> d(R);
+    for (std::size_t r = 0; r < R; ++r) {
+        double acc = 0.0;
+        for (std::size_t j = 0; j < J; ++j) acc += std::norm(p.F * fields[r * J + j] - mean[j]);
+        d[r] = acc / static_cast<double>(J) * Rd / (Rd - 1.0);
+        sum += d[r];
+    }
+    const double diffuse = sum / Rd;
+    for (const double x : d) sum2 += (x - diffuse) * (x - diffuse);
+    ScatterResult res;
+    res.geometry = p.geometry;
+    res.g = roughness_g(o.sigma_um, p.v.vz);
+    res.T_vxy = o.T_um * std::sqrt(p.v.vxy2());
+    res.F2 = p.F2;
+    res.diffuse = diffuse;
+    res.diffuse_stderr = std::sqrt(sum2 / (Rd - 1.0) / Rd);
+    double coherent = 0.0, coherent_var = 0.0;
+    for (const cd& m : mean) {
+        const double c = std::norm(m) - diffuse / Rd;
+        coherent += c;
+        coherent_var += 2.0 * std::max(std::norm(m), 0.0) * diffuse / Rd +
+                        (diffuse / Rd) * (diffuse / Rd);
+    }
+    res.coherent = coherent / static_cast<double>(J);
+    res.coherent_stderr = std::sqrt(coherent_var) / static_cast<double>(J);
+    res.n = p.n;
+    res.dx_um = p.dx_um;
+    const double L = static_cast<double>(p.n) * p.dx_um;
+    res.area_um2 = L * L;
+    res.realisations = R;
+    res.layout = p.layout;
+    res.lattice_index = p.m;
+    res.series_diffuse =
+        diffuse_series(o.correlation, p.F2, o.T_um, res.area_um2, res.g, p.v.vxy2());
+    double rho0 = 1.0;
+    if (p.kind == 1) {
+        rho0 = 0.0;  // a nonzero lattice frequency: the plate's sum vanishes
+    } else if (p.kind == 2) {
+        rho0 = dirichlet(p.v.vx, p.n, p.dx_um) * dirichlet(p.v.vy, p.n, p.dx_um);
+    }
+    res.series_coherent = p.F2 * rho0 * rho0 * std::exp(-res.g);
+    return res;
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------------
+
+std::complex<double> LatticeField::at(long i, long j) const {
+    const auto wrap = [](long k, std::size_t n) {
+        const long nn = static_cast<long>(n);
+        return static_cast<std::size_t>(((k % nn) + nn) % nn);
+    };
+    return values[wrap(j, ny) * nx + wrap(i, nx)];
+}
+
+LatticeField scattering_integral_lattice(const surface::HeightMap& map, double vz_per_um) {
+    check_map(map);
+    check::finite("v_z", vz_per_um);
+    surface::fft::ComplexPlane plane(map.ny, map.nx);
+    const std::size_t count = map.nx * map.ny;
+    cd* data = plane.data();
+    for (std::size_t k = 0; k < count; ++k) {
+        const double phase = vz_per_um * map.heights_um[k];
+        data[k] = cd{std::cos(phase), std::sin(phase)};
+    }
+    // FFTW's forward transform has e^{−i}; I wants e^{+i v·r}: transform the conjugate and
+    // conjugate back, then shift to centred coordinates (a phase per lattice index) and
+    // normalise by the number of points (dx dy / A = 1/(nx ny)).
+    for (std::size_t k = 0; k < count; ++k) data[k] = std::conj(data[k]);
+    plane.forward();
+    LatticeField out;
+    out.nx = map.nx;
+    out.ny = map.ny;
+    out.dvx_per_um = 2.0 * kPi / (static_cast<double>(map.nx) * map.dx_um);
+    out.dvy_per_um = 2.0 * kPi / (static_cast<double>(map.ny) * map.dy_um);
+    out.vz_per_um = vz_per_um;
+    out.values.resize(count);
+    const double norm = 1.0 / static_cast<double>(count);
+    const double cx = 0.5 * static_cast<double>(map.nx - 1);
+    const double cy = 0.5 * static_cast<double>(map.ny - 1);
+    std::vector<cd> shift_x(map.nx), shift_y(map.ny);
+    for (std::size_t i = 0; i < map.nx; ++i) {
+        const long si = i <= map.nx / 2 ? static_cast<long>(i)
+                                        : static_cast<long>(i) - static_cast<long>(map.nx);
+        shift_x[i] = std::polar(1.0, -2.0 * kPi * static_cast<double>(si) * cx /
+                                         static_cast<double>(map.nx));
+    }
+    for (std::size_t j = 0; j < map.ny; ++j) {
+        const long sj = j <= map.ny / 2 ? static_cast<long>(j)
+                                        : static_cast<long>(j) - static_cast<long>(map.ny);
+        shift_y[j] = std::polar(1.0, -2.0 * kPi * static_cast<double>(sj) * cy /
+                                         static_cast<double>(map.ny));
+    }
+    for (std::size_t j = 0; j < map.ny; ++j) {
+        for (std::size_t i = 0; i < map.nx; ++i) {
+            const std::size_t k = j * map.nx + i;
+            out.values[k] = std::conj(data[k]) * norm * shift_x[i] * shift_y[j];
+        }
+    }
+    return out;
+}
+
+std::complex<double> scattering_integral_at(const surface::HeightMap& map,
+                                            const ScatteringVector& v) {
+    check_map(map);
+    check::finite("v_x", v.vx);
+    check::finite("v_y", v.vy);
+    check::finite("v_z", v.vz);
+    const std::vector<cd> ex = centred_phases(map.nx, v.vx, map.dx_um);
+    const std::vector<cd> ey = centred_phases(map.ny, v.vy, map.dy_um);
+    cd sum{};
+    for (std::size_t j = 0; j < map.ny; ++j) {
+        cd row_sum{};
+        const double* row = map.heights_um.data() + j * map.nx;
+        for (std::size_t i = 0; i < map.nx; ++i) {
+            const double phase = v.vz * row[i];
+            row_sum += cd{std::cos(phase), std::sin(phase)} * ex[i];
+        }
+        sum += row_sum * ey[j];
+    }
+    return sum / (static_cast<double>(map.nx) * static_cast<double>(map.ny));
+}
+
+// ---------------------------------------------------------------------------------------------
+
+void check_scatter_options(const ScatterOptions& o) {
+    if (o.correlation != Correlation::Gaussian && o.correlation != Correlation::Exponential) {
+        throw InvalidArgument(
+            "simulation option correlation is invalid: it must be gaussian or exponential");
+    }
+    check_length_um("sigma", o.sigma_um);
+    if (!(o.sigma_um <= kMaxLengthUm * 1e-2)) {
+        throw InvalidArgument(concat("sigma = ", format_message(o.sigma_um),
+                                     " um is out of range for a simulation: it must be at most "
+                                     "1e+28 um"));
+    }
+    check_length_um("T", o.T_um);
+    check_length_um("wavelength", o.wavelength_um);
+    check_grid_side(o.n);
+    if (o.dx_um != 0.0) check_length_um("dx", o.dx_um);
+    if (!(o.patch_over_T == 0.0 || (o.patch_over_T >= 1.0 && o.patch_over_T <= 1e4))) {
+        throw InvalidArgument(concat("simulation option patch_over_T = ",
+                                     format_message(o.patch_over_T),
+                                     " is out of range: it must be 0 (chosen) or in [1, 1e4]"));
+    }
+    if (o.realisations < 2 || o.realisations > kMaxRealisations) {
+        throw InvalidArgument(concat("simulation option realisations = ",
+                                     std::to_string(o.realisations),
+                                     " is out of range: it must be an integer in [2, 1e7]"));
+    }
+    if (o.n != 0 && o.dx_um != 0.0 && !(o.T_um <= static_cast<double>(o.n) * o.dx_um)) {
+        throw InvalidArgument(concat("simulation patch n*dx = ",
+                                     format_message(static_cast<double>(o.n) * o.dx_um),
+                                     " um is shorter than T = ", format_message(o.T_um),
+                                     " um: the patch must be at least one correlation length"));
+    }
+}
+
+ScatterGrid choose_scatter_grid(const Geometry& geom, const ScatterOptions& o) {
+    check::geometry(geom);
+    const ScatteringVector v = scattering_vector(geom, o.wavelength_um);
+    const double w = std::sqrt(v.vxy2());
+    const double T = o.T_um;
+    const double g = roughness_g(o.sigma_um, v.vz);
+    ScatterGrid grid;
+    if (o.dx_um != 0.0) {
+        grid.dx_um = o.dx_um;
+    } else {
+        // Smallest sampling frequency K = 2π/dx (in steps of 10 %) at which the nearest alias
+        // of the kernel's spectrum, at K − |v_xy|, is below kAliasTolerance of its value at v_xy.
+        const double target = series_shape(o.correlation, g, T * T * v.vxy2());
+        double KT = std::max(2.5 * w * T, 4.0);
+        while (KT < kMaxKT) {
+            const double a = KT - w * T;
+            const double alias = series_shape(o.correlation, g, a * a);
+            if (kAliasLatticeSum * alias <= kAliasTolerance * target) break;
+            KT *= 1.1;
+        }
+        KT = std::min(KT, kMaxKT);
+        grid.dx_um = 2.0 * kPi * T / KT;
+    }
+    if (o.n != 0) {
+        grid.n = o.n;
+    } else {
+        double patch_over_T = o.patch_over_T;
+        if (patch_over_T == 0.0) {
+            patch_over_T = o.correlation == Correlation::Gaussian
+                               ? 6.0
+                               : std::max(8.0, std::log(4.0 * std::max(g, 1.0) / kAliasTolerance));
+        }
+        const double want = std::ceil(patch_over_T * T / grid.dx_um);
+        if (!(want <= static_cast<double>(kMaxGridSide))) {
+            throw InvalidArgument(concat(
+                "the simulation grid needed at this geometry (g = ", format_message(g),
+                ", T*v_xy = ", format_message(w * T), ") has ", format_message(want),
+                " points per side with dx = ", format_message(grid.dx_um),
+                " um, beyond the limit of 4096: give n and dx_um, or a smaller patch_over_T"));
+        }
+        grid.n = surface::fft::good_size(std::max(kMinGridSide, static_cast<std::size_t>(want)));
+        grid.n = std::min(grid.n, kMaxGridSide);
+    }
+    if (!(T <= static_cast<double>(grid.n) * grid.dx_um)) {
+        throw InvalidArgument(concat("simulation patch n*dx = ",
+                                     format_message(static_cast<double>(grid.n) * grid.dx_um),
+                                     " um is shorter than T = ", format_message(T),
+                                     " um: the patch must be at least one correlation length"));
+    }
+    return grid;
+}
+
+std::vector<ScatterResult> simulate_scattering(const std::vector<Geometry>& geometries,
+                                               const ScatterOptions& o,
+                                               const ProgressCallback& progress) {
+    check_scatter_options(o);
+    std::vector<Plan> plans;
+    plans.reserve(geometries.size());
+    for (const Geometry& geom : geometries) plans.push_back(make_plan(geom, o));
+
+    const std::size_t R = o.realisations;
+    std::vector<std::vector<cd>> fields(plans.size());
+    for (std::size_t k = 0; k < plans.size(); ++k) fields[k].resize(R * plans[k].directions());
+    const std::size_t total = plans.size() * R;
+
+    std::atomic<std::size_t> next{0}, done{0};
+    std::atomic<bool> stop{false};
+    std::exception_ptr failure;
+    std::mutex failure_mutex;
+    auto work = [&](bool caller) {
+        try {
+            while (!stop.load(std::memory_order_relaxed)) {
+                const std::size_t job = next.fetch_add(1);
+                if (job >= total) break;
+                const std::size_t k = job / R, r = job % R;
+                const Plan& p = plans[k];
+                surface::GenerationOptions g;
+                g.correlation = o.correlation;
+                g.sigma_um = o.sigma_um;
+                g.T_um = o.T_um;
+                g.nx = g.ny = p.n;
+                g.dx_um = g.dy_um = p.dx_um;
+                g.seed = mix(mix(mix(o.seed) + k) + r);
+                const surface::HeightMap map = surface::generate_surface(g);
+                evaluate(p, map.heights_um.data(), fields[k].data() + r * p.directions());
+                const std::size_t finished = done.fetch_add(1) + 1;
+                if (caller && progress) progress(finished, total);
+            }
+        } catch (...) {
+            stop = true;
+            const std::lock_guard<std::mutex> lock(failure_mutex);
+            if (!failure) failure = std::current_exception();
+        }
+    };
+    unsigned threads = o.threads != 0 ? o.threads : std::max(1U, std::thread::hardware_concurrency());
+    threads = static_cast<unsigned>(std::min<std::size_t>(threads, total));
+    std::vector<std::thread> pool;
+    for (unsigned t = 1; t < threads; ++t) pool.emplace_back(work, false);
+    work(true);
+    for (std::thread& t : pool) t.join();
+    if (failure) std::rethrow_exception(failure);
+    if (progress) progress(total, total);
+
+    std::vector<ScatterResult> out;
+    out.reserve(plans.size());
+    for (std::size_t k = 0; k < plans.size(); ++k) out.push_back(summarise(plans[k], o, fields[k]));
+    return out;
+}
+
+ScatterResult simulate_scattering(const Geometry& geom, const ScatterOptions& options) {
+    return simulate_scattering(std::vector<Geometry>{geom}, options).front();
+}
+
+namespace {
+constexpr std::array<NameEntry<PatchLayout>, 2> kLayoutNames{{
+    {"lattice_aligned", PatchLayout::LatticeAligned},
+    {"fixed", PatchLayout::Fixed},
+}};
+}  // namespace
+
+std::string_view to_string(PatchLayout layout) { return name_of(kLayoutNames, layout); }
+PatchLayout parse_patch_layout(std::string_view name) {
+    return parse_name(kLayoutNames, "patch layout", name);
+}
+
+}  // namespace roughscope::simulation
