@@ -48,7 +48,8 @@ py::array_t<double> heights_array(const surface::HeightMap& map) {
     return out;
 }
 
-// A HeightMap from a 1-D (profile) or 2-D (ny, nx) real array and the spacings.
+}  // namespace
+
 surface::HeightMap height_map_from(py::handle heights, py::handle dx, py::handle dy) {
     const double dx_um = real_scalar("dx_um", dx);
     const std::optional<double> dy_um = optional_real("dy_um", dy);
@@ -67,6 +68,8 @@ surface::HeightMap height_map_from(py::handle heights, py::handle dx, py::handle
     surface::validate(map, "heights_um");
     return map;
 }
+
+namespace {
 
 surface::RawSampleType raw_type_of(const std::string& name) {
     const std::string n = normalize_name(name);

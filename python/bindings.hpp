@@ -8,6 +8,7 @@
 #include <pybind11/pybind11.h>
 
 #include "roughscope/serialize/json.hpp"
+#include "roughscope/surface/height_map.hpp"
 
 namespace roughscope::python {
 
@@ -15,6 +16,7 @@ void bind_core(pybind11::module_& m);        // python/bind_core.cpp: models, ge
 void bind_estimation(pybind11::module_& m);  // python/bind_estimation.cpp: §4 estimators, fits
 void bind_curet(pybind11::module_& m);       // python/bind_curet.cpp: CUReT / BRDF tables
 void bind_surface(pybind11::module_& m);     // python/bind_surface.cpp: height data (§3.1)
+void bind_simulation(pybind11::module_& m);  // python/bind_simulation.cpp: Kirchhoff Monte Carlo
 
 // Results cross into Python as real objects, built from the library's serializer
 // (roughscope/serialize): objects → dict (key order kept), arrays → list, numbers → int/float,
@@ -43,6 +45,11 @@ long long integer_scalar(const char* name, pybind11::handle value);
 // Returns the value as float (list of floats).
 pybind11::object real_option(const char* name, pybind11::object value, bool pair = false,
                              bool none_allowed = true);
+// A HeightMap from a 1-D (profile) or 2-D (ny, nx) real array of heights in µm and the spacings
+// dx_um, dy_um (None = dx_um); non-finite heights become missing points (bind_surface.cpp).
+surface::HeightMap height_map_from(pybind11::handle heights, pybind11::handle dx,
+                                   pybind11::handle dy);
+
 // Throws MemoryError (checked before allocating) when `elements` float64 values, `arrays` times,
 // exceed what this machine can hold; `what` describes the shape.
 void check_allocation(double elements, int arrays, const std::string& what);

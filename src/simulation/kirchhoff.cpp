@@ -430,6 +430,18 @@ std::vector<ScatterResult> simulate_scattering(const std::vector<Geometry>& geom
     plans.reserve(geometries.size());
     for (const Geometry& geom : geometries) plans.push_back(make_plan(geom, o));
 
+    // One generator per geometry (the filter is computed once, each realisation draws noise).
+    std::vector<surface::SurfaceGenerator> generators;
+    generators.reserve(plans.size());
+    for (const Plan& p : plans) {
+        surface::GenerationOptions g;
+        g.correlation = o.correlation;
+        g.sigma_um = o.sigma_um;
+        g.T_um = o.T_um;
+        g.nx = g.ny = p.n;
+        g.dx_um = g.dy_um = p.dx_um;
+        generators.emplace_back(g);
+    }
     const std::size_t R = o.realisations;
     std::vector<std::vector<cd>> fields(plans.size());
     for (std::size_t k = 0; k < plans.size(); ++k) fields[k].resize(R * plans[k].directions());
@@ -446,14 +458,8 @@ std::vector<ScatterResult> simulate_scattering(const std::vector<Geometry>& geom
                 if (job >= total) break;
                 const std::size_t k = job / R, r = job % R;
                 const Plan& p = plans[k];
-                surface::GenerationOptions g;
-                g.correlation = o.correlation;
-                g.sigma_um = o.sigma_um;
-                g.T_um = o.T_um;
-                g.nx = g.ny = p.n;
-                g.dx_um = g.dy_um = p.dx_um;
-                g.seed = mix(mix(mix(o.seed) + k) + r);
-                const surface::HeightMap map = surface::generate_surface(g);
+                const surface::HeightMap map =
+                    generators[k].generate(mix(mix(mix(o.seed) + k) + r));
                 evaluate(p, map.heights_um.data(), fields[k].data() + r * p.directions());
                 const std::size_t finished = done.fetch_add(1) + 1;
                 if (caller && progress) progress(finished, total);

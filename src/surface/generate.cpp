@@ -239,9 +239,9 @@ HeightMap filter_noise(const GenerationOptions& o, const std::vector<double>& ga
 
 }  // namespace
 
-HeightMap generate_surface(const GenerationOptions& options) {
+SurfaceGenerator::SurfaceGenerator(const GenerationOptions& options) : options_(options) {
     check_options(options);
-    const GenerationOptions& o = options;
+    const GenerationOptions& o = options_;
     fft::RealToComplex f(o.ny, o.nx, fft::Layout::plane);
     // S = DFT(C_p) is real (C_p is even) and ≥ 0 up to rounding (C_p is positive definite), so the
     // gain σ√S/(nx ny) gives the periodic surface the ensemble ACF σ² C_p on the lattice.
@@ -249,14 +249,20 @@ HeightMap generate_surface(const GenerationOptions& options) {
     f.forward();
     const std::size_t cols = f.spectrum_cols();
     const double points = static_cast<double>(o.nx) * static_cast<double>(o.ny);
-    std::vector<double> gain(o.ny * cols);
+    gain_.resize(o.ny * cols);
     for (std::size_t r = 0; r < o.ny; ++r) {
         const std::complex<double>* row = f.spectrum_row(r);
         for (std::size_t k = 0; k < cols; ++k) {
-            gain[r * cols + k] = o.sigma_um * std::sqrt(std::max(row[k].real(), 0.0)) / points;
+            gain_[r * cols + k] = o.sigma_um * std::sqrt(std::max(row[k].real(), 0.0)) / points;
         }
     }
-    HeightMap map = filter_noise(o, gain, f);
+}
+
+HeightMap SurfaceGenerator::generate(std::uint64_t seed) const {
+    GenerationOptions o = options_;
+    o.seed = seed;
+    fft::RealToComplex f(o.ny, o.nx, fft::Layout::plane);
+    HeightMap map = filter_noise(o, gain_, f);
     map.title = "roughscope generated surface (";
     map.title.append(to_string(o.correlation))
         .append(" correlation, sigma_um = ")
@@ -267,6 +273,10 @@ HeightMap generate_surface(const GenerationOptions& options) {
         .append(std::to_string(o.seed))
         .append(")");
     return map;
+}
+
+HeightMap generate_surface(const GenerationOptions& options) {
+    return SurfaceGenerator(options).generate(options.seed);
 }
 
 HeightMap generate_surface_from_psd(const std::function<double(double k_rad_per_um)>& psd,

@@ -38,7 +38,8 @@ struct LatticeField {
     double dvx_per_um = 0.0, dvy_per_um = 0.0;  // lattice steps 2π/Lx, 2π/Ly
     double vz_per_um = 0.0;
     // I at signed indices (i, j), stored in FFT order: values[jj·nx + ii] with ii = i mod nx,
-    // jj = j mod ny. at(i, j) does the wrapping.
+    // jj = j mod ny. at(i, j) does the wrapping; with the centred coordinates the Nyquist index
+    // of an even side is +n/2 (the value at −n/2 differs by the factor e^{iπ(n−1)} = −1).
     std::vector<std::complex<double>> values;
     std::complex<double> at(long i, long j) const;
     double vx_per_um(long i) const { return dvx_per_um * static_cast<double>(i); }

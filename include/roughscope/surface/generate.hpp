@@ -9,6 +9,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <functional>
+#include <vector>
 
 #include "roughscope/scattering/beckmann.hpp"
 #include "roughscope/surface/height_map.hpp"
@@ -28,6 +29,20 @@ struct GenerationOptions {
 
 // InvalidArgument naming the option and its range for anything out of range.
 HeightMap generate_surface(const GenerationOptions& options);
+
+// Many surfaces of the same statistics: the filter (the periodised ACF's spectrum, the costly part
+// for exponential correlation) is computed once; generate(seed) then draws one surface, equal bit
+// for bit to generate_surface with that seed. generate may run concurrently on one generator.
+class SurfaceGenerator {
+  public:
+    explicit SurfaceGenerator(const GenerationOptions& options);  // validates; options.seed unused
+    HeightMap generate(std::uint64_t seed) const;
+    const GenerationOptions& options() const { return options_; }
+
+  private:
+    GenerationOptions options_;
+    std::vector<double> gain_;  // the half-spectrum gain σ√S/(nx ny)
+};
 
 // The same with the correlation replaced by an isotropic two-sided PSD W(k) of the spatial
 // angular frequency k = |k| (rad/µm), scaled so that the surface's RMS height is sigma_um.

@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <complex>
 #include <cstddef>
 #include <string>
@@ -23,6 +24,18 @@ namespace roughscope::simulation {
 namespace {
 
 using cd = std::complex<double>;
+
+#if defined(__SANITIZE_ADDRESS__)
+constexpr bool kSanitized = true;
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+constexpr bool kSanitized = true;
+#else
+constexpr bool kSanitized = false;
+#endif
+#else
+constexpr bool kSanitized = false;
+#endif
 
 // Σ_{k<n} e^{i u (k − (n−1)/2) d} / n in closed form: sin(n u d/2)/(n sin(u d/2)).
 double dirichlet_closed_form(double u, std::size_t n, double d) {
@@ -77,17 +90,17 @@ TEST(KirchhoffField, LatticeEqualsDirectSummation) {
     const double vz = -5.5;
     const LatticeField lattice = scattering_integral_lattice(map, vz);
     ASSERT_EQ(lattice.values.size(), map.size());
-    for (const long i : {0L, 1L, -1L, 5L, -12L, 11L}) {
-        for (const long j : {0L, 2L, -3L, 8L, -9L}) {
+    for (const long i : {0L, 1L, -1L, 5L, -11L, 12L}) {
+        for (const long j : {0L, 2L, -3L, -8L, 9L}) {
             const cd direct =
                 scattering_integral_at(map, {lattice.vx_per_um(i), lattice.vy_per_um(j), vz});
             EXPECT_NEAR(std::abs(lattice.at(i, j) - direct), 0.0, 1e-13) << i << "," << j;
         }
     }
-    // Parseval: Σ |I|² over the lattice = (1/N) · mean |exp(i vz z)|² = 1/N.
+    // Parseval: Σ |I|² over the lattice = (1/N) Σ |exp(i vz z)|² = 1.
     double power = 0.0;
     for (const cd& v : lattice.values) power += std::norm(v);
-    EXPECT_NEAR(power, 1.0 / static_cast<double>(map.size()), 1e-15);
+    EXPECT_NEAR(power, 1.0, 1e-13);
 }
 
 TEST(KirchhoffField, RefusesMissingPointsAndNonFiniteVectors) {
@@ -138,19 +151,24 @@ TEST(KirchhoffEnsemble, DiffusePowerAgreesWithTheExactSeries) {
     // Large g (≈ 12 and ≈ 30) and T·v_xy up to ~10.
     for (const Correlation corr : {Correlation::Gaussian, Correlation::Exponential}) {
         cases.push_back({corr, 20.0, 10.0, 180.0, 0.15});
-        cases.push_back({corr, 10.0, 10.0, 0.0, 0.2});
+        cases.push_back({corr, 10.0, 10.0, 0.0, 0.22});
         cases.push_back({corr, 75.0, 10.0, 0.0, 0.03});
-        cases.push_back({corr, 50.0, 60.0, 0.0, 0.235});
+        cases.push_back({corr, 50.0, 60.0, 0.0, 0.26});
         cases.push_back({corr, 80.0, 0.0, 0.0, 0.05});
         cases.push_back({corr, 35.0, 35.0, 30.0, 0.01});
     }
     ASSERT_GE(cases.size(), 30U);
-    double max_g = 0.0, max_T_vxy = 0.0, min_g = 1e300;
+    if (kSanitized) {
+        // Under AddressSanitizer the point is memory errors, which a few cases reach; the
+        // release run checks every geometry.
+        cases = {cases[0], cases[13], cases[30]};
+    }
+    double max_g = 0.0, max_T_vxy = 0.0, min_g = 1e300, chi2 = 0.0;
     for (const Case& c : cases) {
         const ScatterResult r = simulate_scattering(
             make_geometry(deg_to_rad(c.theta_i_deg), deg_to_rad(c.theta_s_deg),
                           deg_to_rad(c.phi_s_deg)),
-            options_for(c, 150));
+            options_for(c, 100));
         max_g = std::max(max_g, r.g);
         min_g = std::min(min_g, r.g);
         max_T_vxy = std::max(max_T_vxy, r.T_vxy);
@@ -165,7 +183,16 @@ TEST(KirchhoffEnsemble, DiffusePowerAgreesWithTheExactSeries) {
             << r.series_diffuse;
         // The standard error is a real uncertainty, not a blanket: below 15 % of the value.
         EXPECT_LT(r.diffuse_stderr, 0.15 * r.series_diffuse) << where;
+        const double dev = (r.diffuse - r.series_diffuse) / r.diffuse_stderr;
+        chi2 += dev * dev;
+        std::printf("%s: dev %+.2f\n", where.c_str(), dev);
     }
+    // The standard errors are calibrated: the mean squared deviation is ~1 (not ≪ 1, which an
+    // inflated error would give; not ≫ 1, which a bias would).
+    if (kSanitized) return;
+    const double mean_chi2 = chi2 / static_cast<double>(cases.size());
+    EXPECT_GT(mean_chi2, 0.4);
+    EXPECT_LT(mean_chi2, 2.0);
     EXPECT_LT(min_g, 0.06);
     EXPECT_GT(max_g, 25.0);
     EXPECT_GT(max_T_vxy, 9.0);
@@ -193,7 +220,7 @@ TEST(KirchhoffEnsemble, CoherentPowerIsExpMinusG) {
 TEST(KirchhoffEnsemble, ExponentialAtLargeGFollowsTheSeriesNotEq5) {
     const Case c{Correlation::Exponential, 20.0, 20.0, 0.0, 0.2};
     const Geometry geom = specular_geometry(deg_to_rad(20.0));
-    const ScatterResult r = simulate_scattering(geom, options_for(c, 100));
+    const ScatterResult r = simulate_scattering(geom, options_for(c, 40));
     ASSERT_GE(r.g, 20.0);
     const ScatteringVector v = scattering_vector(geom, 0.5);
     const double eq5 = diffuse_power_very_rough_exponential(r.F2, 0.2, 1.0, r.area_um2,

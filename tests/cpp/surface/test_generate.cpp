@@ -131,6 +131,21 @@ TEST(Generate, SameSeedGivesTheSameBitsAndAnotherSeedAnotherSurface) {
     EXPECT_LT(std::abs(dot / static_cast<double>(a.size())) / (1.5 * 1.5), 0.3);
 }
 
+TEST(Generate, OneGeneratorDrawsTheSurfacesOfGenerateSurfaceConcurrently) {
+    GenerationOptions o = options(Correlation::Exponential, 40, 30, 3, 5);
+    const SurfaceGenerator generator(o);
+    HeightMap b;
+    HeightMap c;
+    std::thread t1([&] { b = generator.generate(5); });
+    std::thread t2([&] { c = generator.generate(6); });
+    t1.join();
+    t2.join();
+    EXPECT_TRUE(bitwise_equal(b, generate_surface(o)));
+    o.seed = 6;
+    EXPECT_TRUE(bitwise_equal(c, generate_surface(o)));
+    EXPECT_FALSE(bitwise_equal(b, c));
+}
+
 TEST(Generate, PinnedValuesOfOneSeed) {
     // The seed's noise stream (mt19937_64 + Boost.Random's ziggurat normal_distribution, row-major)
     // and the filter, pinned: a change of either changes these values. Tolerance: FFT rounding on
