@@ -19,6 +19,7 @@
 #include "roughscope/core/numbers.hpp"
 #include "roughscope/core/text.hpp"
 #include "roughscope/surface/generate.hpp"
+#include "phasor.hpp"
 #include "surface/fft.hpp"
 
 namespace roughscope::simulation {
@@ -55,6 +56,15 @@ void check_map(const surface::HeightMap& map) {
                 "(NaN) points; fill or crop them first");
         }
     }
+}
+
+// a·b and a·conj(b) without the NaN/inf recovery of std::complex's operator* (a library call per
+// product under GCC's default -fcx-fortran-rules off): the operands here are always finite.
+inline cd mul(cd a, cd b) {
+    return {a.real() * b.real() - a.imag() * b.imag(), a.real() * b.imag() + a.imag() * b.real()};
+}
+inline cd mul_conj(cd a, cd b) {
+    return {a.real() * b.real() + a.imag() * b.imag(), a.imag() * b.real() - a.real() * b.imag()};
 }
 
 // SplitMix64's finaliser: the seed of realisation r of geometry k is h(h(h(seed) + k) + r).
@@ -164,21 +174,21 @@ void evaluate(const Plan& p, const double* z, cd* out) {
     const std::size_t n = p.n;
     const double vz = p.v.vz;
     const double norm = 1.0 / (static_cast<double>(n) * static_cast<double>(n));
+    const detail::PhasorTable& table = detail::phasor_table();
     cd s0{}, s1{}, s2{}, s3{};
     for (std::size_t iy = 0; iy < n; ++iy) {
         const double* row = z + iy * n;
         cd r0{}, rp{}, rm{};
         for (std::size_t ix = 0; ix < n; ++ix) {
-            const double phase = vz * row[ix];
-            const cd e{std::cos(phase), std::sin(phase)};
+            const cd e = detail::unit_phasor(vz * row[ix], table);
             if (p.kind == 0) {
                 r0 += e;
             } else if (p.kind == 1) {
                 r0 += e;
-                rp += e * p.ex[ix];
-                rm += e * std::conj(p.ex[ix]);
+                rp += mul(e, p.ex[ix]);
+                rm += mul_conj(e, p.ex[ix]);
             } else {
-                rp += e * p.ex[ix];
+                rp += mul(e, p.ex[ix]);
             }
         }
         if (p.kind == 0) {
@@ -186,10 +196,10 @@ void evaluate(const Plan& p, const double* z, cd* out) {
         } else if (p.kind == 1) {
             s0 += rp;                       // (+m, 0)
             s1 += rm;                       // (−m, 0)
-            s2 += r0 * p.ex[iy];            // (0, +m)
-            s3 += r0 * std::conj(p.ex[iy]);  // (0, −m)
+            s2 += mul(r0, p.ex[iy]);       // (0, +m)
+            s3 += mul_conj(r0, p.ex[iy]);  // (0, −m)
         } else {
-            s0 += rp * p.ey[iy];
+            s0 += mul(rp, p.ey[iy]);
         }
     }
     out[0] = s0 * norm;
@@ -270,18 +280,7 @@ std::complex<double> LatticeField::at(long i, long j) const {
 LatticeField scattering_integral_lattice(const surface::HeightMap& map, double vz_per_um) {
     check_map(map);
     check::finite("v_z", vz_per_um);
-    surface::fft::ComplexPlane plane(map.ny, map.nx);
     const std::size_t count = map.nx * map.ny;
-    cd* data = plane.data();
-    for (std::size_t k = 0; k < count; ++k) {
-        const double phase = vz_per_um * map.heights_um[k];
-        data[k] = cd{std::cos(phase), std::sin(phase)};
-    }
-    // FFTW's forward transform has e^{−i}; I wants e^{+i v·r}: transform the conjugate and
-    // conjugate back, then shift to centred coordinates (a phase per lattice index) and
-    // normalise by the number of points (dx dy / A = 1/(nx ny)).
-    for (std::size_t k = 0; k < count; ++k) data[k] = std::conj(data[k]);
-    plane.forward();
     LatticeField out;
     out.nx = map.nx;
     out.ny = map.ny;
@@ -289,6 +288,16 @@ LatticeField scattering_integral_lattice(const surface::HeightMap& map, double v
     out.dvy_per_um = 2.0 * kPi / (static_cast<double>(map.ny) * map.dy_um);
     out.vz_per_um = vz_per_um;
     out.values.resize(count);
+    cd* data = out.values.data();
+    // FFTW's forward transform has e^{−i}; I wants e^{+i v·r}: transform the conjugate
+    // exp(−i v_z z) in place and conjugate back, then shift to centred coordinates (a phase per
+    // lattice index) and normalise by the number of points (dx dy / A = 1/(nx ny)).
+    surface::fft::ComplexPlane plane(map.ny, map.nx, data);
+    const detail::PhasorTable& table = detail::phasor_table();
+    for (std::size_t k = 0; k < count; ++k) {
+        data[k] = detail::unit_phasor(-vz_per_um * map.heights_um[k], table);
+    }
+    plane.forward();
     const double norm = 1.0 / static_cast<double>(count);
     const double cx = 0.5 * static_cast<double>(map.nx - 1);
     const double cy = 0.5 * static_cast<double>(map.ny - 1);
@@ -306,9 +315,10 @@ LatticeField scattering_integral_lattice(const surface::HeightMap& map, double v
                                          static_cast<double>(map.ny));
     }
     for (std::size_t j = 0; j < map.ny; ++j) {
+        const cd row_factor = norm * shift_y[j];
+        cd* row = data + j * map.nx;
         for (std::size_t i = 0; i < map.nx; ++i) {
-            const std::size_t k = j * map.nx + i;
-            out.values[k] = std::conj(data[k]) * norm * shift_x[i] * shift_y[j];
+            row[i] = mul(std::conj(row[i]), mul(row_factor, shift_x[i]));
         }
     }
     return out;
@@ -322,15 +332,15 @@ std::complex<double> scattering_integral_at(const surface::HeightMap& map,
     check::finite("v_z", v.vz);
     const std::vector<cd> ex = centred_phases(map.nx, v.vx, map.dx_um);
     const std::vector<cd> ey = centred_phases(map.ny, v.vy, map.dy_um);
+    const detail::PhasorTable& table = detail::phasor_table();
     cd sum{};
     for (std::size_t j = 0; j < map.ny; ++j) {
         cd row_sum{};
         const double* row = map.heights_um.data() + j * map.nx;
         for (std::size_t i = 0; i < map.nx; ++i) {
-            const double phase = v.vz * row[i];
-            row_sum += cd{std::cos(phase), std::sin(phase)} * ex[i];
+            row_sum += mul(detail::unit_phasor(v.vz * row[i], table), ex[i]);
         }
-        sum += row_sum * ey[j];
+        sum += mul(row_sum, ey[j]);
     }
     return sum / (static_cast<double>(map.nx) * static_cast<double>(map.ny));
 }
@@ -363,9 +373,9 @@ void check_scatter_options(const ScatterOptions& o) {
                                      " is out of range: it must be an integer in [2, 1e7]"));
     }
     if (o.n != 0 && o.dx_um != 0.0 && !(o.T_um <= static_cast<double>(o.n) * o.dx_um)) {
-        throw InvalidArgument(concat("simulation patch n*dx = ",
+        throw InvalidArgument(concat("simulation patch nx*dx_um = ",
                                      format_message(static_cast<double>(o.n) * o.dx_um),
-                                     " um is shorter than T = ", format_message(o.T_um),
+                                     " um is shorter than T_um = ", format_message(o.T_um),
                                      " um: the patch must be at least one correlation length"));
     }
 }
@@ -406,18 +416,25 @@ ScatterGrid choose_scatter_grid(const Geometry& geom, const ScatterOptions& o) {
         if (!(want <= static_cast<double>(kMaxGridSide))) {
             throw InvalidArgument(concat(
                 "the simulation grid needed at this geometry (g = ", format_message(g),
-                ", T*v_xy = ", format_message(w * T), ") has ", format_message(want),
-                " points per side with dx = ", format_message(grid.dx_um),
-                " um, beyond the limit of 4096: give n and dx_um, or a smaller patch_over_T"));
+                " from sigma_um = ", format_message(o.sigma_um), " and wavelength_um = ",
+                format_message(o.wavelength_um), ", T_um*v_xy = ", format_message(w * T),
+                ") has ", format_message(want), " points per side with dx_um = ",
+                format_message(grid.dx_um),
+                ", beyond the limit of 4096 (nx): give nx and dx_um, or a smaller patch_over_T"));
         }
         grid.n = surface::fft::good_size(std::max(kMinGridSide, static_cast<std::size_t>(want)));
         grid.n = std::min(grid.n, kMaxGridSide);
     }
     if (!(T <= static_cast<double>(grid.n) * grid.dx_um)) {
-        throw InvalidArgument(concat("simulation patch n*dx = ",
-                                     format_message(static_cast<double>(grid.n) * grid.dx_um),
-                                     " um is shorter than T = ", format_message(T),
-                                     " um: the patch must be at least one correlation length"));
+        throw InvalidArgument(concat(
+            "simulation patch nx*dx_um = ", std::to_string(grid.n), " x ",
+            format_message(grid.dx_um), " = ",
+            format_message(static_cast<double>(grid.n) * grid.dx_um),
+            " um is shorter than T_um = ", format_message(T), " um (",
+            o.dx_um != 0.0 ? "dx_um given" : "dx_um chosen to resolve the kernel",
+            " at g = ", format_message(g), " from sigma_um = ", format_message(o.sigma_um),
+            " and wavelength_um = ", format_message(o.wavelength_um),
+            "): the patch must be at least one correlation length; give a larger nx or dx_um"));
     }
     return grid;
 }

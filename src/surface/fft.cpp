@@ -117,12 +117,28 @@ ComplexPlane::ComplexPlane(std::size_t rows, std::size_t cols) : rows_(rows), co
     }
 }
 
+ComplexPlane::ComplexPlane(std::size_t rows, std::size_t cols, std::complex<double>* external)
+    : rows_(rows), cols_(cols), data_(external), owned_(false) {
+    assert(rows >= 1 && cols >= 1 && external != nullptr);
+    auto* buffer = reinterpret_cast<fftw_complex*>(external);
+    {
+        const std::lock_guard<std::mutex> lock(planner_mutex());
+        plan_ = fftw_plan_dft_2d(static_cast<int>(rows), static_cast<int>(cols), buffer, buffer,
+                                 FFTW_FORWARD, FFTW_ESTIMATE);
+    }
+    if (plan_ == nullptr) {
+        throw std::bad_alloc();
+    }
+}
+
 ComplexPlane::~ComplexPlane() {
     {
         const std::lock_guard<std::mutex> lock(planner_mutex());
         fftw_destroy_plan(as_plan(plan_));
     }
-    fftw_free(data_);
+    if (owned_) {
+        fftw_free(data_);
+    }
 }
 
 void ComplexPlane::forward() { fftw_execute(as_plan(plan_)); }

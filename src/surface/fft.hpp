@@ -68,6 +68,9 @@ class RealToComplex {
 class ComplexPlane {
   public:
     ComplexPlane(std::size_t rows, std::size_t cols);  // std::bad_alloc when it cannot allocate
+    // The same on the caller's array of rows·cols values (not owned; it must outlive the plane).
+    // FFTW picks codelets for the array's alignment.
+    ComplexPlane(std::size_t rows, std::size_t cols, std::complex<double>* external);
     ~ComplexPlane();
     ComplexPlane(const ComplexPlane&) = delete;
     ComplexPlane& operator=(const ComplexPlane&) = delete;
@@ -84,6 +87,7 @@ class ComplexPlane {
     std::size_t rows_;
     std::size_t cols_;
     std::complex<double>* data_ = nullptr;
+    bool owned_ = true;
     void* plan_ = nullptr;
 };
 
