@@ -27,7 +27,8 @@ pytestmark = pytest.mark.cli
 
 NAN_RE = re.compile(r"\b(nan|inf|infinity)\b", re.IGNORECASE)
 # "  --sigma FLOAT:> 0   ..." / "  --max-iterations INT:INT in [1 - 100000]" / "--pair INT x 2"
-FLAG_RE = re.compile(r"^\s+(?:-\w,)?(--[\w-]+) (FLOAT|INT)\b( x (\d+))?", re.MULTILINE)
+# / "  --nx UINT:INT in [8,4096]" (unsigned options are swept as integers)
+FLAG_RE = re.compile(r"^\s+(?:-\w,)?(--[\w-]+) U?(FLOAT|INT)\b( x (\d+))?", re.MULTILINE)
 
 EXTREMES = ["0", "-0", "5e-324", "1e-320", "1e-300", "1e-8", "1e8", "1e300",
             "1.7976931348623157e308"]
@@ -232,3 +233,15 @@ def test_surface_flags_at_the_extremes(height_file, tmp_path):
          "--wavelength-um", "0.5"],
     ])
     assert runs >= 25  # (base, flag) pairs: 10 + 5 + 20
+
+
+def test_simulate_scatter_flags_at_the_extremes(tmp_path):
+    # A small fixed grid keeps every accepted extreme fast (the grid is what costs).
+    runs = sweep(["simulate", "scatter"], [
+        ["--sigma-um", "0.05", "--T-um", "1", "--theta-i", "30", "--theta-s", "10", "--phi-s",
+         "45", "--nx", "16", "--realisations", "3", "--json"],
+        ["--sigma-um", "0.05", "--T-um", "1", "--correlation", "exponential", "--theta-i", "20",
+         "--theta-s", "20", "--phi-s", "0", "--nx", "16", "--dx-um", "0.2", "--realisations",
+         "3", "--layout", "fixed"],
+    ])
+    assert runs >= 20  # 2 bases x 11 numeric flags
