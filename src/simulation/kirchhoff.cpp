@@ -123,6 +123,10 @@ struct Plan {
     // (±m, 0), (0, ±m); 2 = one arbitrary (vx, vy) (Fixed).
     int kind = 0;
     std::vector<cd> ex, ey;  // centred phase tables along x and y
+    // Side of the generated periodic surface: n, or 2n for the Fixed layout, whose n × n patch
+    // is a corner of it, so that points near opposite edges of the patch are not the periodic
+    // neighbours they would be on an n-periodic surface (a finite patch of an unbounded surface).
+    std::size_t generated_n = 0;
     std::size_t directions() const { return kind == 1 ? 4 : 1; }
 };
 
@@ -166,18 +170,25 @@ Plan make_plan(const Geometry& geom, const ScatterOptions& o) {
         p.ex = centred_phases(p.n, p.v.vx, p.dx_um);
         p.ey = centred_phases(p.n, p.v.vy, p.dx_um);
     }
+    p.generated_n = p.layout == PatchLayout::Fixed ? 2 * p.n : p.n;
+    if (p.generated_n > kMaxGridSide) {
+        throw InvalidArgument(concat("simulation option nx = ", std::to_string(p.n),
+                                     " is too large for the fixed layout, which generates a "
+                                     "surface of twice the side: it must be at most 2048"));
+    }
     return p;
 }
 
-// I at the plan's directions for one surface (heights z, n × n row-major), into out[0..J).
-void evaluate(const Plan& p, const double* z, cd* out) {
+// I at the plan's directions for the n × n patch at the start of a surface with row stride
+// `stride` (heights z, row-major), into out[0..J).
+void evaluate(const Plan& p, const double* z, std::size_t stride, cd* out) {
     const std::size_t n = p.n;
     const double vz = p.v.vz;
     const double norm = 1.0 / (static_cast<double>(n) * static_cast<double>(n));
     const detail::PhasorTable& table = detail::phasor_table();
     cd s0{}, s1{}, s2{}, s3{};
     for (std::size_t iy = 0; iy < n; ++iy) {
-        const double* row = z + iy * n;
+        const double* row = z + iy * stride;
         cd r0{}, rp{}, rm{};
         for (std::size_t ix = 0; ix < n; ++ix) {
             const cd e = detail::unit_phasor(vz * row[ix], table);
@@ -455,7 +466,7 @@ std::vector<ScatterResult> simulate_scattering(const std::vector<Geometry>& geom
         g.correlation = o.correlation;
         g.sigma_um = o.sigma_um;
         g.T_um = o.T_um;
-        g.nx = g.ny = p.n;
+        g.nx = g.ny = p.generated_n;
         g.dx_um = g.dy_um = p.dx_um;
         generators.emplace_back(g);
     }
@@ -477,7 +488,8 @@ std::vector<ScatterResult> simulate_scattering(const std::vector<Geometry>& geom
                 const Plan& p = plans[k];
                 const surface::HeightMap map =
                     generators[k].generate(mix(mix(mix(o.seed) + k) + r));
-                evaluate(p, map.heights_um.data(), fields[k].data() + r * p.directions());
+                evaluate(p, map.heights_um.data(), p.generated_n,
+                         fields[k].data() + r * p.directions());
                 const std::size_t finished = done.fetch_add(1) + 1;
                 if (caller && progress) progress(finished, total);
             }

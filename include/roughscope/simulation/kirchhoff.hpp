@@ -65,8 +65,11 @@ enum class PatchLayout {
     // the periodic surfaces of the generator the Monte Carlo mean is then the Riemann sum of the
     // infinite-patch integral: no finite-patch leakage from the coherent peak.
     LatticeAligned,
-    // The spacing and the frame are kept; I is evaluated at v by direct summation. The finite
-    // patch shows: the coherent peak ρ0 (a Dirichlet kernel) leaks into nearby directions.
+    // The spacing and the frame are kept; I is evaluated at v by direct summation over an
+    // n × n patch cut from a generated surface of side 2n (so that the patch is a finite piece
+    // of an unbounded surface, not one period of a periodic one). The finite patch shows: the
+    // coherent peak ρ0 (a Dirichlet kernel) leaks into nearby directions and the diffuse part is
+    // the infinite-patch one convolved with the patch's window (bias ~T/L). n ≤ 2048.
     Fixed,
 };
 

@@ -231,6 +231,25 @@ TEST(KirchhoffEnsemble, ExponentialAtLargeGFollowsTheSeriesNotEq5) {
     EXPECT_LT(r.diffuse, 0.2 * eq5);
 }
 
+// The fixed layout keeps the finite patch: near the specular direction the coherent part is the
+// patch's Dirichlet kernel squared times e^{−g} (Eq. 1 with the sampled ρ0).
+TEST(KirchhoffEnsemble, FixedLayoutCoherentPartIsTheSampledPlateKernel) {
+    const Case c{Correlation::Gaussian, 20.0, 21.0, 0.0, 0.02};
+    ScatterOptions o = options_for(c, 300);
+    o.layout = PatchLayout::Fixed;
+    o.n = 32;
+    o.dx_um = 0.25;
+    const Geometry geom = make_geometry(deg_to_rad(20.0), deg_to_rad(21.0), 0.0);
+    const ScatterResult r = simulate_scattering(geom, o);
+    EXPECT_EQ(r.layout, PatchLayout::Fixed);
+    const ScatteringVector v = scattering_vector(geom, 0.5);
+    const double rho0 = dirichlet_closed_form(v.vx, 32, 0.25);
+    ASSERT_GT(rho0, 0.5);  // inside the main lobe: a coherent part well above the noise
+    EXPECT_NEAR(r.series_coherent, r.F2 * rho0 * rho0 * std::exp(-r.g), 1e-12);
+    EXPECT_LE(std::abs(r.coherent - r.series_coherent), 3.0 * r.coherent_stderr)
+        << r.coherent << " +- " << r.coherent_stderr << " vs " << r.series_coherent;
+}
+
 TEST(KirchhoffEnsemble, SameSeedSameNumbersWhateverTheThreads) {
     const Case c{Correlation::Gaussian, 30.0, 10.0, 45.0, 0.05};
     ScatterOptions one = options_for(c, 12);
