@@ -6,8 +6,8 @@ linked relatively) — with:
 * a header (library version, date);
 * "Models": the paper's Figs. 3 and 4 (retro-scattering, B–K and V–H) and a table checking the
   closed forms Eq. 7–11 against the library's general forms at the retro geometry;
-* the sections of :mod:`roughscope.report_estimation`, :mod:`roughscope.report_curet` and
-  :mod:`roughscope.report_surface`
+* the sections of :mod:`roughscope.report_estimation`, :mod:`roughscope.report_curet`,
+  :mod:`roughscope.report_surface` and :mod:`roughscope.report_simulation`
   (each ``section(outdir)`` returns an HTML fragment, or None to be left out).
 
 Everything is written to a temporary folder beside DIR and renamed at the end, so DIR is either
@@ -147,7 +147,7 @@ def build_report(outdir):
     outdir = pathlib.Path(outdir)
     now = datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
     sections = [models_section(outdir)]
-    for name in ("report_estimation", "report_curet", "report_surface"):
+    for name in ("report_estimation", "report_curet", "report_surface", "report_simulation"):
         fragment = _import_section_module(name).section(outdir)
         if fragment is not None:
             sections.append(str(fragment))

@@ -661,10 +661,13 @@ def test_report_writes_index_and_figures(tmp_path, python_env):
     html_text = index.read_text(encoding="utf-8")
     assert "<h2 id=\"models\">Models</h2>" in html_text and rs.__version__ in html_text
     assert "FAIL" not in html_text and "class=\"fail\"" not in html_text
-    for name in ("fig3_bk_retro.png", "fig4_vh_retro.png"):
+    # The simulation section and both of its figures are there.
+    assert "Ground truth: Monte Carlo Kirchhoff scattering" in html_text
+    for name in ("fig3_bk_retro.png", "fig4_vh_retro.png", "simulation_validation.png",
+                 "simulation_estimators.png"):
         png = out / name
         assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
-        assert f'src="{name}"' in html_text
+        assert f'src="{name}"' in html_text or f"src='{name}'" in html_text
     # Nothing temporary left beside the report.
     assert sorted(p.name for p in tmp_path.iterdir()) == ["report"]
 
