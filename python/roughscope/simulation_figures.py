@@ -58,7 +58,7 @@ def estimator_figure(rows, out):
     markers = {"30°/45°": "o", "45.5°/67.5°": "s"}
     for ax, corr in zip(axes, ["gaussian", "exponential"]):
         sub = [r for r in rows if r["correlation"] == corr and r["estimate"] is not None]
-        lo = min([r["true"] for r in rows] + [1e-3])
+        lo = min(r["true"] for r in rows) / 1.5
         hi = max([r["true"] for r in rows]) * 1.3
         ax.plot([lo, hi], [lo, hi], color="#555", lw=1, label="estimate = truth")
         for pair, marker in markers.items():
