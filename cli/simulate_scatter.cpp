@@ -2,8 +2,6 @@
 // (simulation/kirchhoff.hpp) next to the exact series at the same geometry. Documents come from
 // serialize/simulation.hpp (the same as the Python module's); progress goes to stderr when it is
 // a terminal; Ctrl-C stops the run with nothing written (io::OutputFile).
-#include <unistd.h>
-
 #include <cstddef>
 #include <cstdint>
 #include <cstdio>
@@ -13,6 +11,8 @@
 #include <string>
 #include <utility>
 #include <vector>
+
+#include <unistd.h>
 
 #include "common.hpp"
 #include "roughscope/core/errors.hpp"
@@ -71,14 +71,14 @@ std::vector<Geometry> geometries_from_csv(const std::string& path) {
     CsvRow row;
     while (reader.next(row)) {
         try {
-            out.push_back(make_geometry(deg_to_rad(*row.value(c_ti)),
-                                        deg_to_rad(*row.value(c_ts)),
+            out.push_back(make_geometry(deg_to_rad(*row.value(c_ti)), deg_to_rad(*row.value(c_ts)),
                                         deg_to_rad(*row.value(c_ps))));
         } catch (const roughscope::InvalidArgument& e) {
             throw roughscope::DataError(path + ":" + std::to_string(row.line) + ": " + e.what());
         }
     }
-    if (out.empty()) throw roughscope::DataError(reader.source() + ": no data rows after the header");
+    if (out.empty())
+        throw roughscope::DataError(reader.source() + ": no data rows after the header");
     return out;
 }
 
@@ -118,9 +118,8 @@ void run_scatter(const ScatterCommand& c) {
     for (const Geometry& g : geoms) simulation::choose_scatter_grid(g, c.options);
     TerminalProgress progress;
     const std::vector<simulation::ScatterResult> results = simulation::simulate_scattering(
-        geoms, c.options, [&progress](std::size_t done, std::size_t total) {
-            progress(done, total);
-        });
+        geoms, c.options,
+        [&progress](std::size_t done, std::size_t total) { progress(done, total); });
     std::string text;
     if (c.json_output) {
         text = serialize::dump(serialize::to_json(results, c.options));

@@ -39,7 +39,8 @@ std::vector<Geometry> broadcast_geometries(py::handle theta_i_deg, py::handle th
     try {
         b = np.attr("broadcast_arrays")(*arrays);
     } catch (const py::error_already_set&) {
-        throw InvalidArgument("theta_i_deg, theta_s_deg and phi_s_deg cannot be broadcast together");
+        throw InvalidArgument(
+            "theta_i_deg, theta_s_deg and phi_s_deg cannot be broadcast together");
     }
     const auto ti = DoubleArray::ensure(np.attr("ravel")(b[0]));
     const auto ts = DoubleArray::ensure(np.attr("ravel")(b[1]));
@@ -118,8 +119,7 @@ void bind_simulation(py::module_& m) {
             d["vz_per_um"] = field.vz_per_um;
             return d;
         },
-        arg("heights_um"), arg("dx_um"), arg("vz_per_um"), py::kw_only(),
-        arg("dy_um") = py::none(),
+        arg("heights_um"), arg("dx_um"), arg("vz_per_um"), py::kw_only(), arg("dy_um") = py::none(),
         "The scattering integral I = rho/F of one height map (um, (ny, nx)) for one v_z on the "
         "whole lattice v_xy = 2 pi (i/Lx, j/Ly): a dict with 'values' (complex (ny, nx), FFT "
         "order: numpy.fft.fftfreq indexing), 'dvx_per_um', 'dvy_per_um', 'vz_per_um'.");

@@ -106,8 +106,8 @@ std::string scatter_csv(const std::vector<ScatterResult>& results) {
 std::string to_text(const std::vector<ScatterResult>& results, const ScatterOptions& o) {
     std::string out = concat("Monte Carlo Kirchhoff scattering: ", to_string(o.correlation),
                              " correlation, sigma = ", format_message(o.sigma_um),
-                             " um, T = ", format_message(o.T_um), " um, lambda = ",
-                             format_message(o.wavelength_um), " um, factor ",
+                             " um, T = ", format_message(o.T_um),
+                             " um, lambda = ", format_message(o.wavelength_um), " um, factor ",
                              to_string(o.factor), ", seed ", std::to_string(o.seed), "\n");
     char line[512];
     std::snprintf(line, sizeof line, "%8s %8s %8s %10s %8s %13s %11s %13s %7s %13s %11s %5s %6s\n",
@@ -115,9 +115,8 @@ std::string to_text(const std::vector<ScatterResult>& results, const ScatterOpti
                   "dev", "coherent", "stderr", "n", "R");
     out += line;
     for (const ScatterResult& r : results) {
-        const double dev = r.diffuse_stderr > 0.0
-                               ? (r.diffuse - r.series_diffuse) / r.diffuse_stderr
-                               : 0.0;
+        const double dev =
+            r.diffuse_stderr > 0.0 ? (r.diffuse - r.series_diffuse) / r.diffuse_stderr : 0.0;
         std::snprintf(line, sizeof line,
                       "%8.3f %8.3f %8.3f %10.4g %8.4g %13.6g %11.3g %13.6g %7.2f %13.6g %11.3g "
                       "%5zu %6zu\n",
@@ -145,15 +144,17 @@ ScatterOptions scatter_options_from(const Json& options) {
     if (auto v = get_number(options, "wavelength_um")) o.wavelength_um = *v;
     if (auto v = get_string(options, "factor")) o.factor = parse_geometric_factor(*v);
     if (auto v = get_int(options, "n")) {
-        if (*v < 0) throw InvalidArgument(concat("simulation option n = ", std::to_string(*v),
-                                                 " must be 0 (chosen) or in [8, 4096]"));
+        if (*v < 0)
+            throw InvalidArgument(concat("simulation option n = ", std::to_string(*v),
+                                         " must be 0 (chosen) or in [8, 4096]"));
         o.n = static_cast<std::size_t>(*v);
     }
     if (auto v = get_number(options, "dx_um")) o.dx_um = *v;
     if (auto v = get_number(options, "patch_over_T")) o.patch_over_T = *v;
     if (auto v = get_int(options, "realisations")) {
-        if (*v < 2) throw InvalidArgument(concat("simulation option realisations = ",
-                                                 std::to_string(*v), " must be in [2, 1e7]"));
+        if (*v < 2)
+            throw InvalidArgument(concat("simulation option realisations = ", std::to_string(*v),
+                                         " must be in [2, 1e7]"));
         o.realisations = static_cast<std::size_t>(*v);
     }
     if (options.is_object() && options.contains("seed") && !options["seed"].is_null()) {
@@ -163,8 +164,8 @@ ScatterOptions scatter_options_from(const Json& options) {
         } else if (v.is_number_integer() && v.get<std::int64_t>() >= 0) {
             o.seed = static_cast<std::uint64_t>(v.get<std::int64_t>());
         } else {
-            throw InvalidArgument(concat("simulation option seed = ", v.dump(),
-                                         " must be an integer in [0, 2^64)"));
+            throw InvalidArgument(
+                concat("simulation option seed = ", v.dump(), " must be an integer in [0, 2^64)"));
         }
     }
     if (auto v = get_string(options, "layout")) o.layout = simulation::parse_patch_layout(*v);

@@ -14,12 +14,12 @@
 #include <thread>
 #include <vector>
 
+#include "phasor.hpp"
 #include "roughscope/core/errors.hpp"
 #include "roughscope/core/names.hpp"
 #include "roughscope/core/numbers.hpp"
 #include "roughscope/core/text.hpp"
 #include "roughscope/surface/generate.hpp"
-#include "phasor.hpp"
 #include "surface/fft.hpp"
 
 namespace roughscope::simulation {
@@ -142,11 +142,11 @@ Plan make_plan(const Geometry& geom, const ScatterOptions& o) {
     const double w = std::sqrt(p.v.vxy2());
     const double L = static_cast<double>(p.n) * p.dx_um;
     if (w * p.dx_um >= kPi) {
-        throw InvalidArgument(concat(
-            "simulation spacing dx_um = ", format_message(p.dx_um),
-            " is too coarse for this direction: |v_xy| = ", format_message(w),
-            " rad/um lies beyond the grid's Nyquist frequency pi/dx; give dx_um below ",
-            format_message(kPi / w), " um (or 0 to choose it)"));
+        throw InvalidArgument(
+            concat("simulation spacing dx_um = ", format_message(p.dx_um),
+                   " is too coarse for this direction: |v_xy| = ", format_message(w),
+                   " rad/um lies beyond the grid's Nyquist frequency pi/dx; give dx_um below ",
+                   format_message(kPi / w), " um (or 0 to choose it)"));
     }
     p.layout = o.layout;
     if (w == 0.0) {
@@ -205,8 +205,8 @@ void evaluate(const Plan& p, const double* z, std::size_t stride, cd* out) {
         if (p.kind == 0) {
             s0 += r0;
         } else if (p.kind == 1) {
-            s0 += rp;                       // (+m, 0)
-            s1 += rm;                       // (−m, 0)
+            s0 += rp;                      // (+m, 0)
+            s1 += rm;                      // (−m, 0)
             s2 += mul(r0, p.ex[iy]);       // (0, +m)
             s3 += mul_conj(r0, p.ex[iy]);  // (0, −m)
         } else {
@@ -252,8 +252,8 @@ ScatterResult summarise(const Plan& p, const ScatterOptions& o, const std::vecto
     for (const cd& m : mean) {
         const double c = std::norm(m) - diffuse / Rd;
         coherent += c;
-        coherent_var += 2.0 * std::max(std::norm(m), 0.0) * diffuse / Rd +
-                        (diffuse / Rd) * (diffuse / Rd);
+        coherent_var +=
+            2.0 * std::max(std::norm(m), 0.0) * diffuse / Rd + (diffuse / Rd) * (diffuse / Rd);
     }
     res.coherent = coherent / static_cast<double>(J);
     res.coherent_stderr = std::sqrt(coherent_var) / static_cast<double>(J);
@@ -316,14 +316,14 @@ LatticeField scattering_integral_lattice(const surface::HeightMap& map, double v
     for (std::size_t i = 0; i < map.nx; ++i) {
         const long si = i <= map.nx / 2 ? static_cast<long>(i)
                                         : static_cast<long>(i) - static_cast<long>(map.nx);
-        shift_x[i] = std::polar(1.0, -2.0 * kPi * static_cast<double>(si) * cx /
-                                         static_cast<double>(map.nx));
+        shift_x[i] = std::polar(
+            1.0, -2.0 * kPi * static_cast<double>(si) * cx / static_cast<double>(map.nx));
     }
     for (std::size_t j = 0; j < map.ny; ++j) {
         const long sj = j <= map.ny / 2 ? static_cast<long>(j)
                                         : static_cast<long>(j) - static_cast<long>(map.ny);
-        shift_y[j] = std::polar(1.0, -2.0 * kPi * static_cast<double>(sj) * cy /
-                                         static_cast<double>(map.ny));
+        shift_y[j] = std::polar(
+            1.0, -2.0 * kPi * static_cast<double>(sj) * cy / static_cast<double>(map.ny));
     }
     for (std::size_t j = 0; j < map.ny; ++j) {
         const cd row_factor = norm * shift_y[j];
@@ -374,20 +374,20 @@ void check_scatter_options(const ScatterOptions& o) {
     check_grid_side(o.n);
     if (o.dx_um != 0.0) check_length_um("dx", o.dx_um);
     if (!(o.patch_over_T == 0.0 || (o.patch_over_T >= 1.0 && o.patch_over_T <= 1e4))) {
-        throw InvalidArgument(concat("simulation option patch_over_T = ",
-                                     format_message(o.patch_over_T),
-                                     " is out of range: it must be 0 (chosen) or in [1, 1e4]"));
+        throw InvalidArgument(
+            concat("simulation option patch_over_T = ", format_message(o.patch_over_T),
+                   " is out of range: it must be 0 (chosen) or in [1, 1e4]"));
     }
     if (o.realisations < 2 || o.realisations > kMaxRealisations) {
-        throw InvalidArgument(concat("simulation option realisations = ",
-                                     std::to_string(o.realisations),
-                                     " is out of range: it must be an integer in [2, 1e7]"));
+        throw InvalidArgument(
+            concat("simulation option realisations = ", std::to_string(o.realisations),
+                   " is out of range: it must be an integer in [2, 1e7]"));
     }
     if (o.n != 0 && o.dx_um != 0.0 && !(o.T_um <= static_cast<double>(o.n) * o.dx_um)) {
-        throw InvalidArgument(concat("simulation patch nx*dx_um = ",
-                                     format_message(static_cast<double>(o.n) * o.dx_um),
-                                     " um is shorter than T_um = ", format_message(o.T_um),
-                                     " um: the patch must be at least one correlation length"));
+        throw InvalidArgument(concat(
+            "simulation patch nx*dx_um = ", format_message(static_cast<double>(o.n) * o.dx_um),
+            " um is shorter than T_um = ", format_message(o.T_um),
+            " um: the patch must be at least one correlation length"));
     }
 }
 
@@ -428,9 +428,8 @@ ScatterGrid choose_scatter_grid(const Geometry& geom, const ScatterOptions& o) {
             throw InvalidArgument(concat(
                 "the simulation grid needed at this geometry (g = ", format_message(g),
                 " from sigma_um = ", format_message(o.sigma_um), " and wavelength_um = ",
-                format_message(o.wavelength_um), ", T_um*v_xy = ", format_message(w * T),
-                ") has ", format_message(want), " points per side with dx_um = ",
-                format_message(grid.dx_um),
+                format_message(o.wavelength_um), ", T_um*v_xy = ", format_message(w * T), ") has ",
+                format_message(want), " points per side with dx_um = ", format_message(grid.dx_um),
                 ", beyond the limit of 4096 (nx): give nx and dx_um, or a smaller patch_over_T"));
         }
         grid.n = surface::fft::good_size(std::max(kMinGridSide, static_cast<std::size_t>(want)));
@@ -499,7 +498,8 @@ std::vector<ScatterResult> simulate_scattering(const std::vector<Geometry>& geom
             if (!failure) failure = std::current_exception();
         }
     };
-    unsigned threads = o.threads != 0 ? o.threads : std::max(1U, std::thread::hardware_concurrency());
+    unsigned threads =
+        o.threads != 0 ? o.threads : std::max(1U, std::thread::hardware_concurrency());
     threads = static_cast<unsigned>(std::min<std::size_t>(threads, total));
     std::vector<std::thread> pool;
     for (unsigned t = 1; t < threads; ++t) pool.emplace_back(work, false);

@@ -2,10 +2,10 @@
 // Kirchhoff sums, the hot loop of every realisation.
 //
 // θ is reduced to k·(2π/N) + r with k = round(θ N/2π), N = 4096, |r| ≤ π/N (Cody–Waite: 2π/N in
-// two parts, so r carries no error beyond θ's own rounding); e^{iθ} = E[k mod N]·e^{ir} with E a table
-// of correctly rounded cos, sin values and e^{ir} from its Taylor polynomials to r⁷ (remainder
-// below 1e-19). Agrees with std::cos/std::sin to a few 1e-16 (tests/cpp/simulation) at several
-// times their speed, because the loop has no branch and no library call.
+// two parts, so r carries no error beyond θ's own rounding); e^{iθ} = E[k mod N]·e^{ir} with E a
+// table of correctly rounded cos, sin values and e^{ir} from its Taylor polynomials to r⁷
+// (remainder below 1e-19). Agrees with std::cos/std::sin to a few 1e-16 (tests/cpp/simulation) at
+// several times their speed, because the loop has no branch and no library call.
 #pragma once
 
 #include <array>
@@ -38,8 +38,8 @@ inline const PhasorTable& phasor_table() {
 // e^{iθ} for finite θ with |θ| ≤ 1e12 (beyond, the reduction loses the fraction of a turn; the
 // callers' phases v_z·z are far below).
 inline std::complex<double> unit_phasor(double theta, const PhasorTable& t) {
-    constexpr double kStepsPerRadian = static_cast<double>(kPhasorTableSize) /
-                                       (2.0 * 3.14159265358979323846);
+    constexpr double kStepsPerRadian =
+        static_cast<double>(kPhasorTableSize) / (2.0 * 3.14159265358979323846);
     // 2π/N = kStepHi + kStepLo, kStepHi with 26 significant bits: k·kStepHi is exact for
     // |k| < 2^27 (|θ| < 2e5); beyond, its rounding is that of θ itself (~ulp(θ)).
     constexpr double kStepHi = 0.001533980801468715;

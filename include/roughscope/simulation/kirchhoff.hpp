@@ -75,8 +75,8 @@ enum class PatchLayout {
 
 struct ScatterOptions {
     Correlation correlation = Correlation::Gaussian;
-    double sigma_um = 0.1;        // RMS height σ
-    double T_um = 1.0;            // correlation length T
+    double sigma_um = 0.1;         // RMS height σ
+    double T_um = 1.0;             // correlation length T
     double wavelength_um = 0.555;  // λ (the paper's mean wavelength)
     // F multiplying the field (ρ = F I) and the closed form; Beckmann's F_Beck (Eq. 6) by default
     // (for the others F = √F²).
@@ -101,9 +101,9 @@ struct ScatterOptions {
 
 struct ScatterResult {
     Geometry geometry;
-    double g = 0.0;          // σ² v_z²
-    double T_vxy = 0.0;      // T·|v_xy|
-    double F2 = 0.0;         // F² of the chosen factor
+    double g = 0.0;      // σ² v_z²
+    double T_vxy = 0.0;  // T·|v_xy|
+    double F2 = 0.0;     // F² of the chosen factor
     // Monte Carlo estimates with their standard errors:
     //   diffuse  = (1/(R−1)) Σ_r |ρ_r − ρ̄|²  (the unbiased sample variance of the field)
     //   coherent = |ρ̄|² − diffuse/R          (unbiased for |⟨ρ⟩|²; may be slightly negative

@@ -1,11 +1,11 @@
 // The fast e^{iθ} of the Kirchhoff sums (src/simulation/phasor.hpp) against std::cos/std::sin.
-#include "simulation/phasor.hpp"
-
-#include <gtest/gtest.h>
-
 #include <cmath>
 #include <complex>
 #include <limits>
+
+#include <gtest/gtest.h>
+
+#include "simulation/phasor.hpp"
 
 namespace roughscope::simulation::detail {
 namespace {
