@@ -44,9 +44,19 @@ RealToComplex::RealToComplex(std::size_t rows, std::size_t cols, Layout layout)
     if (data_ == nullptr) {
         throw std::bad_alloc();
     }
+    plan(layout);
+}
+
+RealToComplex::RealToComplex(std::size_t rows, std::size_t cols, Layout layout, double* external)
+    : rows_(rows), cols_(cols), data_(external), owned_(false) {
+    assert(rows >= 1 && cols >= 1 && external != nullptr);
+    plan(layout);
+}
+
+void RealToComplex::plan(Layout layout) {
     auto* spectrum = reinterpret_cast<fftw_complex*>(data_);
-    const int n_rows = static_cast<int>(rows);
-    const int n_cols = static_cast<int>(cols);
+    const int n_rows = static_cast<int>(rows_);
+    const int n_cols = static_cast<int>(cols_);
     const unsigned flags = FFTW_ESTIMATE;
     const std::lock_guard<std::mutex> lock(planner_mutex());
     if (layout == Layout::plane) {
@@ -68,7 +78,9 @@ RealToComplex::RealToComplex(std::size_t rows, std::size_t cols, Layout layout)
         if (backward_plan_ != nullptr) {
             fftw_destroy_plan(as_plan(backward_plan_));
         }
-        fftw_free(data_);
+        if (owned_) {
+            fftw_free(data_);
+        }
         throw std::bad_alloc();
     }
 }
@@ -79,7 +91,9 @@ RealToComplex::~RealToComplex() {
         fftw_destroy_plan(as_plan(forward_plan_));
         fftw_destroy_plan(as_plan(backward_plan_));
     }
-    fftw_free(data_);
+    if (owned_) {
+        fftw_free(data_);
+    }
 }
 
 std::complex<double>* RealToComplex::spectrum_row(std::size_t r) {

@@ -33,6 +33,10 @@ class RealToComplex {
     // starts uninitialised (fill_zero() clears it). Throws std::bad_alloc when the buffer cannot
     // be allocated.
     RealToComplex(std::size_t rows, std::size_t cols, Layout layout);
+    // The same on the caller's array of rows·2·(cols/2 + 1) doubles (not owned: it must outlive
+    // the transform; FFTW picks codelets for its alignment, so give it 32-byte alignment for the
+    // fastest ones).
+    RealToComplex(std::size_t rows, std::size_t cols, Layout layout, double* external);
     ~RealToComplex();
     RealToComplex(const RealToComplex&) = delete;
     RealToComplex& operator=(const RealToComplex&) = delete;
@@ -55,9 +59,12 @@ class RealToComplex {
     void backward();  // half spectrum (Hermitian) → real, in place, unnormalised
 
   private:
+    void plan(Layout layout);  // makes both plans on data_; frees an owned buffer on failure
+
     std::size_t rows_;
     std::size_t cols_;
     double* data_ = nullptr;
+    bool owned_ = true;
     void* forward_plan_ = nullptr;
     void* backward_plan_ = nullptr;
 };

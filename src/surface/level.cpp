@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstddef>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Dense>
@@ -152,12 +153,12 @@ void subtract_polynomial(HeightMap& map, int order) {
 
 }  // namespace
 
-HeightMap level(const HeightMap& map, Leveling leveling, int polynomial_order) {
+HeightMap level(HeightMap map, Leveling leveling, int polynomial_order) {
     validate(map, "heights");
     if (leveling == Leveling::Polynomial && (polynomial_order < 1 || polynomial_order > 3))
         throw InvalidArgument("level: polynomial_order = " + std::to_string(polynomial_order) +
                               " is out of range; valid values: 1, 2, 3");
-    HeightMap out = map;
+    HeightMap out = std::move(map);
     switch (leveling) {
         case Leveling::None:
             break;

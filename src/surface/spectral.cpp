@@ -7,7 +7,9 @@
 #include <cmath>
 #include <complex>
 #include <cstddef>
+#include <cstdint>
 #include <limits>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -144,21 +146,43 @@ Acf2d acf_2d(const HeightMap& levelled, AcfEstimator estimator) {
     acf.ny = 2 * ny - 1;
     acf.dx_um = levelled.dx_um;
     acf.dy_um = levelled.dy_um;
-    acf.values.resize(acf.nx * acf.ny);
     const auto jx_max = static_cast<std::ptrdiff_t>(nx) - 1;
     const auto jy_max = static_cast<std::ptrdiff_t>(ny) - 1;
 
-    fft::RealToComplex f(py, px, fft::Layout::plane);
-    // Sums of products R(τ) = Σ_r z(r) z(r + τ) over the valid pairs (missing points are 0).
-    load_heights(levelled, f);
-    autocorrelate_in_place(f);
-    for (std::ptrdiff_t jy = -jy_max; jy <= jy_max; ++jy) {
-        const double* src = f.real_row(wrap(jy, py));
-        double* dst = acf.values.data() + static_cast<std::size_t>(jy + jy_max) * acf.nx;
-        for (std::ptrdiff_t jx = -jx_max; jx <= jx_max; ++jx) {
-            dst[jx + jx_max] = src[wrap(jx, px)] * scale;
+    // The transform works inside acf.values itself (at a 32-byte aligned offset, for FFTW's
+    // fastest codelets): the padded array is rearranged in place into the lag grid afterwards,
+    // so the peak memory is one padded array (~4 maps), not the array and the grid side by side.
+    const std::size_t stride = 2 * (px / 2 + 1);  // doubles per row of the real array
+    std::vector<double>& buffer = acf.values;
+    buffer.resize(py * stride + 4);
+    const auto misalignment = reinterpret_cast<std::uintptr_t>(buffer.data()) % 32;
+    const std::size_t offset = misalignment == 0 ? 0 : (32 - misalignment) / sizeof(double);
+    {
+        fft::RealToComplex f(py, px, fft::Layout::plane, buffer.data() + offset);
+        // Sums of products R(τ) = Σ_r z(r) z(r + τ) over the valid pairs (missing points are 0).
+        load_heights(levelled, f);
+        autocorrelate_in_place(f);
+    }
+    // Circular layout (row wrap(jy), column wrap(jx)) → lag grid (row jy + jy_max, column
+    // jx + jx_max): rotate the rows so that the negative lags come first, then each used row's
+    // columns likewise, then pack the used (2nx − 1) × (2ny − 1) block to the front.
+    double* const base = buffer.data() + offset;
+    if (jy_max > 0) {
+        std::rotate(base, base + (py - static_cast<std::size_t>(jy_max)) * stride,
+                    base + py * stride);
+    }
+    for (std::size_t r = 0; r < acf.ny; ++r) {
+        double* row = base + r * stride;
+        if (jx_max > 0) {
+            std::rotate(row, row + (px - static_cast<std::size_t>(jx_max)), row + px);
+        }
+        double* dst = buffer.data() + r * acf.nx;
+        for (std::size_t c = 0; c < acf.nx; ++c) {
+            dst[c] = row[c] * scale;  // dst ≤ row + c: moving forward is safe
         }
     }
+    buffer.resize(acf.nx * acf.ny);
+
     const double r0 = acf.at_lag(0, 0);
     const std::size_t valid = levelled.count_valid();
     if (!(r0 > 0)) {
@@ -168,15 +192,17 @@ Acf2d acf_2d(const HeightMap& levelled, AcfEstimator estimator) {
     }
 
     // Valid-pair counts N(τ): (nx − |jx|)(ny − |jy|) for a complete map, else the same FFT
-    // correlation of the mask (rounded: it is an integer up to rounding).
+    // correlation of the mask (rounded: it is an integer up to rounding) in a second array.
     const bool complete = valid == levelled.size();
+    std::unique_ptr<fft::RealToComplex> mask;
     if (!complete) {
-        load_mask(levelled, f);
-        autocorrelate_in_place(f);
+        mask = std::make_unique<fft::RealToComplex>(py, px, fft::Layout::plane);
+        load_mask(levelled, *mask);
+        autocorrelate_in_place(*mask);
     }
     const double mean_square = r0 / static_cast<double>(valid);  // σ² of the valid points
     for (std::ptrdiff_t jy = -jy_max; jy <= jy_max; ++jy) {
-        const double* counts = f.real_row(wrap(jy, py));
+        const double* counts = complete ? nullptr : mask->real_row(wrap(jy, py));
         double* row = acf.values.data() + static_cast<std::size_t>(jy + jy_max) * acf.nx;
         for (std::ptrdiff_t jx = -jx_max; jx <= jx_max; ++jx) {
             const double pairs =

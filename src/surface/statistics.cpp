@@ -12,6 +12,7 @@
 #include <limits>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "acf_lines.hpp"
@@ -259,8 +260,8 @@ HeightMoments height_moments(const HeightMap& map) {
     return m;
 }
 
-SurfaceStatistics surface_statistics(const HeightMap& map, const StatisticsOptions& options) {
-    HeightMap levelled = level(map, options.leveling, options.polynomial_order);
+SurfaceStatistics surface_statistics(HeightMap map, const StatisticsOptions& options) {
+    HeightMap levelled = level(std::move(map), options.leveling, options.polynomial_order);
     if (options.cutoff_um) levelled = gaussian_filter(levelled, *options.cutoff_um).roughness;
     const AcfEstimator estimator = options.acf_estimator;
     const bool profile = levelled.is_profile();

@@ -248,3 +248,34 @@ def test_predict_file_excludes_given_values(gaussian_x3p):
 def test_surface_needs_a_subcommand():
     proc = run("surface", check=False)
     assert proc.returncode == EXIT_USAGE
+
+
+MEASURE = """
+import resource, subprocess, sys
+p = subprocess.run(sys.argv[1:], stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+sys.stderr.buffer.write(p.stderr)
+print(p.returncode, resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss)
+"""
+
+
+@pytest.mark.skipif(os.environ.get("ROUGHSCOPE_SANITIZED") == "1",
+                    reason="memory is not measured under AddressSanitizer")
+def test_stats_peak_memory_is_at_most_six_copies_of_the_map(tmp_path):
+    # 2048² float64 heights: one copy is 32 MiB; the 2-D ACF's padded array is ~4 copies and is
+    # also where the ACF is left (no second array), and the map is levelled in place.
+    import sys
+
+    n = 2048
+    path = tmp_path / "big.gsf"
+    run("surface", "generate", "--sigma-um", "0.5", "--T-um", "8", "--nx", n, "--ny", n,
+        "--dx-um", "1", "--seed", "2", "--out", path)
+    baseline = subprocess.run([sys.executable, "-c", MEASURE, cli_path(), "--version"],
+                              capture_output=True, text=True, timeout=60)
+    base_kb = int(baseline.stdout.split()[1])
+    p = subprocess.run([sys.executable, "-c", MEASURE, cli_path(), "surface", "stats", str(path),
+                        "--json"], capture_output=True, text=True, timeout=600)
+    code, peak_kb = (int(v) for v in p.stdout.split())
+    assert code == 0, p.stderr
+    copy_kb = n * n * 8 / 1024
+    assert (peak_kb - base_kb) / copy_kb <= 6.0, \
+        f"peak {peak_kb / 1024:.0f} MiB = {(peak_kb - base_kb) / copy_kb:.2f} copies"

@@ -27,8 +27,9 @@ std::string to_string(Leveling leveling);
 Leveling parse_leveling(std::string_view name);
 
 // `map` minus its background. polynomial_order: 1..3, used by Leveling::Polynomial only.
-// InvalidArgument when too few valid points determine the background.
-HeightMap level(const HeightMap& map, Leveling leveling, int polynomial_order = 1);
+// InvalidArgument when too few valid points determine the background. Pass an rvalue
+// (std::move) to level in place without a copy.
+HeightMap level(HeightMap map, Leveling leveling, int polynomial_order = 1);
 
 // ---- Gaussian filter: ISO 16610-21 (profiles, along x) and ISO 16610-61 (areal) --------------
 // Weighting s(x) = 1/(α λc) exp(−π (x/(α λc))²), α = sqrt(ln 2 / π): 50 % transmission of a
@@ -100,7 +101,10 @@ struct SurfaceStatistics {
     std::optional<double> Sdq;
 };
 
-SurfaceStatistics surface_statistics(const HeightMap& map, const StatisticsOptions& options = {});
+// Pass the map as an rvalue (std::move) when it is not needed afterwards: it is then levelled in
+// place, and the peak memory of a complete map is 6 copies of it (the map, and the 2-D ACF's
+// zero-padded array of ~4), instead of 7.
+SurfaceStatistics surface_statistics(HeightMap map, const StatisticsOptions& options = {});
 
 // ---- The pieces of surface_statistics, for callers that need one of them -----------------------
 // The height moments above in one pass over the map (no levelling): Sq, Sa, Ssk, Sku, Sp, Sv, Sz.
