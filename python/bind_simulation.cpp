@@ -2,10 +2,12 @@
 // vectorised over geometries, and the scattering integral of one height map.
 //
 // simulate_scatter returns the serializer's document (serialize/simulation.hpp), the same as
-// `roughscope simulate scatter --json`. The run releases the GIL; Ctrl-C (KeyboardInterrupt) and
+// `roughscope simulate scatter --json`; its options are keyword arguments checked like every
+// numeric argument of the module (TypeError naming a non-real value). The run releases the GIL; Ctrl-C (KeyboardInterrupt) and
 // the optional progress callback are served between realisations, and an exception from either
 // stops the run.
 #include <complex>
+#include <cstdint>
 #include <cstddef>
 #include <cstring>
 #include <string>
@@ -17,6 +19,8 @@
 
 #include "bindings.hpp"
 #include "roughscope/core/errors.hpp"
+#include "roughscope/core/names.hpp"
+#include "roughscope/core/text.hpp"
 #include "roughscope/scattering/geometry.hpp"
 #include "roughscope/serialize/simulation.hpp"
 #include "roughscope/simulation/kirchhoff.hpp"
@@ -53,6 +57,14 @@ std::vector<Geometry> broadcast_geometries(py::handle theta_i_deg, py::handle th
     return geoms;
 }
 
+// A count argument: None → `absent`, else a non-negative integer (TypeError for a non-integer).
+std::size_t non_negative_count(const char* name, py::handle value, std::size_t absent) {
+    if (value.is_none()) return absent;
+    const long long v = integer_scalar(name, value);
+    if (v < 0) throw InvalidArgument(concat(name, " = ", std::to_string(v), " must be >= 0"));
+    return static_cast<std::size_t>(v);
+}
+
 }  // namespace
 
 void bind_simulation(py::module_& m) {
@@ -60,22 +72,39 @@ void bind_simulation(py::module_& m) {
     m.def(
         "simulate_scatter",
         [](py::handle theta_i_deg, py::handle theta_s_deg, py::handle phi_s_deg,
-           const py::kwargs& kwargs) {
-            py::object progress = py::none();
-            py::dict options;
-            for (const auto& [key, value] : kwargs) {
-                if (py::str(key).cast<std::string>() == "progress") {
-                    progress = py::reinterpret_borrow<py::object>(value);
-                } else {
-                    options[key] = value;
-                }
-            }
-            if (!progress.is_none() && !PyCallable_Check(progress.ptr()))
+           py::handle sigma_um, py::handle T_um, const std::string& correlation,
+           py::handle wavelength_um, const std::string& factor, py::handle n, py::handle dx_um,
+           py::handle patch_over_T, py::handle realisations, py::handle seed,
+           const std::string& layout, py::handle threads, const py::object& progress) {
+            if (!progress.is_none() && PyCallable_Check(progress.ptr()) == 0)
                 throw py::type_error("progress must be a callable (done, total) or None");
             const std::vector<Geometry> geoms =
                 broadcast_geometries(theta_i_deg, theta_s_deg, phi_s_deg);
-            const simulation::ScatterOptions o =
-                serialize::scatter_options_from(from_python(options, "simulate_scatter option"));
+            simulation::ScatterOptions o;
+            o.correlation = parse_correlation(normalize_name(correlation));
+            o.sigma_um = real_scalar("sigma_um", sigma_um);
+            o.T_um = real_scalar("T_um", T_um);
+            o.wavelength_um = real_scalar("wavelength_um", wavelength_um);
+            o.factor = parse_geometric_factor(normalize_name(factor));
+            o.n = non_negative_count("n", n, 0);
+            o.dx_um = optional_real("dx_um", dx_um).value_or(0.0);
+            o.patch_over_T = optional_real("patch_over_T", patch_over_T).value_or(0.0);
+            const long long r = integer_scalar("realisations", realisations);
+            if (r < 2 || r > 10'000'000)
+                throw InvalidArgument(concat("realisations = ", std::to_string(r),
+                                             " is out of range: it must be in [2, 1e7]"));
+            o.realisations = static_cast<std::size_t>(r);
+            const long long s = integer_scalar("seed", seed);
+            if (s < 0) throw InvalidArgument(concat("seed = ", std::to_string(s), " must be >= 0"));
+            o.seed = static_cast<std::uint64_t>(s);
+            o.layout = simulation::parse_patch_layout(normalize_name(layout));
+            const long long t = integer_scalar("threads", threads);
+            if (t < 0 || t > 1024)
+                throw InvalidArgument(concat("threads = ", std::to_string(t),
+                                             " is out of range: it must be in [0, 1024] (0 = all "
+                                             "cores)"));
+            o.threads = static_cast<unsigned>(t);
+            simulation::check_scatter_options(o);
             std::vector<simulation::ScatterResult> results;
             {
                 py::gil_scoped_release release;
@@ -88,14 +117,16 @@ void bind_simulation(py::module_& m) {
             }
             return to_python(serialize::to_json(results, o));
         },
-        arg("theta_i_deg"), arg("theta_s_deg"), arg("phi_s_deg"),
+        arg("theta_i_deg"), arg("theta_s_deg"), arg("phi_s_deg"), py::kw_only(), arg("sigma_um"),
+        arg("T_um"), arg("correlation") = "gaussian", arg("wavelength_um") = 0.555,
+        arg("factor") = "beckmann", arg("n") = py::none(), arg("dx_um") = py::none(),
+        arg("patch_over_T") = py::none(), arg("realisations") = 100, arg("seed") = 1,
+        arg("layout") = "lattice_aligned", arg("threads") = 0, arg("progress") = py::none(),
         "Monte Carlo Kirchhoff scattering on generated surfaces at the geometries (degrees; "
         "broadcast): the dict of `roughscope simulate scatter --json` ('options', 'results' with "
         "diffuse, diffuse_stderr, coherent, coherent_stderr, series_diffuse, g, ... per geometry). "
-        "Keyword options: correlation ('gaussian'), sigma_um, T_um, wavelength_um (0.555), factor "
-        "('beckmann'), n and dx_um (None = chosen), patch_over_T (None = chosen), realisations "
-        "(100), seed (1), layout ('lattice_aligned' or 'fixed'), threads (0 = all cores), "
-        "progress (a callable(done, total) or None). docs/simulation.md.");
+        "n and dx_um (None = chosen from the geometry), patch_over_T (None = chosen), threads "
+        "(0 = all cores), progress (a callable(done, total) or None). docs/simulation.md.");
 
     m.def(
         "scattering_integral_lattice",

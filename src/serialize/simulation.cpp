@@ -7,7 +7,6 @@
 #include <string>
 #include <vector>
 
-#include "options.hpp"
 #include "roughscope/core/errors.hpp"
 #include "roughscope/core/numbers.hpp"
 #include "roughscope/core/text.hpp"
@@ -130,53 +129,6 @@ std::string to_text(const std::vector<ScatterResult>& results, const ScatterOpti
         "exact series (Eq. 2 or the exponential series) with the simulated patch's area; dev: "
         "(diffuse - series)/stderr\n";
     return out;
-}
-
-ScatterOptions scatter_options_from(const Json& options) {
-    using namespace detail;
-    check_keys(options, "simulation option",
-               {"correlation", "sigma_um", "T_um", "wavelength_um", "factor", "n", "dx_um",
-                "patch_over_T", "realisations", "seed", "layout", "threads"});
-    ScatterOptions o;
-    if (auto v = get_string(options, "correlation")) o.correlation = parse_correlation(*v);
-    if (auto v = get_number(options, "sigma_um")) o.sigma_um = *v;
-    if (auto v = get_number(options, "T_um")) o.T_um = *v;
-    if (auto v = get_number(options, "wavelength_um")) o.wavelength_um = *v;
-    if (auto v = get_string(options, "factor")) o.factor = parse_geometric_factor(*v);
-    if (auto v = get_int(options, "n")) {
-        if (*v < 0)
-            throw InvalidArgument(concat("simulation option n = ", std::to_string(*v),
-                                         " must be 0 (chosen) or in [8, 4096]"));
-        o.n = static_cast<std::size_t>(*v);
-    }
-    if (auto v = get_number(options, "dx_um")) o.dx_um = *v;
-    if (auto v = get_number(options, "patch_over_T")) o.patch_over_T = *v;
-    if (auto v = get_int(options, "realisations")) {
-        if (*v < 2)
-            throw InvalidArgument(concat("simulation option realisations = ", std::to_string(*v),
-                                         " must be in [2, 1e7]"));
-        o.realisations = static_cast<std::size_t>(*v);
-    }
-    if (options.is_object() && options.contains("seed") && !options["seed"].is_null()) {
-        const Json& v = options["seed"];
-        if (v.is_number_unsigned()) {
-            o.seed = v.get<std::uint64_t>();
-        } else if (v.is_number_integer() && v.get<std::int64_t>() >= 0) {
-            o.seed = static_cast<std::uint64_t>(v.get<std::int64_t>());
-        } else {
-            throw InvalidArgument(
-                concat("simulation option seed = ", v.dump(), " must be an integer in [0, 2^64)"));
-        }
-    }
-    if (auto v = get_string(options, "layout")) o.layout = simulation::parse_patch_layout(*v);
-    if (auto v = get_int(options, "threads")) {
-        if (*v < 0 || *v > 1024)
-            throw InvalidArgument(concat("simulation option threads = ", std::to_string(*v),
-                                         " must be in [0, 1024] (0 = all cores)"));
-        o.threads = static_cast<unsigned>(*v);
-    }
-    simulation::check_scatter_options(o);
-    return o;
 }
 
 }  // namespace roughscope::serialize

@@ -125,8 +125,10 @@ def test_cli_and_python_give_the_same_numbers():
 def test_python_failures_raise_the_library_errors():
     with pytest.raises(rs.InvalidArgument, match="realisations"):
         rs.simulate_scatter(30, 0, 0, sigma_um=0.04, T_um=1, realisations=1)
-    with pytest.raises(rs.InvalidArgument, match="unknown simulation option 'sigma'"):
+    with pytest.raises(TypeError):
         rs.simulate_scatter(30, 0, 0, sigma=0.04, T_um=1)
+    with pytest.raises(TypeError, match="sigma_um"):
+        rs.simulate_scatter(30, 0, 0, sigma_um="0.04", T_um=1)
     with pytest.raises(rs.InvalidArgument, match="theta_i"):
         rs.simulate_scatter(95, 0, 0, sigma_um=0.04, T_um=1)
     with pytest.raises(TypeError):

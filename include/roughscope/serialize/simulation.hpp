@@ -29,9 +29,4 @@ std::string scatter_csv(const std::vector<simulation::ScatterResult>& results);
 std::string to_text(const std::vector<simulation::ScatterResult>& results,
                     const simulation::ScatterOptions& options);
 
-// ScatterOptions from named options (Python keyword arguments as JSON): keys as in
-// to_json(results, options)'s "options" plus threads; unknown keys and wrong types throw
-// InvalidArgument naming the key; values are then validated by check_scatter_options.
-simulation::ScatterOptions scatter_options_from(const Json& options);
-
 }  // namespace roughscope::serialize
