@@ -71,21 +71,6 @@ std::uint64_t splitmix64(std::uint64_t x) {
     return x ^ (x >> 31);
 }
 
-struct CameraFrame {
-    Eigen::Vector3d right, up;
-};
-
-// The orthographic camera's image axes (capture.hpp, "Frame").
-CameraFrame camera_frame(const Eigen::Vector3d& view) {
-    const Eigen::Vector3d forward = -view;
-    const bool near_y = std::abs(view.y()) > std::cos(deg_to_rad(0.1));
-    const Eigen::Vector3d up_hint = near_y ? Eigen::Vector3d::UnitX() : Eigen::Vector3d::UnitY();
-    CameraFrame frame;
-    frame.right = forward.cross(up_hint).normalized();
-    frame.up = frame.right.cross(forward).normalized();
-    return frame;
-}
-
 // The surface normal seen through image-plane point p (std::nullopt: the ray misses).
 std::optional<Eigen::Vector3d> surface_normal(SceneShape shape, const Eigen::Vector3d& p,
                                               const Eigen::Vector3d& view, double radius) {
@@ -152,6 +137,16 @@ Response parse_response(std::string_view name) {
 Eigen::Vector3d direction_from_angles(double theta_rad, double phi_rad) {
     return {std::sin(theta_rad) * std::cos(phi_rad), std::sin(theta_rad) * std::sin(phi_rad),
             std::cos(theta_rad)};
+}
+
+CameraAxes camera_axes(const Eigen::Vector3d& view) {
+    const Eigen::Vector3d forward = -view;
+    const bool near_y = std::abs(view.y()) > std::cos(deg_to_rad(0.1));
+    const Eigen::Vector3d up_hint = near_y ? Eigen::Vector3d::UnitX() : Eigen::Vector3d::UnitY();
+    CameraAxes axes;
+    axes.right = forward.cross(up_hint).normalized();
+    axes.up = axes.right.cross(forward).normalized();
+    return axes;
 }
 
 double scene_radius_um(const Scene& scene) {
@@ -360,7 +355,7 @@ Capture render_capture(const Scene& scene, const std::vector<SurfaceTruth>& trut
         out.normal.resize(3 * N);
     }
 
-    const CameraFrame frame = camera_frame(scene.view);
+    const CameraAxes frame = camera_axes(scene.view);
     const double radius = scene_radius_um(scene);
     const double s = scene.pixel_size_um;
     const double half_w = 0.5 * static_cast<double>(W), half_h = 0.5 * static_cast<double>(H);

@@ -71,6 +71,12 @@ struct Scene {
     double background_radiance = 0.0;  // brightness of pixels that miss the object (≥ 0)
 };
 
+// The orthographic camera's image axes for view direction V (see "Frame" above).
+struct CameraAxes {
+    Eigen::Vector3d right, up;
+};
+CameraAxes camera_axes(const Eigen::Vector3d& view);
+
 // The radius actually used (radius_um or its default).
 double scene_radius_um(const Scene& scene);
 
