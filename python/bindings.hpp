@@ -15,6 +15,7 @@ void bind_core(pybind11::module_& m);        // python/bind_core.cpp: models, ge
 void bind_estimation(pybind11::module_& m);  // python/bind_estimation.cpp: §4 estimators, fits
 void bind_curet(pybind11::module_& m);       // python/bind_curet.cpp: CUReT / BRDF tables
 void bind_surface(pybind11::module_& m);     // python/bind_surface.cpp: height data (§3.1)
+void bind_capture(pybind11::module_& m);     // python/bind_capture.cpp: synthetic captures
 
 // Results cross into Python as real objects, built from the library's serializer
 // (roughscope/serialize): objects → dict (key order kept), arrays → list, numbers → int/float,

@@ -237,4 +237,5 @@ PYBIND11_MODULE(_core, m) {
     roughscope::python::bind_estimation(m);
     roughscope::python::bind_curet(m);
     roughscope::python::bind_surface(m);
+    roughscope::python::bind_capture(m);
 }

@@ -28,7 +28,7 @@ Json direction(const Eigen::Vector3d& v) {
     out["x"] = number(v.x());
     out["y"] = number(v.y());
     out["z"] = number(v.z());
-    out["theta_deg"] = degrees(std::acos(std::clamp(v.z(), -1.0, 1.0)));
+    out["theta_deg"] = degrees(std::atan2(std::hypot(v.x(), v.y()), v.z()));
     const double phi = std::hypot(v.x(), v.y()) > 0.0 ? std::atan2(v.y(), v.x()) : 0.0;
     out["phi_deg"] = degrees(phi < 0.0 ? phi + 2.0 * kPi : phi);
     return out;
@@ -88,7 +88,7 @@ Json capture_sidecar(const simulation::Capture& capture, const CaptureRecord& re
     files["image"] = image_file;
     files["format"] = std::string(simulation::to_string(format));
     files["sidecar"] = sidecar_file;
-    doc["files"] = files;
+    doc["files"] = image_file.empty() ? Json(nullptr) : files;
 
     Json scene;
     scene["shape"] = std::string(simulation::to_string(s.shape));

@@ -23,7 +23,7 @@ struct CaptureRecord {
 };
 
 // The sidecar document. Keys, in order: format ("roughscope-capture"), version (1), files
-// {image, format, sidecar}, scene {shape, width, height, pixel_size_um, radius_um (null for the
+// {image, format, sidecar} (null when image_file is empty: a capture not written), scene {shape, width, height, pixel_size_um, radius_um (null for the
 // plane), light {x, y, z, theta_deg, phi_deg}, view {…}, image_right [x, y, z], image_up [x, y, z],
 // background_radiance}, truth {regions: [{label, model, sigma_um, T_um, sigma_over_T,
 // correlation, factor, radiometry, wavelength_um, oren_nayar_sigma_deg, oren_nayar_albedo,
