@@ -41,10 +41,10 @@ struct CaptureCommand {
 void run_capture(CaptureCommand& c) {
     c.scene.width = static_cast<std::size_t>(c.width);
     c.scene.height = static_cast<std::size_t>(c.height);
-    c.scene.light = simulation::direction_from_angles(deg_to_rad(c.theta_i_deg),
-                                                      deg_to_rad(c.phi_i_deg));
-    c.scene.view = simulation::direction_from_angles(deg_to_rad(c.theta_v_deg),
-                                                     deg_to_rad(c.phi_v_deg));
+    c.scene.light =
+        simulation::direction_from_angles(deg_to_rad(c.theta_i_deg), deg_to_rad(c.phi_i_deg));
+    c.scene.view =
+        simulation::direction_from_angles(deg_to_rad(c.theta_v_deg), deg_to_rad(c.phi_v_deg));
     c.camera.bit_depth = c.bits;
     c.camera.shot_noise = !c.no_shot_noise;
     c.truth.oren_nayar.sigma_rad = deg_to_rad(c.oren_nayar_sigma_deg);
@@ -71,8 +71,7 @@ void run_capture(CaptureCommand& c) {
         const std::size_t n = record.truths.size();
         record.labels.resize(c.scene.width * c.scene.height);
         for (std::size_t i = 0; i < record.labels.size(); ++i)
-            record.labels[i] =
-                static_cast<std::int32_t>((i % c.scene.width) * n / c.scene.width);
+            record.labels[i] = static_cast<std::int32_t>((i % c.scene.width) * n / c.scene.width);
     }
     const fs::path dir(c.out_dir);
     if (fs::exists(dir) && !fs::is_directory(dir))
@@ -96,7 +95,8 @@ void add_simulate_capture(CLI::App& simulate) {
     CLI::App* cmd = simulate.add_subcommand(
         "capture",
         "Synthetic camera capture of a plane, cylinder or sphere of known roughness: image "
-        "(PNG, TIFF, float TIFF or DNG) + JSON sidecar with the truth (docs/simulation-captures.md)");
+        "(PNG, TIFF, float TIFF or DNG) + JSON sidecar with the truth "
+        "(docs/simulation-captures.md)");
     const std::string gs = "Scene";
     add_enum_option(*cmd, "--scene", c.scene.shape, simulation::parse_scene_shape,
                     "plane (default), cylinder (axis = scene Y) or sphere")

@@ -30,14 +30,39 @@ namespace {
 using simulation::CaptureFormat;
 
 const std::set<std::string>& capture_keys() {
-    static const std::set<std::string> keys{
-        "scene",        "width",       "height",        "pixel_size_um",  "radius_um",
-        "theta_i_deg",  "phi_i_deg",   "theta_v_deg",   "phi_v_deg",      "background",
-        "sigma_over_T", "T_um",        "correlation",   "model",          "factor",
-        "wavelength_um", "oren_nayar_sigma_deg", "lafortune_n", "labels",  "brightness",
-        "electrons_per_unit_s", "exposure_s", "gain", "full_well_e",      "black_level",
-        "read_noise_e", "bits",        "response",      "gamma",          "vignetting",
-        "shot_noise",   "seed",        "keep_geometry"};
+    static const std::set<std::string> keys{"scene",
+                                            "width",
+                                            "height",
+                                            "pixel_size_um",
+                                            "radius_um",
+                                            "theta_i_deg",
+                                            "phi_i_deg",
+                                            "theta_v_deg",
+                                            "phi_v_deg",
+                                            "background",
+                                            "sigma_over_T",
+                                            "T_um",
+                                            "correlation",
+                                            "model",
+                                            "factor",
+                                            "wavelength_um",
+                                            "oren_nayar_sigma_deg",
+                                            "lafortune_n",
+                                            "labels",
+                                            "brightness",
+                                            "electrons_per_unit_s",
+                                            "exposure_s",
+                                            "gain",
+                                            "full_well_e",
+                                            "black_level",
+                                            "read_noise_e",
+                                            "bits",
+                                            "response",
+                                            "gamma",
+                                            "vignetting",
+                                            "shot_noise",
+                                            "seed",
+                                            "keep_geometry"};
     return keys;
 }
 
@@ -75,8 +100,8 @@ Request request_from(const py::kwargs& kw) {
     for (const char* k : {"theta_i_deg", "theta_v_deg"}) {
         const double t = real(k, 0.0);
         if (!(t >= 0.0 && t < 90.0))
-            throw InvalidArgument(concat(k, " = ", format_message(t),
-                                         " is outside the valid range [0, 90) degrees"));
+            throw InvalidArgument(
+                concat(k, " = ", format_message(t), " is outside the valid range [0, 90) degrees"));
     }
     s.light = simulation::direction_from_angles(deg_to_rad(real("theta_i_deg", 30.0)),
                                                 deg_to_rad(real("phi_i_deg", 180.0)));
@@ -95,13 +120,13 @@ Request request_from(const py::kwargs& kw) {
     if (has("brightness")) {
         py::object f = kw["brightness"];
         if (!PyCallable_Check(f.ptr()))
-            throw py::type_error("brightness must be a callable (theta_i_deg, theta_s_deg, "
-                                 "phi_s_deg) -> float");
+            throw py::type_error(
+                "brightness must be a callable (theta_i_deg, theta_s_deg, "
+                "phi_s_deg) -> float");
         truth.model = simulation::BrightnessModel::Tabulated;
         truth.tabulated = [f](const Geometry& g) {
             py::gil_scoped_acquire gil;
-            return f(rad_to_deg(g.theta_i_rad), rad_to_deg(g.theta_s_rad),
-                     rad_to_deg(g.phi_s_rad))
+            return f(rad_to_deg(g.theta_i_rad), rad_to_deg(g.theta_s_rad), rad_to_deg(g.phi_s_rad))
                 .cast<double>();
         };
     }
@@ -114,8 +139,8 @@ Request request_from(const py::kwargs& kw) {
     }
     for (double ratio : ratios) {
         if (!(ratio > 0.0 && std::isfinite(ratio)))
-            throw InvalidArgument(concat("sigma_over_T = ", format_message(ratio),
-                                         " must be finite and > 0"));
+            throw InvalidArgument(
+                concat("sigma_over_T = ", format_message(ratio), " must be finite and > 0"));
         simulation::SurfaceTruth t = truth;
         t.sigma_um = ratio * truth.T_um;
         r.record.truths.push_back(t);
@@ -123,16 +148,18 @@ Request request_from(const py::kwargs& kw) {
     if (has("labels")) {
         auto labels = py::array_t<std::int32_t, py::array::c_style | py::array::forcecast>::ensure(
             kw["labels"]);
-        if (!labels || labels.ndim() != 2 || static_cast<std::size_t>(labels.shape(0)) != s.height ||
+        if (!labels || labels.ndim() != 2 ||
+            static_cast<std::size_t>(labels.shape(0)) != s.height ||
             static_cast<std::size_t>(labels.shape(1)) != s.width)
-            throw InvalidArgument(concat("labels must be an integer array of shape (height, width) "
-                                         "= (",
-                                         std::to_string(s.height), ", ", std::to_string(s.width),
-                                         ")"));
+            throw InvalidArgument(
+                concat("labels must be an integer array of shape (height, width) "
+                       "= (",
+                       std::to_string(s.height), ", ", std::to_string(s.width), ")"));
         r.record.labels.assign(labels.data(), labels.data() + labels.size());
     } else if (ratios.size() > 1) {
-        throw InvalidArgument("sigma_over_T: several values need labels (an integer array of "
-                              "shape (height, width) indexing them)");
+        throw InvalidArgument(
+            "sigma_over_T: several values need labels (an integer array of "
+            "shape (height, width) indexing them)");
     }
 
     simulation::CameraModel& c = r.record.camera;
@@ -149,7 +176,8 @@ Request request_from(const py::kwargs& kw) {
     c.shot_noise = has("shot_noise") ? kw["shot_noise"].cast<bool>() : true;
     if (has("seed")) {
         const long long seed = integer_scalar("seed", kw["seed"]);
-        if (seed < 0) throw InvalidArgument(concat("seed = ", std::to_string(seed), " must be >= 0"));
+        if (seed < 0)
+            throw InvalidArgument(concat("seed = ", std::to_string(seed), " must be >= 0"));
         c.seed = static_cast<std::uint64_t>(seed);
     }
     r.options.keep_geometry = has("keep_geometry") ? kw["keep_geometry"].cast<bool>() : true;
@@ -182,7 +210,8 @@ py::dict capture_dict(const simulation::Capture& c, const serialize::CaptureReco
     out["expected_dn"] = image(c.expected_dn, h, w);
     out["dn"] = image(c.dn, h, w);
     py::array_t<bool> sat({static_cast<py::ssize_t>(h), static_cast<py::ssize_t>(w)});
-    for (std::size_t i = 0; i < c.saturated.size(); ++i) sat.mutable_data()[i] = c.saturated[i] != 0;
+    for (std::size_t i = 0; i < c.saturated.size(); ++i)
+        sat.mutable_data()[i] = c.saturated[i] != 0;
     out["saturated"] = sat;
     if (!c.label.empty()) {
         out["label"] = image(c.label, h, w);
@@ -210,8 +239,8 @@ void bind_capture(py::module_& m) {
                 c = simulation::render_capture(r.record.scene, r.record.truths, r.record.labels,
                                                r.record.camera, r.options);
             }
-            return capture_dict(c, r.record,
-                                serialize::capture_sidecar(c, r.record, CaptureFormat::Png, "", ""));
+            return capture_dict(
+                c, r.record, serialize::capture_sidecar(c, r.record, CaptureFormat::Png, "", ""));
         },
         "Render a synthetic capture (keywords as docs/simulation-captures.md, 'Python'). Returns a "
         "dict of (height, width) arrays radiance, expected_dn, dn (uint16), saturated (bool), and "
@@ -229,8 +258,8 @@ void bind_capture(py::module_& m) {
                 c = simulation::render_capture(r.record.scene, r.record.truths, r.record.labels,
                                                r.record.camera, r.options);
             }
-            const serialize::CaptureFiles files =
-                serialize::write_capture_files(c, r.record, f, std::filesystem::path(out_dir), stem);
+            const serialize::CaptureFiles files = serialize::write_capture_files(
+                c, r.record, f, std::filesystem::path(out_dir), stem);
             py::dict out;
             out["image"] = files.image.string();
             out["sidecar"] = files.sidecar.string();

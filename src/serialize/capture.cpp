@@ -20,7 +20,9 @@ namespace {
 using simulation::BrightnessModel;
 using simulation::Response;
 
-Json vector3(const Eigen::Vector3d& v) { return Json::array({number(v.x()), number(v.y()), number(v.z())}); }
+Json vector3(const Eigen::Vector3d& v) {
+    return Json::array({number(v.x()), number(v.y()), number(v.z())});
+}
 
 // A direction with its polar angle from Z and azimuth from X (degrees).
 Json direction(const Eigen::Vector3d& v) {
@@ -139,8 +141,8 @@ Json capture_sidecar(const simulation::Capture& capture, const CaptureRecord& re
 }
 
 CaptureFiles write_capture_files(const simulation::Capture& capture, const CaptureRecord& record,
-                                 simulation::CaptureFormat format,
-                                 const std::filesystem::path& dir, const std::string& stem) {
+                                 simulation::CaptureFormat format, const std::filesystem::path& dir,
+                                 const std::string& stem) {
     const std::string image_name = concat(stem, ".", simulation::file_extension(format));
     const std::string sidecar_name = concat(stem, ".json");
     // Everything that can fail on the input first, then the two writes.

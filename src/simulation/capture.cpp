@@ -8,10 +8,12 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <exception>
 #include <functional>
 #include <limits>
 #include <optional>
 #include <string>
+#include <thread>
 #include <utility>
 #include <vector>
 
@@ -23,6 +25,13 @@
 #include "roughscope/core/names.hpp"
 #include "roughscope/core/numbers.hpp"
 #include "roughscope/core/text.hpp"
+
+// GCC 12 cannot see that boost::random::poisson_distribution initialises the union member of the
+// branch (PTRD or inversion) its mean selects, and warns falsely when the distribution is kept
+// between draws (as here, to reuse it for equal means).
+#if defined(__GNUC__) && !defined(__clang__)
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#endif
 
 namespace roughscope::simulation {
 
@@ -167,9 +176,10 @@ void check_scene(const Scene& scene) {
     check_unit("light", scene.light);
     check_unit("view", scene.view);
     if (scene.shape == SceneShape::Plane && scene.view.z() <= 1e-12)
-        throw InvalidArgument(concat("view: a plane is seen only from above (view z > 0, theta_v in "
-                                     "[0, 90) deg); got view z = ",
-                                     number_text(scene.view.z())));
+        throw InvalidArgument(
+            concat("view: a plane is seen only from above (view z > 0, theta_v in "
+                   "[0, 90) deg); got view z = ",
+                   number_text(scene.view.z())));
     if (scene.shape == SceneShape::Cylinder && std::abs(scene.view.y()) > std::cos(deg_to_rad(1.0)))
         throw InvalidArgument(
             "view: the cylinder's axis is the scene Y axis; a view within 1 deg of it sees only "
@@ -198,8 +208,8 @@ void check_camera(const CameraModel& camera) {
                                      number_text(camera.white_level_dn()), ") for ",
                                      std::to_string(camera.bit_depth), " bits"));
     if (!(camera.gamma >= 0.1 && camera.gamma <= 10.0))
-        throw InvalidArgument(concat("gamma = ", number_text(camera.gamma),
-                                     " is outside the valid range [0.1, 10]"));
+        throw InvalidArgument(
+            concat("gamma = ", number_text(camera.gamma), " is outside the valid range [0.1, 10]"));
     if (!(camera.vignetting >= 0.0 && camera.vignetting <= 1.0))
         throw InvalidArgument(concat("vignetting = ", number_text(camera.vignetting),
                                      " is outside the valid range [0, 1]"));
@@ -241,10 +251,9 @@ double surface_brightness(const SurfaceTruth& truth, const Geometry& geom) {
                 throw InvalidArgument("tabulated brightness: no table or callback given");
             const double value = truth.tabulated(geom);
             if (!std::isfinite(value) || value < 0.0)
-                throw InvalidArgument(concat("tabulated brightness = ", number_text(value),
-                                             " at theta_i = ",
-                                             number_text(rad_to_deg(geom.theta_i_rad)),
-                                             " deg is not a finite value >= 0"));
+                throw InvalidArgument(concat(
+                    "tabulated brightness = ", number_text(value), " at theta_i = ",
+                    number_text(rad_to_deg(geom.theta_i_rad)), " deg is not a finite value >= 0"));
             return value;
         }
     }
@@ -275,8 +284,8 @@ std::function<double(const Geometry&)> table_brightness(BrightnessTable table) {
                                      " values for a grid of ", std::to_string(expected)));
     for (double v : table.values)
         if (!std::isfinite(v) || v < 0.0)
-            throw InvalidArgument(concat("brightness table: value ", number_text(v),
-                                         " is not a finite value >= 0"));
+            throw InvalidArgument(
+                concat("brightness table: value ", number_text(v), " is not a finite value >= 0"));
     return [t = std::move(table)](const Geometry& g) {
         // Index and weight along one axis, clamped at the edges.
         auto locate = [](const std::vector<double>& axis, double x) {
@@ -296,8 +305,8 @@ std::function<double(const Geometry&)> table_brightness(BrightnessTable table) {
         for (int da = 0; da < 2; ++da)
             for (int db = 0; db < 2; ++db)
                 for (int dc = 0; dc < 2; ++dc) {
-                    const double w = (da ? wa : 1.0 - wa) * (db ? wb : 1.0 - wb) *
-                                     (dc ? wc : 1.0 - wc);
+                    const double w =
+                        (da ? wa : 1.0 - wa) * (db ? wb : 1.0 - wb) * (dc ? wc : 1.0 - wc);
                     if (w == 0.0) continue;
                     sum += w * t.values[((a + da) * ns + (b + db)) * np + (c + dc)];
                 }
@@ -330,8 +339,8 @@ Capture render_capture(const Scene& scene, const std::vector<SurfaceTruth>& trut
         const SurfaceTruth& t = truths[k];
         const std::string which = concat("truth ", std::to_string(k), " ");
         if (!(t.sigma_um > 0.0 && std::isfinite(t.sigma_um)))
-            throw InvalidArgument(concat(which, "sigma_um = ", number_text(t.sigma_um),
-                                         " must be finite and > 0"));
+            throw InvalidArgument(
+                concat(which, "sigma_um = ", number_text(t.sigma_um), " must be finite and > 0"));
         if (!(t.T_um > 0.0 && std::isfinite(t.T_um)))
             throw InvalidArgument(
                 concat(which, "T_um = ", number_text(t.T_um), " must be finite and > 0"));
@@ -364,87 +373,129 @@ Capture render_capture(const Scene& scene, const std::vector<SurfaceTruth>& trut
     const double k_t = camera.electrons_per_unit_s * camera.exposure_s;
     const double full_well = camera.full_well_e;
 
-    // The last brightness computed (a plane, or neighbouring pixels of one region on a flat
-    // patch, repeat the same normal).
-    Eigen::Vector3d last_normal(kNaN, kNaN, kNaN);
-    std::int32_t last_label = -2;
-    double last_brightness = 0.0;
-    std::optional<Geometry> last_geometry;
+    // Rows [row_begin, row_end) with their own caches and counts; each row draws from its own
+    // stream, so the split into blocks does not change the result.
+    struct BlockCounts {
+        std::size_t object = 0, saturated = 0;
+    };
+    auto render_rows = [&](std::size_t row_begin, std::size_t row_end, BlockCounts& counts) {
+        // The last brightness computed (a plane, or neighbouring pixels of one region on a flat
+        // patch, repeat the same normal) and the last shot-noise distribution (same mean).
+        Eigen::Vector3d last_normal(kNaN, kNaN, kNaN);
+        std::int32_t last_label = -2;
+        double last_brightness = 0.0;
+        std::optional<Geometry> last_geometry;
+        boost::random::poisson_distribution<std::int64_t, double> shot(1.0);
 
-    for (std::size_t row = 0; row < H; ++row) {
-        boost::random::mt19937_64 engine(splitmix64(camera.seed ^ splitmix64(row)));
-        boost::random::normal_distribution<double> read_noise(0.0, 1.0);
-        const double y_img = (half_h - static_cast<double>(row) - 0.5) * s;
-        const double dy = static_cast<double>(row) + 0.5 - half_h;
-        for (std::size_t col = 0; col < W; ++col) {
-            const std::size_t i = row * W + col;
-            const double x_img = (static_cast<double>(col) + 0.5 - half_w) * s;
-            const Eigen::Vector3d p = x_img * frame.right + y_img * frame.up;
-            const auto normal = surface_normal(scene.shape, p, scene.view, radius);
-            double radiance = scene.background_radiance;
-            std::int32_t label = -1;
-            std::optional<Geometry> geometry;
-            if (normal) {
-                ++out.object_count;
-                label = labels.empty() ? 0 : labels[i];
-                if (label == last_label && *normal == last_normal) {
-                    radiance = last_brightness;
-                    geometry = last_geometry;
-                } else {
-                    geometry = geometry_from_vectors(*normal, scene.light, scene.view);
-                    radiance = geometry ? surface_brightness(
-                                              truths[static_cast<std::size_t>(label)], *geometry)
-                                        : 0.0;
-                    last_normal = *normal;
-                    last_label = label;
-                    last_brightness = radiance;
-                    last_geometry = geometry;
+        for (std::size_t row = row_begin; row < row_end; ++row) {
+            boost::random::mt19937_64 engine(splitmix64(camera.seed ^ splitmix64(row)));
+            boost::random::normal_distribution<double> read_noise(0.0, 1.0);
+            const double y_img = (half_h - static_cast<double>(row) - 0.5) * s;
+            const double dy = static_cast<double>(row) + 0.5 - half_h;
+            for (std::size_t col = 0; col < W; ++col) {
+                const std::size_t i = row * W + col;
+                const double x_img = (static_cast<double>(col) + 0.5 - half_w) * s;
+                const Eigen::Vector3d p = x_img * frame.right + y_img * frame.up;
+                const auto normal = surface_normal(scene.shape, p, scene.view, radius);
+                double radiance = scene.background_radiance;
+                std::int32_t label = -1;
+                std::optional<Geometry> geometry;
+                if (normal) {
+                    ++counts.object;
+                    label = labels.empty() ? 0 : labels[i];
+                    if (label == last_label && *normal == last_normal) {
+                        radiance = last_brightness;
+                        geometry = last_geometry;
+                    } else {
+                        geometry = geometry_from_vectors(*normal, scene.light, scene.view);
+                        radiance = geometry
+                                       ? surface_brightness(truths[static_cast<std::size_t>(label)],
+                                                            *geometry)
+                                       : 0.0;
+                        last_normal = *normal;
+                        last_label = label;
+                        last_brightness = radiance;
+                        last_geometry = geometry;
+                    }
                 }
-            }
-            // Camera (docs/simulation-captures.md, "Camera").
-            const double dx = static_cast<double>(col) + 0.5 - half_w;
-            const double vignette =
-                camera.vignetting > 0.0 ? 1.0 - camera.vignetting * (dx * dx + dy * dy) / half_diag2
-                                        : 1.0;
-            const double mu_e = k_t * radiance * vignette;
-            double n_e = mu_e;
-            if (camera.shot_noise && mu_e > 0.0) {
-                if (mu_e - full_well > 40.0 * std::sqrt(mu_e)) {
-                    n_e = full_well;  // a draw below the full well has probability < 1e-300
-                } else {
-                    boost::random::poisson_distribution<std::int64_t, double> shot(mu_e);
-                    n_e = static_cast<double>(shot(engine));
+                // Camera (docs/simulation-captures.md, "Camera").
+                const double dx = static_cast<double>(col) + 0.5 - half_w;
+                const double vignette =
+                    camera.vignetting > 0.0
+                        ? 1.0 - camera.vignetting * (dx * dx + dy * dy) / half_diag2
+                        : 1.0;
+                const double mu_e = k_t * radiance * vignette;
+                double n_e = mu_e;
+                if (camera.shot_noise && mu_e > 0.0) {
+                    if (mu_e - full_well > 40.0 * std::sqrt(mu_e)) {
+                        n_e = full_well;  // a draw below the full well has probability < 1e-300
+                    } else {
+                        if (shot.mean() != mu_e)
+                            shot = boost::random::poisson_distribution<std::int64_t, double>(mu_e);
+                        n_e = static_cast<double>(shot(engine));
+                    }
                 }
-            }
-            bool saturated = false;
-            if (n_e >= full_well) {
-                n_e = full_well;
-                saturated = true;
-            }
-            const double x_e =
-                camera.read_noise_e > 0.0 ? n_e + camera.read_noise_e * read_noise(engine) : n_e;
-            const double signal = camera.gain_dn_per_e * x_e + camera.black_level_dn;
-            if (signal >= white) saturated = true;
-            const double clipped = std::clamp(signal, 0.0, white);
-            const double encoded = camera.response == Response::Linear
-                                       ? clipped
-                                       : white * encode_response(camera, clipped / white);
-            out.dn[i] = static_cast<std::uint16_t>(std::floor(encoded + 0.5));
-            out.saturated[i] = saturated ? 1 : 0;
-            out.saturated_count += saturated ? 1 : 0;
-            out.radiance[i] = static_cast<float>(radiance);
-            out.expected_dn[i] =
-                static_cast<float>(camera.gain_dn_per_e * mu_e + camera.black_level_dn);
-            if (options.keep_geometry) {
-                out.label[i] = label;
-                out.theta_i_rad[i] = geometry ? static_cast<float>(geometry->theta_i_rad) : kNaNf;
-                out.theta_s_rad[i] = geometry ? static_cast<float>(geometry->theta_s_rad) : kNaNf;
-                out.phi_s_rad[i] = geometry ? static_cast<float>(geometry->phi_s_rad) : kNaNf;
-                for (int c = 0; c < 3; ++c)
-                    out.normal[3 * i + static_cast<std::size_t>(c)] =
-                        normal ? static_cast<float>((*normal)[c]) : kNaNf;
+                bool saturated = false;
+                if (n_e >= full_well) {
+                    n_e = full_well;
+                    saturated = true;
+                }
+                const double x_e = camera.read_noise_e > 0.0
+                                       ? n_e + camera.read_noise_e * read_noise(engine)
+                                       : n_e;
+                const double signal = camera.gain_dn_per_e * x_e + camera.black_level_dn;
+                if (signal >= white) saturated = true;
+                const double clipped = std::clamp(signal, 0.0, white);
+                const double encoded = camera.response == Response::Linear
+                                           ? clipped
+                                           : white * encode_response(camera, clipped / white);
+                out.dn[i] = static_cast<std::uint16_t>(std::floor(encoded + 0.5));
+                out.saturated[i] = saturated ? 1 : 0;
+                counts.saturated += saturated ? 1 : 0;
+                out.radiance[i] = static_cast<float>(radiance);
+                out.expected_dn[i] =
+                    static_cast<float>(camera.gain_dn_per_e * mu_e + camera.black_level_dn);
+                if (options.keep_geometry) {
+                    out.label[i] = label;
+                    out.theta_i_rad[i] =
+                        geometry ? static_cast<float>(geometry->theta_i_rad) : kNaNf;
+                    out.theta_s_rad[i] =
+                        geometry ? static_cast<float>(geometry->theta_s_rad) : kNaNf;
+                    out.phi_s_rad[i] = geometry ? static_cast<float>(geometry->phi_s_rad) : kNaNf;
+                    for (int c = 0; c < 3; ++c)
+                        out.normal[3 * i + static_cast<std::size_t>(c)] =
+                            normal ? static_cast<float>((*normal)[c]) : kNaNf;
+                }
             }
         }
+    };
+
+    std::size_t threads =
+        options.threads != 0 ? options.threads : std::max(1U, std::thread::hardware_concurrency());
+    threads = std::min({threads, H, std::size_t{64}});
+    if (N < 65536) threads = 1;  // not worth a thread
+    std::vector<BlockCounts> counts(threads);
+    if (threads == 1) {
+        render_rows(0, H, counts[0]);
+    } else {
+        std::vector<std::exception_ptr> errors(threads);
+        std::vector<std::thread> workers;
+        for (std::size_t t = 0; t < threads; ++t) {
+            workers.emplace_back([&, t] {
+                try {
+                    render_rows(H * t / threads, H * (t + 1) / threads, counts[t]);
+                } catch (...) {
+                    errors[t] = std::current_exception();
+                }
+            });
+        }
+        for (auto& w : workers) w.join();
+        for (const auto& e : errors)
+            if (e) std::rethrow_exception(e);
+    }
+    for (const BlockCounts& c : counts) {
+        out.object_count += c.object;
+        out.saturated_count += c.saturated;
     }
     return out;
 }

@@ -261,8 +261,7 @@ std::string encode_capture_tiff_float(const Capture& capture) {
     out.reserve(capture.expected_dn.size() * 4 + 4096);
     {
         TiffWriter writer(out);
-        set_common_tags(writer.get(), capture, 32, 1, SAMPLEFORMAT_IEEEFP,
-                        PHOTOMETRIC_MINISBLACK);
+        set_common_tags(writer.get(), capture, 32, 1, SAMPLEFORMAT_IEEEFP, PHOTOMETRIC_MINISBLACK);
         writer.write_rows(reinterpret_cast<const unsigned char*>(capture.expected_dn.data()),
                           capture.width * 4, capture.height);
         writer.finish();
@@ -281,7 +280,8 @@ std::string encode_capture_dng(const Capture& capture, const CameraModel& camera
                                      " is not allowed (use response linear)"));
     const std::size_t n = capture.dn.size();
     std::vector<std::uint16_t> rgb(3 * n);
-    for (std::size_t i = 0; i < n; ++i) rgb[3 * i] = rgb[3 * i + 1] = rgb[3 * i + 2] = capture.dn[i];
+    for (std::size_t i = 0; i < n; ++i)
+        rgb[3 * i] = rgb[3 * i + 1] = rgb[3 * i + 2] = capture.dn[i];
     std::string out;
     out.reserve(rgb.size() * 2 + 4096);
     {

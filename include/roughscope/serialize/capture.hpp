@@ -23,14 +23,15 @@ struct CaptureRecord {
 };
 
 // The sidecar document. Keys, in order: format ("roughscope-capture"), version (1), files
-// {image, format, sidecar} (null when image_file is empty: a capture not written), scene {shape, width, height, pixel_size_um, radius_um (null for the
-// plane), light {x, y, z, theta_deg, phi_deg}, view {…}, image_right [x, y, z], image_up [x, y, z],
-// background_radiance}, truth {regions: [{label, model, sigma_um, T_um, sigma_over_T,
-// correlation, factor, radiometry, wavelength_um, oren_nayar_sigma_deg, oren_nayar_albedo,
-// lafortune_n, pixels, bbox [col0, row0, col1, row1] or null}]}, camera {electrons_per_unit_s,
-// exposure_s, gain_dn_per_e, full_well_e, black_level_dn, white_level_dn, read_noise_e, bit_depth,
-// response, gamma (null unless gamma), vignetting, shot_noise, seed}, statistics {object_pixels,
-// saturated_pixels, background_pixels}, documentation.
+// {image, format, sidecar} (null when image_file is empty: a capture not written), scene {shape,
+// width, height, pixel_size_um, radius_um (null for the plane), light {x, y, z, theta_deg,
+// phi_deg}, view {…}, image_right [x, y, z], image_up [x, y, z], background_radiance}, truth
+// {regions: [{label, model, sigma_um, T_um, sigma_over_T, correlation, factor, radiometry,
+// wavelength_um, oren_nayar_sigma_deg, oren_nayar_albedo, lafortune_n, pixels, bbox [col0, row0,
+// col1, row1] or null}]}, camera {electrons_per_unit_s, exposure_s, gain_dn_per_e, full_well_e,
+// black_level_dn, white_level_dn, read_noise_e, bit_depth, response, gamma (null unless gamma),
+// vignetting, shot_noise, seed}, statistics {object_pixels, saturated_pixels, background_pixels},
+// documentation.
 Json capture_sidecar(const simulation::Capture& capture, const CaptureRecord& record,
                      simulation::CaptureFormat format, const std::string& image_file,
                      const std::string& sidecar_file);
@@ -44,8 +45,7 @@ struct CaptureFiles {
 // was). `dir` must exist. Throws InvalidArgument (e.g. DNG with a non-linear response) or
 // DataError (cannot write).
 CaptureFiles write_capture_files(const simulation::Capture& capture, const CaptureRecord& record,
-                                 simulation::CaptureFormat format,
-                                 const std::filesystem::path& dir,
+                                 simulation::CaptureFormat format, const std::filesystem::path& dir,
                                  const std::string& stem = "capture");
 
 }  // namespace roughscope::serialize

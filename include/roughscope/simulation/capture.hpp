@@ -61,13 +61,13 @@ Eigen::Vector3d direction_from_angles(double theta_rad, double phi_rad);
 
 struct Scene {
     SceneShape shape = SceneShape::Plane;
-    std::size_t width = 256;   // pixels, 1..65535
-    std::size_t height = 256;  // pixels, 1..65535
+    std::size_t width = 256;      // pixels, 1..65535
+    std::size_t height = 256;     // pixels, 1..65535
     double pixel_size_um = 10.0;  // object-space side of one pixel, µm (> 0)
     // Sphere and cylinder radius, µm; 0 = 0.4 · min(width, height) · pixel_size_um.
     double radius_um = 0.0;
     Eigen::Vector3d light = direction_from_angles(deg_to_rad(30.0), kPi);  // L, unit
-    Eigen::Vector3d view = Eigen::Vector3d(0.0, 0.0, 1.0);                  // V, unit
+    Eigen::Vector3d view = Eigen::Vector3d(0.0, 0.0, 1.0);                 // V, unit
     double background_radiance = 0.0;  // brightness of pixels that miss the object (≥ 0)
 };
 
@@ -143,11 +143,11 @@ struct CameraModel {
     double read_noise_e = 3.0;              // σ_read, electrons RMS (≥ 0)
     int bit_depth = 14;                     // 8, 12, 14 or 16
     Response response = Response::Linear;
-    double gamma = 2.2;                 // Response::Gamma: DN = white · u^(1/γ); γ in [0.1, 10]
-    double vignetting = 0.0;            // v(ρ) = 1 − vignetting · ρ², ρ = r / half-diagonal; [0, 1]
-    bool shot_noise = true;             // false: n_e = μ_e (no Poisson draw)
+    double gamma = 2.2;       // Response::Gamma: DN = white · u^(1/γ); γ in [0.1, 10]
+    double vignetting = 0.0;  // v(ρ) = 1 − vignetting · ρ², ρ = r / half-diagonal; [0, 1]
+    bool shot_noise = true;   // false: n_e = μ_e (no Poisson draw)
     std::uint64_t seed = 1;
-    double white_level_dn() const;      // 2^bit_depth − 1
+    double white_level_dn() const;  // 2^bit_depth − 1
 };
 
 // Throws InvalidArgument naming the field and its valid range.
@@ -165,19 +165,22 @@ struct CaptureOptions {
     // Keep the per-pixel label, (θi, θs, φs) and normal (4 + 12 + 12 bytes a pixel); off for
     // very large images when only the pixels are needed.
     bool keep_geometry = true;
+    // Worker threads over blocks of rows (0 = all cores; images below 65536 pixels use one). The
+    // result does not depend on it.
+    std::size_t threads = 0;
 };
 
 struct Capture {
     std::size_t width = 0, height = 0;
     int bit_depth = 14;
-    std::vector<float> radiance;        // model brightness E per pixel (background included)
-    std::vector<float> expected_dn;     // gain · μ_e + black: the noise-free linear signal, DN
-    std::vector<std::uint16_t> dn;      // the quantised pixel values
+    std::vector<float> radiance;          // model brightness E per pixel (background included)
+    std::vector<float> expected_dn;       // gain · μ_e + black: the noise-free linear signal, DN
+    std::vector<std::uint16_t> dn;        // the quantised pixel values
     std::vector<std::uint8_t> saturated;  // 1 where clipped (full well or white level)
     // keep_geometry only (else empty):
-    std::vector<std::int32_t> label;      // truth index, −1 for the background
+    std::vector<std::int32_t> label;                         // truth index, −1 for the background
     std::vector<float> theta_i_rad, theta_s_rad, phi_s_rad;  // NaN for background / below horizon
-    std::vector<float> normal;            // n, 3 per pixel (x, y, z); NaN for background
+    std::vector<float> normal;  // n, 3 per pixel (x, y, z); NaN for background
     std::size_t saturated_count = 0;
     std::size_t object_count = 0;  // pixels on the object
 };
@@ -208,7 +211,6 @@ std::string encode_capture_tiff_float(const Capture& capture);
 // WhiteLevel, identity ColorMatrix1, AsShotNeutral 1 1 1. Linear response only (InvalidArgument
 // otherwise: a DNG holds linear raw values).
 std::string encode_capture_dng(const Capture& capture, const CameraModel& camera);
-std::string encode_capture(const Capture& capture, const CameraModel& camera,
-                           CaptureFormat format);
+std::string encode_capture(const Capture& capture, const CameraModel& camera, CaptureFormat format);
 
 }  // namespace roughscope::simulation

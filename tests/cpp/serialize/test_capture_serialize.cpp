@@ -1,18 +1,16 @@
 // The capture sidecar (serialize/capture.hpp): the truth, geometry and camera read back from the
 // written JSON equal the inputs; nothing is written when the image cannot be encoded.
-#include "roughscope/serialize/capture.hpp"
-
-#include <gtest/gtest.h>
-
 #include <cmath>
 #include <cstdint>
 #include <filesystem>
 #include <string>
 
+#include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
 #include "../io/test_files.hpp"
 #include "roughscope/core/errors.hpp"
+#include "roughscope/serialize/capture.hpp"
 
 namespace roughscope::serialize {
 namespace {

@@ -2,19 +2,18 @@
 // at the known geometry of a plane, the photon-transfer relation of Poisson + read noise, the
 // clipping rule, the IEC 61966-2-1 sRGB values, the geometry of the sphere's centre and the
 // cylinder's symmetry, and reproducibility from the seed.
-#include "roughscope/simulation/capture.hpp"
-
-#include <gtest/gtest.h>
-
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <vector>
 
+#include <gtest/gtest.h>
+
 #include "roughscope/core/errors.hpp"
 #include "roughscope/scattering/beckmann.hpp"
 #include "roughscope/scattering/geometry.hpp"
 #include "roughscope/scattering/reflectance_models.hpp"
+#include "roughscope/simulation/capture.hpp"
 
 namespace roughscope::simulation {
 namespace {
@@ -148,7 +147,8 @@ TEST(CaptureCamera, FlatFieldFollowsPhotonTransfer) {
     EXPECT_NEAR(mean, 0.5 * 1000.0 + 64.0, 4.0 * std::sqrt(expected_var / n));
     EXPECT_NEAR(var, expected_var, 4.0 * expected_var * std::sqrt(2.0 / n));
     // Mean and variance of the theory at the true mean, too.
-    EXPECT_NEAR(var, 0.5 * 500.0 + 0.25 * 9.0 + 1.0 / 12.0, 4.0 * expected_var * std::sqrt(2.0 / n));
+    EXPECT_NEAR(var, 0.5 * 500.0 + 0.25 * 9.0 + 1.0 / 12.0,
+                4.0 * expected_var * std::sqrt(2.0 / n));
 }
 
 TEST(CaptureCamera, SaturationMaskIsExactlyWhereClipped) {
@@ -213,7 +213,8 @@ TEST(CaptureCamera, SrgbMatchesIec61966Values) {
     camera.response = Response::Srgb;
     const Capture c = render_capture(scene, {truth}, {}, camera);
     const double signal = 0.001 * 20000.0 * std::cos(deg_to_rad(45.0));
-    EXPECT_EQ(c.dn[0], static_cast<std::uint16_t>(std::lround(255.0 * srgb_encode(signal / 255.0))));
+    EXPECT_EQ(c.dn[0],
+              static_cast<std::uint16_t>(std::lround(255.0 * srgb_encode(signal / 255.0))));
     camera.response = Response::Gamma;
     camera.gamma = 2.0;
     const Capture g = render_capture(scene, {truth}, {}, camera);
@@ -234,6 +235,25 @@ TEST(CaptureCamera, SameSeedSameBytesOtherSeedOtherBytes) {
     camera.seed = 43;
     const Capture d = render_capture(scene, {truth}, {}, camera);
     EXPECT_NE(a.dn, d.dn);
+}
+
+TEST(CaptureCamera, ThreadCountDoesNotChangeTheResult) {
+    Scene scene;
+    scene.shape = SceneShape::Sphere;
+    scene.width = 300;
+    scene.height = 257;  // ≥ 65536 pixels: threaded
+    SurfaceTruth truth;
+    CameraModel camera;
+    camera.seed = 5;
+    CaptureOptions one, three;
+    one.threads = 1;
+    three.threads = 3;
+    const Capture a = render_capture(scene, {truth}, {}, camera, one);
+    const Capture b = render_capture(scene, {truth}, {}, camera, three);
+    EXPECT_EQ(a.dn, b.dn);
+    EXPECT_EQ(a.object_count, b.object_count);
+    EXPECT_EQ(a.saturated_count, b.saturated_count);
+    EXPECT_EQ(a.theta_i_rad.size(), b.theta_i_rad.size());
 }
 
 TEST(CaptureCamera, VignettingScalesByOneMinusStrengthRhoSquared) {
@@ -290,8 +310,8 @@ TEST(CaptureTruth, TabulatedBrightnessInterpolatesItsTable) {
     SurfaceTruth truth;
     truth.model = BrightnessModel::Tabulated;
     truth.tabulated = f;
-    const Capture c = render_capture(plane_scene(0.25 * 180.0 / kPi, 0.0, 0.0), {truth}, {},
-                                     noiseless_camera());
+    const Capture c =
+        render_capture(plane_scene(0.25 * 180.0 / kPi, 0.0, 0.0), {truth}, {}, noiseless_camera());
     EXPECT_NEAR(c.radiance[0], 1.5, 1e-6);
     table.values.pop_back();
     EXPECT_THROW(table_brightness(table), InvalidArgument);

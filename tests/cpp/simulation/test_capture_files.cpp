@@ -1,18 +1,17 @@
 // Capture files read back by independent decoders: libpng and libtiff give the written DN (and
 // the float TIFF the linear signal), and Debian's LibRaw decodes the DNG to the same linear DN
 // with the written black and white levels.
-#include <libraw/libraw.h>
-#include <png.h>
-#include <tiffio.h>
-
-#include <gtest/gtest.h>
-
 #include <cstddef>
 #include <cstdint>
 #include <cstdio>
 #include <filesystem>
 #include <string>
 #include <vector>
+
+#include <gtest/gtest.h>
+#include <libraw/libraw.h>
+#include <png.h>
+#include <tiffio.h>
 
 #include "../io/test_files.hpp"
 #include "roughscope/core/errors.hpp"
@@ -81,7 +80,8 @@ std::vector<T> read_tiff(const fs::path& path, std::uint16_t& bits, std::uint16_
     TIFFGetField(tif, TIFFTAG_BITSPERSAMPLE, &bits);
     TIFFGetFieldDefaulted(tif, TIFFTAG_SAMPLEFORMAT, &format);
     std::vector<T> out(std::size_t{w} * h);
-    for (std::uint32_t r = 0; r < h; ++r) TIFFReadScanline(tif, out.data() + std::size_t{r} * w, r, 0);
+    for (std::uint32_t r = 0; r < h; ++r)
+        TIFFReadScanline(tif, out.data() + std::size_t{r} * w, r, 0);
     TIFFClose(tif);
     return out;
 }
