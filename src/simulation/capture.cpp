@@ -83,28 +83,28 @@ std::uint64_t splitmix64(std::uint64_t x) {
 // The surface normal seen through image-plane point p (std::nullopt: the ray misses).
 std::optional<Eigen::Vector3d> surface_normal(SceneShape shape, const Eigen::Vector3d& p,
                                               const Eigen::Vector3d& view, double radius) {
+    // In units of the radius (q = p / R), so that no length under- or overflows.
     switch (shape) {
         case SceneShape::Plane:
             return Eigen::Vector3d::UnitZ();
         case SceneShape::Sphere: {
-            const double r2 = radius * radius - p.squaredNorm();
-            if (r2 < 0.0) return std::nullopt;
-            const Eigen::Vector3d hit = p + std::sqrt(r2) * view;
-            return hit.normalized();
+            const Eigen::Vector3d q = p / radius;
+            const double h2 = 1.0 - q.squaredNorm();
+            if (!(h2 >= 0.0)) return std::nullopt;
+            return (q + std::sqrt(h2) * view).normalized();
         }
         case SceneShape::Cylinder: {
-            // |p⊥ + t V⊥|² = R² with ⊥ = the components across the Y axis; the larger root is the
+            // |q⊥ + t V⊥|² = 1 with ⊥ = the components across the Y axis; the larger root is the
             // side facing the camera.
-            const Eigen::Vector3d p_perp(p.x(), 0.0, p.z());
+            const Eigen::Vector3d q_perp(p.x() / radius, 0.0, p.z() / radius);
             const Eigen::Vector3d v_perp(view.x(), 0.0, view.z());
             const double a = v_perp.squaredNorm();
-            const double b = 2.0 * p_perp.dot(v_perp);
-            const double c = p_perp.squaredNorm() - radius * radius;
+            const double b = 2.0 * q_perp.dot(v_perp);
+            const double c = q_perp.squaredNorm() - 1.0;
             const double disc = b * b - 4.0 * a * c;
-            if (disc < 0.0) return std::nullopt;
+            if (!(disc >= 0.0)) return std::nullopt;
             const double t = (-b + std::sqrt(disc)) / (2.0 * a);
-            const Eigen::Vector3d hit = p_perp + t * v_perp;
-            return hit.normalized();
+            return (q_perp + t * v_perp).normalized();
         }
     }
     return std::nullopt;
@@ -170,9 +170,20 @@ void check_scene(const Scene& scene) {
     if (scene.height < 1 || scene.height > 65535)
         throw InvalidArgument(concat("height = ", std::to_string(scene.height),
                                      " pixels is outside the valid range [1, 65535]"));
-    check::positive("pixel_size_um", scene.pixel_size_um, "um");
-    check::non_negative("radius_um", scene.radius_um, "um");
-    check::non_negative("background_radiance", scene.background_radiance);
+    if (scene.width * scene.height > kMaxCapturePixels)
+        throw InvalidArgument(concat("width x height = ", std::to_string(scene.width), " x ",
+                                     std::to_string(scene.height),
+                                     " pixels is more than the valid maximum of 2^28 pixels"));
+    if (!(scene.pixel_size_um >= 1e-9 && scene.pixel_size_um <= 1e12))
+        throw InvalidArgument(concat("pixel_size_um = ", number_text(scene.pixel_size_um),
+                                     " um is outside the valid range [1e-9, 1e12] um"));
+    if (!(scene.radius_um >= 0.0 && scene.radius_um <= 1e15))
+        throw InvalidArgument(concat("radius_um = ", number_text(scene.radius_um),
+                                     " um is outside the valid range [0, 1e15] um"));
+    if (!(scene.background_radiance >= 0.0 && scene.background_radiance <= 1e30))
+        throw InvalidArgument(concat("background_radiance = ",
+                                     number_text(scene.background_radiance),
+                                     " is outside the valid range [0, 1e30]"));
     check_unit("light", scene.light);
     check_unit("view", scene.view);
     if (scene.shape == SceneShape::Plane && scene.view.z() <= 1e-12)
@@ -426,7 +437,9 @@ Capture render_capture(const Scene& scene, const std::vector<SurfaceTruth>& trut
                         : 1.0;
                 const double mu_e = k_t * radiance * vignette;
                 double n_e = mu_e;
-                if (camera.shot_noise && mu_e > 0.0) {
+                if (!(mu_e <= 1e300)) {
+                    n_e = full_well;  // overflowed: saturated whatever the draw
+                } else if (camera.shot_noise && mu_e > 0.0) {
                     if (mu_e - full_well > 40.0 * std::sqrt(mu_e)) {
                         n_e = full_well;  // a draw below the full well has probability < 1e-300
                     } else {

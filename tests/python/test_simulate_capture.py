@@ -150,3 +150,14 @@ def test_out_is_a_file_fails(tmp_path):
     line = fails(EXIT_DATA, "--out", target)
     assert "not a directory" in line
     assert target.read_text() == "keep"
+
+
+def test_numeric_flags_at_the_extremes(tmp_path):
+    """Every numeric flag of `simulate capture` at the extremes of the double range: exit 0 or 2
+    (naming the flag), never 1, no NaN (test_extreme_flags.sweep)."""
+    from test_extreme_flags import sweep
+    assert sweep(["simulate", "capture"], [
+        ["--width", "16", "--height", "12", "--out", str(tmp_path / "a")],
+        ["--scene", "sphere", "--width", "15", "--height", "11", "--model",
+         "mean_scattered_power", "--format", "dng", "--out", str(tmp_path / "b")],
+    ]) >= 40

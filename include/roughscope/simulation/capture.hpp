@@ -59,16 +59,19 @@ SceneShape parse_scene_shape(std::string_view name);
 // cos θ). The paper's light is at φ = π: direction_from_angles(θi, π) = light_direction(θi...).
 Eigen::Vector3d direction_from_angles(double theta_rad, double phi_rad);
 
+// The largest image rendered (width × height): 2^28 pixels (≈ 268 MP).
+inline constexpr std::size_t kMaxCapturePixels = std::size_t{1} << 28;
+
 struct Scene {
     SceneShape shape = SceneShape::Plane;
     std::size_t width = 256;      // pixels, 1..65535
     std::size_t height = 256;     // pixels, 1..65535
-    double pixel_size_um = 10.0;  // object-space side of one pixel, µm (> 0)
-    // Sphere and cylinder radius, µm; 0 = 0.4 · min(width, height) · pixel_size_um.
+    double pixel_size_um = 10.0;  // object-space side of one pixel, µm, [1e-9, 1e12]
+    // Sphere and cylinder radius, µm, [0, 1e15]; 0 = 0.4 · min(width, height) · pixel_size_um.
     double radius_um = 0.0;
     Eigen::Vector3d light = direction_from_angles(deg_to_rad(30.0), kPi);  // L, unit
     Eigen::Vector3d view = Eigen::Vector3d(0.0, 0.0, 1.0);                 // V, unit
-    double background_radiance = 0.0;  // brightness of pixels that miss the object (≥ 0)
+    double background_radiance = 0.0;  // brightness of pixels that miss the object, [0, 1e30]
 };
 
 // The orthographic camera's image axes for view direction V (see "Frame" above).
