@@ -181,9 +181,9 @@ void check_scene(const Scene& scene) {
         throw InvalidArgument(concat("radius_um = ", number_text(scene.radius_um),
                                      " um is outside the valid range [0, 1e15] um"));
     if (!(scene.background_radiance >= 0.0 && scene.background_radiance <= 1e30))
-        throw InvalidArgument(concat("background_radiance = ",
-                                     number_text(scene.background_radiance),
-                                     " is outside the valid range [0, 1e30]"));
+        throw InvalidArgument(
+            concat("background_radiance = ", number_text(scene.background_radiance),
+                   " is outside the valid range [0, 1e30]"));
     check_unit("light", scene.light);
     check_unit("view", scene.view);
     if (scene.shape == SceneShape::Plane && scene.view.z() <= 1e-12)
