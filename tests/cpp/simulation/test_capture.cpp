@@ -192,6 +192,46 @@ TEST(CaptureCamera, SaturationMaskIsExactlyWhereClipped) {
     }
 }
 
+TEST(CaptureCamera, OverexposureSaturatesAtTheFullWellWithShotNoise) {
+    Scene scene = plane_scene(10.0, 0.0, 0.0);
+    SurfaceTruth truth;
+    truth.model = BrightnessModel::Lambert;
+    CameraModel camera;
+    camera.read_noise_e = 0.0;
+    camera.bit_depth = 16;
+    camera.full_well_e = 50000.0;
+    camera.gain_dn_per_e = 0.5;
+    camera.black_level_dn = 10.0;
+    for (double exposure_s : {3.0, 1e300}) {  // μe ≈ 6e4 (Poisson draws) and overflowing
+        camera.exposure_s = exposure_s;
+        const Capture c = render_capture(scene, {truth}, {}, camera);
+        std::size_t at_full_well = 0;
+        for (std::size_t i = 0; i < c.dn.size(); ++i) {
+            ASSERT_EQ(c.saturated[i], 1) << i;
+            at_full_well += c.dn[i] == 25010 ? 1 : 0;
+        }
+        EXPECT_EQ(at_full_well, c.dn.size());  // P(Poisson(5.9e4) < 5e4) < 1e-100
+        EXPECT_EQ(c.saturated_count, c.dn.size());
+    }
+}
+
+TEST(CaptureScene, MeanScatteredPowerModelIsEquationOne) {
+    const Scene scene = plane_scene(40.0, 25.0, 30.0);
+    SurfaceTruth truth;
+    truth.model = BrightnessModel::MeanScatteredPower;
+    truth.sigma_um = 0.08;
+    truth.T_um = 1.5;
+    truth.correlation = Correlation::Exponential;
+    const Capture c = render_capture(scene, {truth}, {}, noiseless_camera());
+    ModelOptions options;  // the truth's defaults: VH factor, radiance
+    const double expected =
+        mean_scattered_power(make_geometry(deg_to_rad(40.0), deg_to_rad(25.0), deg_to_rad(30.0)),
+                             {0.08, 1.5, Correlation::Exponential}, options)
+            .brightness;
+    EXPECT_FLOAT_EQ(c.radiance[0], static_cast<float>(expected));
+    EXPECT_NEAR(c.phi_s_rad[0], deg_to_rad(30.0), 1e-6);
+}
+
 TEST(CaptureCamera, SrgbMatchesIec61966Values) {
     // IEC 61966-2-1 values: the linear segment, the joint, middle grey and half intensity.
     EXPECT_NEAR(srgb_encode(0.001), 0.01292, 1e-12);
