@@ -80,6 +80,58 @@ std::uint64_t splitmix64(std::uint64_t x) {
     return x ^ (x >> 31);
 }
 
+// Exact Poisson sampling by inversion for a mean that repeats along a row (a plane, the
+// background, flat regions): the probabilities p(k) = e^{−μ} μ^k / k! on
+// [μ − 13√μ − 1, μ + 13√μ + 1] (outside it the mass is < 1e−37) by the recurrence
+// p(k+1) = p(k) μ/(k+1) from lgamma at the first k, their cumulative sum normalised, and a guide
+// table for the search (docs/simulation-captures.md, "Camera").
+class PoissonTable {
+  public:
+    static constexpr double kMinMean = 10.0;  // below: Boost's inversion is as fast
+    static constexpr double kMaxMean = 1e7;   // above: the table would be large
+
+    double mean() const { return mean_; }
+
+    void build(double mu) {
+        mean_ = mu;
+        const double spread = 13.0 * std::sqrt(mu) + 1.0;
+        first_ = static_cast<std::int64_t>(std::max(0.0, std::floor(mu - spread)));
+        const auto last = static_cast<std::int64_t>(std::ceil(mu + spread));
+        cdf_.resize(static_cast<std::size_t>(last - first_ + 1));
+        const auto k0 = static_cast<double>(first_);
+        double p = std::exp(k0 * std::log(mu) - mu - std::lgamma(k0 + 1.0));
+        double sum = 0.0;
+        for (std::size_t j = 0; j < cdf_.size(); ++j) {
+            sum += p;
+            cdf_[j] = sum;
+            p *= mu / (k0 + static_cast<double>(j) + 1.0);
+        }
+        for (double& c : cdf_) c /= sum;
+        cdf_.back() = 1.0;
+        guide_.resize(cdf_.size());
+        std::size_t j = 0;
+        for (std::size_t g = 0; g < guide_.size(); ++g) {
+            const double u = static_cast<double>(g) / static_cast<double>(guide_.size());
+            while (cdf_[j] < u) ++j;
+            guide_[g] = static_cast<std::uint32_t>(j);
+        }
+    }
+
+    template <class Engine>
+    std::int64_t operator()(Engine& engine) const {
+        const double u = static_cast<double>(engine() >> 11) * 0x1.0p-53;  // [0, 1)
+        std::size_t j = guide_[static_cast<std::size_t>(u * static_cast<double>(guide_.size()))];
+        while (cdf_[j] <= u) ++j;
+        return first_ + static_cast<std::int64_t>(j);
+    }
+
+  private:
+    double mean_ = -1.0;
+    std::int64_t first_ = 0;
+    std::vector<double> cdf_;
+    std::vector<std::uint32_t> guide_;
+};
+
 // The surface normal seen through image-plane point p (std::nullopt: the ray misses).
 std::optional<Eigen::Vector3d> surface_normal(SceneShape shape, const Eigen::Vector3d& p,
                                               const Eigen::Vector3d& view, double radius) {
@@ -397,10 +449,12 @@ Capture render_capture(const Scene& scene, const std::vector<SurfaceTruth>& trut
         double last_brightness = 0.0;
         std::optional<Geometry> last_geometry;
         boost::random::poisson_distribution<std::int64_t, double> shot(1.0);
+        PoissonTable table;
 
         for (std::size_t row = row_begin; row < row_end; ++row) {
             boost::random::mt19937_64 engine(splitmix64(camera.seed ^ splitmix64(row)));
             boost::random::normal_distribution<double> read_noise(0.0, 1.0);
+            double previous_mu = -1.0;
             const double y_img = (half_h - static_cast<double>(row) - 0.5) * s;
             const double dy = static_cast<double>(row) + 0.5 - half_h;
             for (std::size_t col = 0; col < W; ++col) {
@@ -443,11 +497,23 @@ Capture render_capture(const Scene& scene, const std::vector<SurfaceTruth>& trut
                     if (mu_e - full_well > 40.0 * std::sqrt(mu_e)) {
                         n_e = full_well;  // a draw below the full well has probability < 1e-300
                     } else {
-                        if (shot.mean() != mu_e)
-                            shot = boost::random::poisson_distribution<std::int64_t, double>(mu_e);
-                        n_e = static_cast<double>(shot(engine));
+                        // The same mean as the previous pixel of this row: the inversion table
+                        // (exact; the rule depends on the row alone, so threads do not matter).
+                        const bool repeated = mu_e == previous_mu &&
+                                              mu_e >= PoissonTable::kMinMean &&
+                                              mu_e <= PoissonTable::kMaxMean;
+                        if (repeated) {
+                            if (table.mean() != mu_e) table.build(mu_e);
+                            n_e = static_cast<double>(table(engine));
+                        } else {
+                            if (shot.mean() != mu_e)
+                                shot =
+                                    boost::random::poisson_distribution<std::int64_t, double>(mu_e);
+                            n_e = static_cast<double>(shot(engine));
+                        }
                     }
                 }
+                previous_mu = mu_e;
                 bool saturated = false;
                 if (n_e >= full_well) {
                     n_e = full_well;

@@ -151,6 +151,38 @@ TEST(CaptureCamera, FlatFieldFollowsPhotonTransfer) {
                 4.0 * expected_var * std::sqrt(2.0 / n));
 }
 
+TEST(CaptureCamera, FlatFieldCountsFollowThePoissonLaw) {
+    // Gain 1 e/DN, no read noise, no black level: the DN are the photo-electron counts of a
+    // repeated mean (the inversion-table path) and of varying means (Boost's PTRD path).
+    for (const bool vignetted : {false, true}) {
+        Scene scene = plane_scene(0.0, 0.0, 0.0);
+        scene.width = 400;
+        scene.height = 250;
+        SurfaceTruth truth;
+        truth.model = BrightnessModel::Lambert;
+        CameraModel camera;
+        camera.electrons_per_unit_s = 30.0;
+        camera.gain_dn_per_e = 1.0;
+        camera.read_noise_e = 0.0;
+        camera.black_level_dn = 0.0;
+        camera.bit_depth = 16;
+        camera.vignetting = vignetted ? 1e-9 : 0.0;  // distinct means, the same law (to 1e-9)
+        const Capture c = render_capture(scene, {truth}, {}, camera);
+        std::vector<double> counts(200, 0.0);
+        for (std::uint16_t v : c.dn) counts[std::min<std::size_t>(v, 199)] += 1.0;
+        // χ² over the bins 15..45 (expected ≥ 150 each) against N e^{−30} 30^k / k!.
+        const auto n = static_cast<double>(c.dn.size());
+        double chi2 = 0.0;
+        for (int k = 15; k <= 45; ++k) {
+            const double expected = n * std::exp(k * std::log(30.0) - 30.0 - std::lgamma(k + 1.0));
+            chi2 += (counts[static_cast<std::size_t>(k)] - expected) *
+                    (counts[static_cast<std::size_t>(k)] - expected) / expected;
+        }
+        // 31 bins: χ² has mean 31 and standard deviation ≈ 7.9; 31 + 5·7.9 ≈ 70.
+        EXPECT_LT(chi2, 70.0) << (vignetted ? "PTRD path" : "table path");
+    }
+}
+
 TEST(CaptureCamera, SaturationMaskIsExactlyWhereClipped) {
     Scene scene;
     scene.shape = SceneShape::Sphere;
