@@ -116,6 +116,16 @@ TEST(CaptureScene, CylinderIsConstantAlongItsAxis) {
         if (col > 0 && c.radiance[col] != c.radiance[col - 1]) ++varying_columns;
     }
     EXPECT_GT(varying_columns, 20U);  // but it varies across the axis
+    // Seen along Z, the normal at image x is (x/R, 0, √(1 − x²/R²)).
+    scene.view = Eigen::Vector3d::UnitZ();
+    const Capture top = render_capture(scene, {truth}, {}, noiseless_camera());
+    const double R = scene_radius_um(scene);
+    for (std::size_t col = 20; col < 44; ++col) {
+        const double x = (static_cast<double>(col) + 0.5 - 32.0) * scene.pixel_size_um;
+        EXPECT_NEAR(top.normal[3 * (5 * 64 + col)], x / R, 1e-6);
+        EXPECT_NEAR(top.normal[3 * (5 * 64 + col) + 1], 0.0, 1e-6);
+        EXPECT_NEAR(top.normal[3 * (5 * 64 + col) + 2], std::sqrt(1.0 - x * x / (R * R)), 1e-6);
+    }
     // Background at the sides: radius 0.4 · 40 · 10 µm = 160 µm = 16 pixels of 64.
     EXPECT_EQ(c.label[0], -1);
     EXPECT_EQ(c.label[32], 0);

@@ -117,12 +117,12 @@ TEST(CaptureFiles, TiffReadsBackTheDnAndFloatTiffTheLinearSignal) {
 }
 
 TEST(CaptureFiles, LibRawDecodesTheDngToTheWrittenLinearDn) {
-    for (int bits : {12, 14, 16}) {
+    for (int bits : {8, 12, 14, 16}) {
         SCOPED_TRACE(bits);
         const Capture c = noisy_sphere(bits, 11);
         CameraModel camera;
         camera.bit_depth = bits;
-        camera.black_level_dn = 64.0;
+        camera.black_level_dn = bits == 8 ? 4.0 : 64.0;
         const fs::path path =
             write(encode_capture_dng(c, camera), concat("c", std::to_string(bits), ".dng"));
         LibRaw raw;
@@ -133,7 +133,7 @@ TEST(CaptureFiles, LibRawDecodesTheDngToTheWrittenLinearDn) {
         EXPECT_TRUE(raw.imgdata.idata.dng_version != 0);
         EXPECT_EQ(raw.imgdata.color.maximum, static_cast<unsigned>(camera.white_level_dn()));
         const unsigned black = raw.imgdata.color.black + raw.imgdata.color.cblack[0];
-        EXPECT_EQ(black, 64U);
+        EXPECT_EQ(black, static_cast<unsigned>(camera.black_level_dn));
         // LibRaw 0.20 unpacks a 3-sample LinearRaw image to color4_image (4 samples a pixel, the
         // 4th unused; values as stored, the black level not subtracted).
         EXPECT_EQ(raw.imgdata.idata.colors, 3);
