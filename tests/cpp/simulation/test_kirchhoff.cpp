@@ -2,19 +2,20 @@
 // the tilted plate in closed form (Dirichlet kernels), the FFT lattice against direct summation,
 // and the ensemble against the exact series (Eq. 2 and the exact exponential series) and the
 // coherent term e^{−g} (Eq. 1) within their standard errors.
+#include "roughscope/simulation/kirchhoff.hpp"
+
+#include <gtest/gtest.h>
+
 #include <cmath>
 #include <complex>
 #include <cstddef>
 #include <string>
 #include <vector>
 
-#include <gtest/gtest.h>
-
 #include "roughscope/core/errors.hpp"
 #include "roughscope/scattering/beckmann.hpp"
 #include "roughscope/scattering/factors.hpp"
 #include "roughscope/scattering/geometry.hpp"
-#include "roughscope/simulation/kirchhoff.hpp"
 #include "roughscope/surface/generate.hpp"
 #include "roughscope/surface/height_map.hpp"
 
@@ -146,18 +147,18 @@ TEST(KirchhoffEnsemble, DiffusePowerAgreesWithTheExactSeries) {
     ASSERT_GE(cases.size(), 30U);
     double max_g = 0.0, max_T_vxy = 0.0, min_g = 1e300;
     for (const Case& c : cases) {
-        const ScatterResult r =
-            simulate_scattering(make_geometry(deg_to_rad(c.theta_i_deg), deg_to_rad(c.theta_s_deg),
-                                              deg_to_rad(c.phi_s_deg)),
-                                options_for(c, 150));
+        const ScatterResult r = simulate_scattering(
+            make_geometry(deg_to_rad(c.theta_i_deg), deg_to_rad(c.theta_s_deg),
+                          deg_to_rad(c.phi_s_deg)),
+            options_for(c, 150));
         max_g = std::max(max_g, r.g);
         min_g = std::min(min_g, r.g);
         max_T_vxy = std::max(max_T_vxy, r.T_vxy);
-        const std::string where = std::string(to_string(c.correlation)) + " at " +
-                                  std::to_string(c.theta_i_deg) + "/" +
-                                  std::to_string(c.theta_s_deg) + "/" +
-                                  std::to_string(c.phi_s_deg) + " g=" + std::to_string(r.g) +
-                                  " T*vxy=" + std::to_string(r.T_vxy) + " n=" + std::to_string(r.n);
+        const std::string where =
+            std::string(to_string(c.correlation)) + " at " + std::to_string(c.theta_i_deg) + "/" +
+            std::to_string(c.theta_s_deg) + "/" + std::to_string(c.phi_s_deg) + " g=" +
+            std::to_string(r.g) + " T*vxy=" + std::to_string(r.T_vxy) + " n=" +
+            std::to_string(r.n);
         ASSERT_GT(r.diffuse_stderr, 0.0) << where;
         EXPECT_LE(std::abs(r.diffuse - r.series_diffuse), 3.0 * r.diffuse_stderr)
             << where << ": simulated " << r.diffuse << " +- " << r.diffuse_stderr << ", series "
@@ -195,10 +196,10 @@ TEST(KirchhoffEnsemble, ExponentialAtLargeGFollowsTheSeriesNotEq5) {
     const ScatterResult r = simulate_scattering(geom, options_for(c, 100));
     ASSERT_GE(r.g, 20.0);
     const ScatteringVector v = scattering_vector(geom, 0.5);
-    const double eq5 =
-        diffuse_power_very_rough_exponential(r.F2, 0.2, 1.0, r.area_um2, v.vz * v.vz, v.vxy2());
-    const double limit =
-        diffuse_power_very_rough_exponential_series_limit(r.F2, 1.0, r.area_um2, r.g, v.vxy2());
+    const double eq5 = diffuse_power_very_rough_exponential(r.F2, 0.2, 1.0, r.area_um2,
+                                                            v.vz * v.vz, v.vxy2());
+    const double limit = diffuse_power_very_rough_exponential_series_limit(r.F2, 1.0, r.area_um2,
+                                                                           r.g, v.vxy2());
     EXPECT_LE(std::abs(r.diffuse - limit), 3.0 * r.diffuse_stderr + 0.1 * limit);
     EXPECT_LT(r.diffuse, 0.2 * eq5);
 }
@@ -224,9 +225,9 @@ TEST(KirchhoffEnsemble, LatticeAlignedPutsTheDirectionOnTheLattice) {
     const ScatterResult r = simulate_scattering(geom, options_for(c, 4));
     ASSERT_GT(r.lattice_index, 0);
     const double w = std::sqrt(scattering_vector(geom, 0.5).vxy2());
-    EXPECT_NEAR(
-        2.0 * kPi * static_cast<double>(r.lattice_index) / (static_cast<double>(r.n) * r.dx_um), w,
-        1e-12 * w);
+    EXPECT_NEAR(2.0 * kPi * static_cast<double>(r.lattice_index) /
+                    (static_cast<double>(r.n) * r.dx_um),
+                w, 1e-12 * w);
     EXPECT_EQ(r.series_coherent, 0.0);
 }
 
