@@ -77,12 +77,22 @@ Request request_from(const py::kwargs& kw) {
         if (capture_keys().count(key) == 0)
             throw py::type_error(concat("unexpected keyword argument '", key, "'"));
     }
-    auto has = [&kw](const char* k) { return kw.contains(k) && !kw[k].is_none(); };
+    // A number given as None is a TypeError (real_scalar, integer_scalar); None means "not
+    // given" only for labels and brightness.
+    auto has = [&kw](const char* k) { return kw.contains(k); };
+    auto has_object = [&kw](const char* k) { return kw.contains(k) && !kw[k].is_none(); };
     auto real = [&](const char* k, double fallback) {
         return has(k) ? real_scalar(k, kw[k]) : fallback;
     };
     auto text = [&](const char* k, const char* fallback) {
-        return has(k) ? kw[k].cast<std::string>() : std::string(fallback);
+        if (!has(k)) return std::string(fallback);
+        if (!py::isinstance<py::str>(kw[k])) throw py::type_error(concat(k, " must be a str"));
+        return kw[k].cast<std::string>();
+    };
+    auto flag = [&](const char* k, bool fallback) {
+        if (!has(k)) return fallback;
+        if (!py::isinstance<py::bool_>(kw[k])) throw py::type_error(concat(k, " must be a bool"));
+        return kw[k].cast<bool>();
     };
     Request r;
     simulation::Scene& s = r.record.scene;
@@ -117,7 +127,7 @@ Request request_from(const py::kwargs& kw) {
     truth.model_options.wavelength_um = real("wavelength_um", 0.555);
     truth.oren_nayar.sigma_rad = deg_to_rad(real("oren_nayar_sigma_deg", 20.0));
     truth.lafortune_n = real("lafortune_n", 1.0);
-    if (has("brightness")) {
+    if (has_object("brightness")) {
         py::object f = kw["brightness"];
         if (!PyCallable_Check(f.ptr()))
             throw py::type_error(
@@ -145,7 +155,7 @@ Request request_from(const py::kwargs& kw) {
         t.sigma_um = ratio * truth.T_um;
         r.record.truths.push_back(t);
     }
-    if (has("labels")) {
+    if (has_object("labels")) {
         auto labels = py::array_t<std::int32_t, py::array::c_style | py::array::forcecast>::ensure(
             kw["labels"]);
         if (!labels || labels.ndim() != 2 ||
@@ -173,14 +183,14 @@ Request request_from(const py::kwargs& kw) {
     c.response = simulation::parse_response(text("response", "linear"));
     c.gamma = real("gamma", c.gamma);
     c.vignetting = real("vignetting", c.vignetting);
-    c.shot_noise = has("shot_noise") ? kw["shot_noise"].cast<bool>() : true;
+    c.shot_noise = flag("shot_noise", true);
     if (has("seed")) {
         const long long seed = integer_scalar("seed", kw["seed"]);
         if (seed < 0)
             throw InvalidArgument(concat("seed = ", std::to_string(seed), " must be >= 0"));
         c.seed = static_cast<std::uint64_t>(seed);
     }
-    r.options.keep_geometry = has("keep_geometry") ? kw["keep_geometry"].cast<bool>() : true;
+    r.options.keep_geometry = flag("keep_geometry", true);
     return r;
 }
 
