@@ -238,4 +238,5 @@ PYBIND11_MODULE(_core, m) {
     roughscope::python::bind_curet(m);
     roughscope::python::bind_surface(m);
     roughscope::python::bind_simulation(m);
+    roughscope::python::bind_capture(m);
 }
