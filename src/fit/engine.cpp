@@ -493,6 +493,9 @@ struct Run {
     int iterations = 0;              // over every solve
 };
 
+// From this many residuals on, the trust-region steps use the normal equations (solve_from).
+constexpr std::size_t kNormalEquationsResiduals = 100000;
+
 // Whether the optimised variable j sits on one of its bounds.
 bool on_bound(const Evaluator& e, int j, double u) {
     const double tol = 1e-9 * std::max(1.0, std::abs(u));
@@ -514,7 +517,12 @@ Run solve_from(const Evaluator& e, const LeastSquaresOptions& O, std::vector<dou
         if (std::isfinite(e.upper(j))) problem.SetParameterUpperBound(run.x.data(), j, e.upper(j));
     }
     ceres::Solver::Options so;
-    so.linear_solver_type = ceres::DENSE_QR;
+    // Dense QR of the N × p Jacobian for the step, except for very long data: there Ceres's QR
+    // keeps two more N × p copies and the Householder workspaces (~40 bytes per residual), so the
+    // step comes from the p × p normal equations instead (p ≤ a few, well conditioned after the
+    // parameter scaling). The rank test and the covariance always use our own QR (below).
+    so.linear_solver_type =
+        e.size() >= kNormalEquationsResiduals ? ceres::DENSE_NORMAL_CHOLESKY : ceres::DENSE_QR;
     so.trust_region_strategy_type = ceres::LEVENBERG_MARQUARDT;
     so.max_num_iterations = O.max_iterations;
     so.function_tolerance = O.function_tolerance;
