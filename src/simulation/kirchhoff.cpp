@@ -449,6 +449,18 @@ ScatterGrid choose_scatter_grid(const Geometry& geom, const ScatterOptions& o) {
     return grid;
 }
 
+std::vector<ScatterPlanSummary> check_scattering_run(const std::vector<Geometry>& geometries,
+                                                     const ScatterOptions& o) {
+    check_scatter_options(o);
+    std::vector<ScatterPlanSummary> out;
+    out.reserve(geometries.size());
+    for (const Geometry& geom : geometries) {
+        const Plan p = make_plan(geom, o);
+        out.push_back({p.n, p.dx_um, p.generated_n, p.layout, p.m});
+    }
+    return out;
+}
+
 std::vector<ScatterResult> simulate_scattering(const std::vector<Geometry>& geometries,
                                                const ScatterOptions& o,
                                                const ProgressCallback& progress) {

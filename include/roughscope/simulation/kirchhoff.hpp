@@ -142,6 +142,25 @@ struct ScatterGrid {
 };
 ScatterGrid choose_scatter_grid(const Geometry& geom, const ScatterOptions& options);
 
+// The grid simulate_scattering will use at one geometry (the fields of ScatterResult of the same
+// names) and the side of the surface it generates per realisation (n, or 2n for the fixed
+// layout): the work of a realisation grows like generated_n² log generated_n.
+struct ScatterPlanSummary {
+    std::size_t n = 0;
+    double dx_um = 0.0;
+    std::size_t generated_n = 0;
+    PatchLayout layout = PatchLayout::LatticeAligned;
+    long lattice_index = 0;
+};
+
+// Everything simulate_scattering validates before the first realisation, without generating a
+// surface: the options (check_scatter_options), each geometry (check::geometry) and the grid
+// chosen or given there (n ≤ 4096, dx below the Nyquist limit π/|v_xy|, n·dx ≥ T). Throws the
+// same InvalidArgument simulate_scattering would; a run that passes it fails only on memory or
+// interruption. Returns the grid of each geometry. Cheap (no surface, no FFT).
+std::vector<ScatterPlanSummary> check_scattering_run(const std::vector<Geometry>& geometries,
+                                                     const ScatterOptions& options);
+
 // The ensemble at each geometry (validated as by check::geometry).
 std::vector<ScatterResult> simulate_scattering(const std::vector<Geometry>& geometries,
                                                const ScatterOptions& options,

@@ -318,5 +318,57 @@ TEST(KirchhoffEnsemble, InvalidOptionsNameTheOptionAndRange) {
     EXPECT_NE(message(o).find("4096"), std::string::npos) << message(o);
 }
 
+TEST(KirchhoffEnsemble, CheckScatteringRunRaisesWhatTheRunRaisesWithoutRunning) {
+    const Geometry normal = normal_view_geometry(deg_to_rad(30.0));
+    const Geometry oblique = make_geometry(deg_to_rad(60.0), deg_to_rad(60.0), deg_to_rad(180.0));
+    const auto message = [](auto&& call) {
+        try {
+            call();
+        } catch (const InvalidArgument& e) {
+            return std::string(e.what());
+        }
+        return std::string("no error");
+    };
+    std::vector<ScatterOptions> bad(6);
+    bad[0].realisations = 1;
+    bad[1].n = 5;
+    bad[2].sigma_um = -1.0;
+    bad[3].n = 16;
+    bad[3].dx_um = 0.01;  // patch shorter than T
+    bad[4].dx_um = 2.0;   // |v_xy| beyond π/dx at the oblique geometry only
+    bad[5].correlation = Correlation::Exponential;
+    bad[5].sigma_um = 30.0;  // grid beyond 4096 points per side
+    for (std::size_t i = 0; i < bad.size(); ++i) {
+        const std::vector<Geometry> geoms{normal, oblique};
+        const std::string checked = message([&] { check_scattering_run(geoms, bad[i]); });
+        const std::string run = message([&] { simulate_scattering(geoms, bad[i]); });
+        EXPECT_NE(checked, "no error") << "case " << i;
+        EXPECT_EQ(checked, run) << "case " << i;
+    }
+    // A bad geometry (θi beyond 90°) is refused as check::geometry does.
+    ScatterOptions good;
+    good.realisations = 2;
+    Geometry beyond = normal;
+    beyond.theta_i_rad = deg_to_rad(95.0);
+    const std::string checked = message([&] { check_scattering_run({normal, beyond}, good); });
+    EXPECT_EQ(checked, message([&] { simulate_scattering({normal, beyond}, good); }));
+    EXPECT_NE(checked, "no error");
+    // What runs passes, and the grid announced is the grid simulated.
+    for (const PatchLayout layout : {PatchLayout::LatticeAligned, PatchLayout::Fixed}) {
+        good.layout = layout;
+        const std::vector<ScatterPlanSummary> plans = check_scattering_run({normal, oblique}, good);
+        const std::vector<ScatterResult> results = simulate_scattering({normal, oblique}, good);
+        ASSERT_EQ(plans.size(), 2U);
+        for (std::size_t k = 0; k < 2; ++k) {
+            EXPECT_EQ(plans[k].n, results[k].n);
+            EXPECT_EQ(plans[k].dx_um, results[k].dx_um);
+            EXPECT_EQ(plans[k].layout, results[k].layout);
+            EXPECT_EQ(plans[k].lattice_index, results[k].lattice_index);
+            EXPECT_EQ(plans[k].generated_n,
+                      layout == PatchLayout::Fixed ? 2 * results[k].n : results[k].n);
+        }
+    }
+}
+
 }  // namespace
 }  // namespace roughscope::simulation
