@@ -3,12 +3,12 @@
 //
 // simulate_scatter returns the serializer's document (serialize/simulation.hpp), the same as
 // `roughscope simulate scatter --json`; its options are keyword arguments checked like every
-// numeric argument of the module (TypeError naming a non-real value). The run releases the GIL; Ctrl-C (KeyboardInterrupt) and
-// the optional progress callback are served between realisations, and an exception from either
-// stops the run.
+// numeric argument of the module (TypeError naming a non-real value). The run releases the GIL;
+// Ctrl-C (KeyboardInterrupt) and the optional progress callback are served between realisations,
+// and an exception from either stops the run.
 #include <complex>
-#include <cstdint>
 #include <cstddef>
+#include <cstdint>
 #include <cstring>
 #include <string>
 #include <vector>
@@ -65,6 +65,68 @@ std::size_t non_negative_count(const char* name, py::handle value, std::size_t a
     return static_cast<std::size_t>(v);
 }
 
+// A seed: an integer in [0, 2^64 − 1] (TypeError for a non-integer, InvalidArgument outside).
+// (integer_scalar's long long would refuse the upper half of the range.)
+std::uint64_t seed_from(py::handle value) {
+    const py::module_ np = py::module_::import("numpy");
+    // (NumPy's timedelta64 derives from its signedinteger: not an integer here.)
+    const bool integer =
+        !PyBool_Check(value.ptr()) &&
+        (PyLong_Check(value.ptr()) || (py::isinstance(value, np.attr("integer")) &&
+                                       !py::isinstance(value, np.attr("timedelta64"))));
+    if (!integer) {
+        throw py::type_error(concat(
+            "seed must be an integer (int or a NumPy integer), not ",
+            value.is_none() ? std::string("None")
+                            : py::str(py::type::of(value).attr("__name__")).cast<std::string>()));
+    }
+    const py::int_ v(py::reinterpret_borrow<py::object>(value));
+    const unsigned long long s = PyLong_AsUnsignedLongLong(v.ptr());
+    if (PyErr_Occurred() != nullptr) {
+        PyErr_Clear();
+        throw InvalidArgument(concat("seed = ", py::str(py::handle(v)).cast<std::string>(),
+                                     " is out of range: it must be an integer in [0, 2^64 - 1]"));
+    }
+    return static_cast<std::uint64_t>(s);
+}
+
+// The options of simulate_scatter and check_simulate_scatter (the same keyword arguments),
+// validated by check_scatter_options.
+simulation::ScatterOptions scatter_options(py::handle sigma_um, py::handle T_um,
+                                           const std::string& correlation, py::handle wavelength_um,
+                                           const std::string& factor, py::handle n,
+                                           py::handle dx_um, py::handle patch_over_T,
+                                           py::handle realisations, py::handle seed,
+                                           const std::string& layout, py::handle threads,
+                                           const py::object& progress) {
+    if (!progress.is_none() && PyCallable_Check(progress.ptr()) == 0)
+        throw py::type_error("progress must be a callable (done, total) or None");
+    simulation::ScatterOptions o;
+    o.correlation = parse_correlation(normalize_name(correlation));
+    o.sigma_um = real_scalar("sigma_um", sigma_um);
+    o.T_um = real_scalar("T_um", T_um);
+    o.wavelength_um = real_scalar("wavelength_um", wavelength_um);
+    o.factor = parse_geometric_factor(normalize_name(factor));
+    o.n = non_negative_count("n", n, 0);
+    o.dx_um = optional_real("dx_um", dx_um).value_or(0.0);
+    o.patch_over_T = optional_real("patch_over_T", patch_over_T).value_or(0.0);
+    const long long r = integer_scalar("realisations", realisations);
+    if (r < 2 || r > 10'000'000)
+        throw InvalidArgument(concat("realisations = ", std::to_string(r),
+                                     " is out of range: it must be in [2, 1e7]"));
+    o.realisations = static_cast<std::size_t>(r);
+    o.seed = seed_from(seed);
+    o.layout = simulation::parse_patch_layout(normalize_name(layout));
+    const long long t = integer_scalar("threads", threads);
+    if (t < 0 || t > 1024)
+        throw InvalidArgument(concat("threads = ", std::to_string(t),
+                                     " is out of range: it must be in [0, 1024] (0 = all "
+                                     "cores)"));
+    o.threads = static_cast<unsigned>(t);
+    simulation::check_scatter_options(o);
+    return o;
+}
+
 }  // namespace
 
 void bind_simulation(py::module_& m) {
@@ -76,35 +138,11 @@ void bind_simulation(py::module_& m) {
            py::handle wavelength_um, const std::string& factor, py::handle n, py::handle dx_um,
            py::handle patch_over_T, py::handle realisations, py::handle seed,
            const std::string& layout, py::handle threads, const py::object& progress) {
-            if (!progress.is_none() && PyCallable_Check(progress.ptr()) == 0)
-                throw py::type_error("progress must be a callable (done, total) or None");
+            const simulation::ScatterOptions o =
+                scatter_options(sigma_um, T_um, correlation, wavelength_um, factor, n, dx_um,
+                                patch_over_T, realisations, seed, layout, threads, progress);
             const std::vector<Geometry> geoms =
                 broadcast_geometries(theta_i_deg, theta_s_deg, phi_s_deg);
-            simulation::ScatterOptions o;
-            o.correlation = parse_correlation(normalize_name(correlation));
-            o.sigma_um = real_scalar("sigma_um", sigma_um);
-            o.T_um = real_scalar("T_um", T_um);
-            o.wavelength_um = real_scalar("wavelength_um", wavelength_um);
-            o.factor = parse_geometric_factor(normalize_name(factor));
-            o.n = non_negative_count("n", n, 0);
-            o.dx_um = optional_real("dx_um", dx_um).value_or(0.0);
-            o.patch_over_T = optional_real("patch_over_T", patch_over_T).value_or(0.0);
-            const long long r = integer_scalar("realisations", realisations);
-            if (r < 2 || r > 10'000'000)
-                throw InvalidArgument(concat("realisations = ", std::to_string(r),
-                                             " is out of range: it must be in [2, 1e7]"));
-            o.realisations = static_cast<std::size_t>(r);
-            const long long s = integer_scalar("seed", seed);
-            if (s < 0) throw InvalidArgument(concat("seed = ", std::to_string(s), " must be >= 0"));
-            o.seed = static_cast<std::uint64_t>(s);
-            o.layout = simulation::parse_patch_layout(normalize_name(layout));
-            const long long t = integer_scalar("threads", threads);
-            if (t < 0 || t > 1024)
-                throw InvalidArgument(concat("threads = ", std::to_string(t),
-                                             " is out of range: it must be in [0, 1024] (0 = all "
-                                             "cores)"));
-            o.threads = static_cast<unsigned>(t);
-            simulation::check_scatter_options(o);
             std::vector<simulation::ScatterResult> results;
             {
                 py::gil_scoped_release release;
@@ -127,6 +165,44 @@ void bind_simulation(py::module_& m) {
         "diffuse, diffuse_stderr, coherent, coherent_stderr, series_diffuse, g, ... per geometry). "
         "n and dx_um (None = chosen from the geometry), patch_over_T (None = chosen), threads "
         "(0 = all cores), progress (a callable(done, total) or None). docs/simulation.md.");
+
+    m.def(
+        "check_simulate_scatter",
+        [](py::handle theta_i_deg, py::handle theta_s_deg, py::handle phi_s_deg,
+           py::handle sigma_um, py::handle T_um, const std::string& correlation,
+           py::handle wavelength_um, const std::string& factor, py::handle n, py::handle dx_um,
+           py::handle patch_over_T, py::handle realisations, py::handle seed,
+           const std::string& layout, py::handle threads, const py::object& progress) {
+            const simulation::ScatterOptions o =
+                scatter_options(sigma_um, T_um, correlation, wavelength_um, factor, n, dx_um,
+                                patch_over_T, realisations, seed, layout, threads, progress);
+            const std::vector<Geometry> geoms =
+                broadcast_geometries(theta_i_deg, theta_s_deg, phi_s_deg);
+            py::list plans;
+            for (const simulation::ScatterPlanSummary& plan :
+                 simulation::check_scattering_run(geoms, o)) {
+                py::dict d;
+                d["n"] = plan.n;
+                d["dx_um"] = plan.dx_um;
+                d["generated_n"] = plan.generated_n;
+                d["layout"] = std::string(simulation::to_string(plan.layout));
+                d["lattice_index"] = plan.lattice_index;
+                plans.append(d);
+            }
+            return plans;
+        },
+        arg("theta_i_deg"), arg("theta_s_deg"), arg("phi_s_deg"), py::kw_only(), arg("sigma_um"),
+        arg("T_um"), arg("correlation") = "gaussian", arg("wavelength_um") = 0.555,
+        arg("factor") = "beckmann", arg("n") = py::none(), arg("dx_um") = py::none(),
+        arg("patch_over_T") = py::none(), arg("realisations") = 100, arg("seed") = 1,
+        arg("layout") = "lattice_aligned", arg("threads") = 0, arg("progress") = py::none(),
+        "Validates a simulate_scatter call without running it: the same arguments, the same "
+        "InvalidArgument/TypeError that simulate_scatter would raise before its first realisation "
+        "(options, geometries, the grid chosen or given at each geometry). Returns one dict per "
+        "geometry (broadcast, C order) with the grid the run will use: 'n', 'dx_um', 'layout', "
+        "'lattice_index' (as in its results) and 'generated_n' (the side of the surface "
+        "generated per realisation). Cheap: no surface is generated. "
+        "docs/simulation-sweeps.md.");
 
     m.def(
         "scattering_integral_lattice",

@@ -16,6 +16,7 @@
 #include "bindings.hpp"
 #include "roughscope/core/errors.hpp"
 #include "roughscope/core/numbers.hpp"
+#include "roughscope/core/text.hpp"
 #include "roughscope/version.hpp"
 
 namespace py = pybind11;
@@ -58,7 +59,21 @@ serialize::Json from_python(py::handle value, const std::string& where) {
     using Json = serialize::Json;
     if (value.is_none()) return nullptr;
     if (py::isinstance<py::bool_>(value)) return value.cast<bool>();
-    if (py::isinstance<py::int_>(value)) return value.cast<std::int64_t>();
+    if (py::isinstance<py::int_>(value)) {
+        // JSON integers are int64 or uint64: a Python int in [-2^63, 2^64) (seeds up to 2^64 - 1).
+        int overflow = 0;
+        const long long signed_value = PyLong_AsLongLongAndOverflow(value.ptr(), &overflow);
+        if (overflow == 0 && !PyErr_Occurred()) return static_cast<std::int64_t>(signed_value);
+        PyErr_Clear();
+        if (overflow > 0) {
+            const unsigned long long unsigned_value = PyLong_AsUnsignedLongLong(value.ptr());
+            if (!PyErr_Occurred()) return static_cast<std::uint64_t>(unsigned_value);
+            PyErr_Clear();
+        }
+        throw InvalidArgument(concat(where, " = ", py::str(value).cast<std::string>(),
+                                     " is out of range for an integer: it must be in "
+                                     "[-2^63, 2^64)"));
+    }
     if (py::isinstance<py::float_>(value)) return value.cast<double>();
     if (PyComplex_Check(value.ptr()) || py::isinstance<py::bytes>(value))
         throw py::type_error(where + " has an unsupported type " +

@@ -113,6 +113,8 @@ GOOD_CALLS = {
     "paper_tables_path": [((), {})],
     "predict_brightness": [((TI, TS, PS), dict(sigma_um=0.1, T_um=2.0, wavelength_um=0.555))],
     "rad_to_deg": [((0.5,), {})],
+    "check_simulate_scatter": [((TI, TS, PS), dict(sigma_um=0.05, T_um=1.0, wavelength_um=0.5,
+                                                   n=16, realisations=3, seed=2))],
     "read_height_map": [((HEIGHT_FILE,), dict(dx_um=1.0, dy_um=1.0, z_scale_um=1.0))],
     "ratio_range_correlation_length": [((0.05, 10.0, 40.0), dict(wavelength_um=0.555))],
     "ratio_range_exponential": [((10.0, 40.0), {})],
