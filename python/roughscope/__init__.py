@@ -23,7 +23,8 @@ from ._units import deg_to_rad, rad_to_deg  # noqa: F401
 def __getattr__(name):
     # Lazy submodules: importing roughscope must not import matplotlib.
     if name in ("figures", "report", "report_estimation", "report_curet", "curet", "plot",
-                "surface_figures", "report_surface", "simulation_figures", "report_simulation"):
+                "surface_figures", "report_surface", "simulation_figures", "report_simulation",
+                "sweep"):
         import importlib
 
         return importlib.import_module(f".{name}", __name__)
