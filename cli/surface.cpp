@@ -204,8 +204,8 @@ void run_stats(const StatsCommand& c) {
     const serialize::StatisticsInput input =
         serialize::statistics_input(map, so, c.file, format_name(c.file, ro));
     // Without a figure the map is not needed afterwards: levelled in place (one copy less).
-    const surface::SurfaceStatistics stats =
-        plot ? surface::surface_statistics(map, so) : surface::surface_statistics(std::move(map), so);
+    const surface::SurfaceStatistics stats = plot ? surface::surface_statistics(map, so)
+                                                  : surface::surface_statistics(std::move(map), so);
     if (plot) {
         json doc = serialize::to_json(input, stats, true);
         // The image shows the heights the statistics saw: levelled, and filtered with a cutoff.
