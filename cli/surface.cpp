@@ -203,16 +203,18 @@ void run_stats(const StatsCommand& c) {
     const surface::StatisticsOptions so = stats_options(c.stats, plot);
     const serialize::StatisticsInput input =
         serialize::statistics_input(map, so, c.file, format_name(c.file, ro));
-    // Without a figure the map is not needed afterwards: levelled in place (one copy less).
-    const surface::SurfaceStatistics stats = plot ? surface::surface_statistics(map, so)
-                                                  : surface::surface_statistics(std::move(map), so);
+    surface::SurfaceStatistics stats;
     if (plot) {
+        stats = surface::surface_statistics(map, so);
         json doc = serialize::to_json(input, stats, true);
         // The image shows the heights the statistics saw: levelled, and filtered with a cutoff.
-        surface::HeightMap shown = surface::level(map, so.leveling, so.polynomial_order);
+        surface::HeightMap shown = surface::level(std::move(map), so.leveling, so.polynomial_order);
         if (so.cutoff_um) shown = surface::gaussian_filter(shown, *so.cutoff_um).roughness;
         doc["image"] = serialize::height_image_json(shown);
         draw_plot(doc, c.plot_path);
+    } else {
+        // The map is not needed afterwards: levelled in place (one copy less at the peak).
+        stats = surface::surface_statistics(std::move(map), so);
     }
     emit(c.out, c.out.json_output ? serialize::dump(serialize::to_json(input, stats))
                                   : serialize::to_text(input, stats));
