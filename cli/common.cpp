@@ -6,6 +6,9 @@
 #include <cstdio>
 #include <exception>
 #include <iostream>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "roughscope/core/text.hpp"
 
@@ -280,6 +283,36 @@ void print_key_values(std::ostream& out,
     for (const auto& [k, v] : items) {
         out << k << std::string(width - k.size() + 2, ' ') << v << '\n';
     }
+}
+
+std::vector<Geometry> geometries_from_angle_lists(const std::vector<double>& theta_i_deg,
+                                                  const std::vector<double>& theta_s_deg,
+                                                  const std::vector<double>& phi_s_deg,
+                                                  std::string_view alternative) {
+    const std::size_t n = std::max({theta_i_deg.size(), theta_s_deg.size(), phi_s_deg.size()});
+    for (const auto& [values, flag] : {std::pair{&theta_i_deg, "--theta-i"},
+                                       {&theta_s_deg, "--theta-s"},
+                                       {&phi_s_deg, "--phi-s"}}) {
+        if (values->empty())
+            throw UsageError(concat("missing ", flag,
+                                    ": give --theta-i DEG --theta-s DEG --phi-s DEG (lists "
+                                    "separated by commas; phi_s = 0 is the specular plane)",
+                                    alternative));
+        if (values->size() != 1 && values->size() != n)
+            throw UsageError(concat(flag, " has ", std::to_string(values->size()),
+                                    " values; give 1 or ", std::to_string(n),
+                                    " (as many as the longest geometry list)"));
+    }
+    auto pick = [](const std::vector<double>& v, std::size_t i) {
+        return v.size() == 1 ? v[0] : v[i];
+    };
+    std::vector<Geometry> out;
+    out.reserve(n);
+    for (std::size_t i = 0; i < n; ++i)
+        out.push_back(make_geometry(deg_to_rad(pick(theta_i_deg, i)),
+                                    deg_to_rad(pick(theta_s_deg, i)),
+                                    deg_to_rad(pick(phi_s_deg, i))));
+    return out;
 }
 
 }  // namespace roughscope::cli

@@ -161,6 +161,15 @@ CLI::Option* add_non_negative_option(CLI::App& app, const std::string& flag, dou
 CLI::Option* add_range_option(CLI::App& app, const std::string& flag, double& value, double lo,
                               double hi, const std::string& description);
 
+// Geometries from the lists of --theta-i, --theta-s, --phi-s (degrees): each list has 1 value
+// (repeated) or as many as the longest. UsageError naming the flag for a missing or mismatched
+// list (`alternative` is appended to the "missing" message, e.g. ", or --csv FILE");
+// InvalidArgument from make_geometry for an angle out of range.
+std::vector<Geometry> geometries_from_angle_lists(const std::vector<double>& theta_i_deg,
+                                                  const std::vector<double>& theta_s_deg,
+                                                  const std::vector<double>& phi_s_deg,
+                                                  std::string_view alternative = "");
+
 // True if the option exists and was given on the command line.
 bool given(const CLI::Option* option);
 

@@ -306,29 +306,7 @@ struct PredictCommand {
 };
 
 std::vector<Geometry> geometries(const PredictCommand& c) {
-    const std::size_t n =
-        std::max({c.theta_i_deg.size(), c.theta_s_deg.size(), c.phi_s_deg.size()});
-    for (const auto& [values, flag] : {std::pair{&c.theta_i_deg, "--theta-i"},
-                                       {&c.theta_s_deg, "--theta-s"},
-                                       {&c.phi_s_deg, "--phi-s"}}) {
-        if (values->empty())
-            throw UsageError(std::string("missing ") + flag +
-                             ": give --theta-i DEG --theta-s DEG --phi-s DEG (lists separated by "
-                             "commas; phi_s = 0 is the specular plane)");
-        if (values->size() != 1 && values->size() != n)
-            throw UsageError(std::string(flag) + " has " + std::to_string(values->size()) +
-                             " values; give 1 or " + std::to_string(n) +
-                             " (as many as the longest geometry list)");
-    }
-    auto pick = [](const std::vector<double>& v, std::size_t i) {
-        return v.size() == 1 ? v[0] : v[i];
-    };
-    std::vector<Geometry> out;
-    for (std::size_t i = 0; i < n; ++i)
-        out.push_back(make_geometry(deg_to_rad(pick(c.theta_i_deg, i)),
-                                    deg_to_rad(pick(c.theta_s_deg, i)),
-                                    deg_to_rad(pick(c.phi_s_deg, i))));
-    return out;
+    return geometries_from_angle_lists(c.theta_i_deg, c.theta_s_deg, c.phi_s_deg);
 }
 
 void run_predict(const PredictCommand& c) {

@@ -32,31 +32,6 @@ namespace {
 
 using DoubleArray = py::array_t<double, py::array::c_style | py::array::forcecast>;
 
-std::vector<Geometry> broadcast_geometries(py::handle theta_i_deg, py::handle theta_s_deg,
-                                           py::handle phi_s_deg) {
-    const py::object np = py::module_::import("numpy");
-    py::list arrays;
-    arrays.append(real_array("theta_i_deg", theta_i_deg));
-    arrays.append(real_array("theta_s_deg", theta_s_deg));
-    arrays.append(real_array("phi_s_deg", phi_s_deg));
-    py::list b;
-    try {
-        b = np.attr("broadcast_arrays")(*arrays);
-    } catch (const py::error_already_set&) {
-        throw InvalidArgument(
-            "theta_i_deg, theta_s_deg and phi_s_deg cannot be broadcast together");
-    }
-    const auto ti = DoubleArray::ensure(np.attr("ravel")(b[0]));
-    const auto ts = DoubleArray::ensure(np.attr("ravel")(b[1]));
-    const auto ps = DoubleArray::ensure(np.attr("ravel")(b[2]));
-    std::vector<Geometry> geoms;
-    for (py::ssize_t i = 0; i < ti.size(); ++i)
-        geoms.push_back(make_geometry(deg_to_rad(ti.data()[i]), deg_to_rad(ts.data()[i]),
-                                      deg_to_rad(ps.data()[i])));
-    if (geoms.empty()) throw InvalidArgument("no geometry given: the angle arrays are empty");
-    return geoms;
-}
-
 // A count argument: None → `absent`, else a non-negative integer (TypeError for a non-integer).
 std::size_t non_negative_count(const char* name, py::handle value, std::size_t absent) {
     if (value.is_none()) return absent;
@@ -143,6 +118,8 @@ void bind_simulation(py::module_& m) {
                                 patch_over_T, realisations, seed, layout, threads, progress);
             const std::vector<Geometry> geoms =
                 broadcast_geometries(theta_i_deg, theta_s_deg, phi_s_deg);
+            if (geoms.empty())
+                throw InvalidArgument("no geometry given: the angle arrays are empty");
             std::vector<simulation::ScatterResult> results;
             {
                 py::gil_scoped_release release;
@@ -178,6 +155,8 @@ void bind_simulation(py::module_& m) {
                                 patch_over_T, realisations, seed, layout, threads, progress);
             const std::vector<Geometry> geoms =
                 broadcast_geometries(theta_i_deg, theta_s_deg, phi_s_deg);
+            if (geoms.empty())
+                throw InvalidArgument("no geometry given: the angle arrays are empty");
             py::list plans;
             for (const simulation::ScatterPlanSummary& plan :
                  simulation::check_scattering_run(geoms, o)) {

@@ -250,26 +250,8 @@ void bind_surface(py::module_& m) {
            py::handle sigma_um, py::handle T_um, std::optional<std::string> correlation,
            py::handle statistics, py::handle wavelength_um, const std::string& factor,
            const std::string& radiometry, const std::string& regime) {
-            const py::object np = py::module_::import("numpy");
-            py::list arrays;
-            arrays.append(real_array("theta_i_deg", theta_i_deg));
-            arrays.append(real_array("theta_s_deg", theta_s_deg));
-            arrays.append(real_array("phi_s_deg", phi_s_deg));
-            py::list b;
-            try {
-                b = np.attr("broadcast_arrays")(*arrays);
-            } catch (const py::error_already_set&) {
-                throw InvalidArgument(
-                    "theta_i_deg, theta_s_deg and phi_s_deg cannot be broadcast "
-                    "together");
-            }
-            const auto ti = DoubleArray::ensure(np.attr("ravel")(b[0]));
-            const auto ts = DoubleArray::ensure(np.attr("ravel")(b[1]));
-            const auto ps = DoubleArray::ensure(np.attr("ravel")(b[2]));
-            std::vector<Geometry> geoms;
-            for (py::ssize_t i = 0; i < ti.size(); ++i)
-                geoms.push_back(make_geometry(deg_to_rad(ti.data()[i]), deg_to_rad(ts.data()[i]),
-                                              deg_to_rad(ps.data()[i])));
+            const std::vector<Geometry> geoms =
+                broadcast_geometries(theta_i_deg, theta_s_deg, phi_s_deg);
             ModelOptions o;
             o.wavelength_um = real_scalar("wavelength_um", wavelength_um);
             o.factor = parse_geometric_factor(normalize_name(factor));

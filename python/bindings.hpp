@@ -3,10 +3,12 @@
 
 #include <optional>
 #include <string>
+#include <vector>
 
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 
+#include "roughscope/scattering/geometry.hpp"
 #include "roughscope/serialize/json.hpp"
 #include "roughscope/surface/height_map.hpp"
 
@@ -50,6 +52,13 @@ pybind11::object real_option(const char* name, pybind11::object value, bool pair
 // dx_um, dy_um (None = dx_um); non-finite heights become missing points (bind_surface.cpp).
 surface::HeightMap height_map_from(pybind11::handle heights, pybind11::handle dx,
                                    pybind11::handle dy);
+
+// Geometries from three angle arguments in degrees (each a real number or array; broadcast
+// together, then flattened): TypeError for non-real input, InvalidArgument for shapes that do
+// not broadcast or an angle out of range (make_geometry). module.cpp.
+std::vector<Geometry> broadcast_geometries(pybind11::handle theta_i_deg,
+                                           pybind11::handle theta_s_deg,
+                                           pybind11::handle phi_s_deg);
 
 // Throws MemoryError (checked before allocating) when `elements` float64 values, `arrays` times,
 // exceed what this machine can hold; `what` describes the shape.

@@ -23,6 +23,33 @@ namespace py = pybind11;
 
 namespace roughscope::python {
 
+std::vector<Geometry> broadcast_geometries(py::handle theta_i_deg, py::handle theta_s_deg,
+                                           py::handle phi_s_deg) {
+    const py::object np = py::module_::import("numpy");
+    py::list arrays;
+    arrays.append(real_array("theta_i_deg", theta_i_deg));
+    arrays.append(real_array("theta_s_deg", theta_s_deg));
+    arrays.append(real_array("phi_s_deg", phi_s_deg));
+    py::list b;
+    try {
+        b = np.attr("broadcast_arrays")(*arrays);
+    } catch (const py::error_already_set&) {
+        throw InvalidArgument(
+            "theta_i_deg, theta_s_deg and phi_s_deg cannot be broadcast together");
+    }
+    const auto ti = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(
+        np.attr("ravel")(b[0]));
+    const auto ts = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(
+        np.attr("ravel")(b[1]));
+    const auto ps = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(
+        np.attr("ravel")(b[2]));
+    std::vector<Geometry> geoms;
+    for (py::ssize_t i = 0; i < ti.size(); ++i)
+        geoms.push_back(make_geometry(deg_to_rad(ti.data()[i]), deg_to_rad(ts.data()[i]),
+                                      deg_to_rad(ps.data()[i])));
+    return geoms;
+}
+
 py::object to_python(const serialize::Json& value) {
     using Json = serialize::Json;
     switch (value.type()) {
