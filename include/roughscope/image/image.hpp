@@ -1,0 +1,78 @@
+// Photographs on a linear scale: the value type every part of the image topic works on.
+//
+// A LinearImage holds what a camera pixel measured, brought back to a scale proportional to the
+// light that reached it: the stored code values with the camera's black level subtracted, the
+// response (sRGB, gamma) inverted, divided by (white level − black level), so 0 is black and 1
+// the largest value the file can hold. It is *not* divided by the exposure time: the measurement
+// does that (image/measure.hpp), from the capture file or the file's metadata.
+//
+// Layout: planar, row-major, row 0 at the top. Plane c (0 = R, 1 = G, 2 = B; a grey image has one
+// plane), row r, column x is values[(c · height + r) · width + x]. Per pixel (not per channel),
+// `flags` marks pixels that must never enter a measurement: a channel at the white level or
+// clipped by the camera (kSaturated), or a channel at code 0 after the black level, where the
+// true value may lie below what was recorded (kClippedLow).
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace roughscope::image {
+
+// How the stored code values relate to light (the camera's tone response).
+//   Linear: value ∝ light (RAW, linear 16-bit TIFF/PNG, float TIFF).
+//   Srgb:   IEC 61966-2-1 sRGB encoding (most JPEGs and 8-bit PNGs).
+//   Gamma:  value = light^(1/γ) (γ given).
+enum class ImageResponse { Linear, Srgb, Gamma };
+std::string_view to_string(ImageResponse response);  // "linear", "srgb", "gamma"
+ImageResponse parse_image_response(std::string_view name);
+
+enum PixelFlag : std::uint8_t {
+    kPixelSaturated = 1,   // a channel at or above the white level (or clipped by the camera)
+    kPixelClippedLow = 2,  // a channel at or below code 0 after the black level
+};
+
+// What the file said about itself and what reading it did.
+struct ImageInfo {
+    std::string source;             // the path (or the name given to decode_image)
+    std::string format;             // "png", "tiff", "jpeg", "raw" (any LibRaw format)
+    std::string raw_format;         // RAW only: LibRaw's make/model or format name; else empty
+    int bits_per_sample = 0;        // 8, 16, 32 (float) as stored; RAW: bits of the sensor data
+    bool is_float = false;          // float samples (TIFF)
+    double white_level_dn = 0.0;    // the stored code of full scale (float: 1)
+    std::vector<double> black_level_dn;  // per plane, subtracted (0 unless RAW or given)
+    ImageResponse response = ImageResponse::Linear;  // the response that was inverted
+    double gamma = 0.0;                              // ImageResponse::Gamma only
+    // What the file's own metadata says of its response, when it says anything: an sRGB, gAMA or
+    // iCCP chunk (PNG), a JPEG (sRGB unless stated otherwise), an EXIF colour space, a RAW
+    // (linear). `file_response_evidence` names the evidence ("PNG sRGB chunk").
+    std::optional<ImageResponse> file_response;
+    std::string file_response_evidence;
+    // From EXIF or the RAW metadata, when present.
+    std::optional<double> exposure_s;
+    std::optional<double> f_number;
+    std::optional<double> iso;
+    std::vector<std::string> warnings;  // e.g. a declared response that the file contradicts
+};
+
+struct LinearImage {
+    std::size_t width = 0;
+    std::size_t height = 0;
+    std::size_t channels = 0;           // 1 (grey) or 3 (R, G, B)
+    std::vector<float> values;          // channels · height · width, see the layout above
+    std::vector<std::uint8_t> flags;    // height · width, PixelFlag bits
+    ImageInfo info;
+
+    std::size_t pixel_count() const { return width * height; }
+    float value(std::size_t channel, std::size_t row, std::size_t col) const {
+        return values[(channel * height + row) * width + col];
+    }
+    const float* plane(std::size_t channel) const {
+        return values.data() + channel * height * width;
+    }
+};
+
+}  // namespace roughscope::image
