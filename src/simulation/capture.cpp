@@ -54,12 +54,6 @@ constexpr std::array<NameEntry<BrightnessModel>, 8> kModelNames{{
     {"table", BrightnessModel::Tabulated},
 }};
 
-constexpr std::array<NameEntry<Response>, 3> kResponseNames{{
-    {"linear", Response::Linear},
-    {"srgb", Response::Srgb},
-    {"gamma", Response::Gamma},
-}};
-
 constexpr float kNaNf = std::numeric_limits<float>::quiet_NaN();
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
@@ -187,10 +181,6 @@ std::string_view to_string(BrightnessModel model) { return name_of(kModelNames, 
 BrightnessModel parse_brightness_model(std::string_view name) {
     return parse_name(kModelNames, "brightness model", name);
 }
-std::string_view to_string(Response response) { return name_of(kResponseNames, response); }
-Response parse_response(std::string_view name) {
-    return parse_name(kResponseNames, "response", name);
-}
 
 // ---------------------------------------------------------------------------------------------
 // Scene, truth, camera
@@ -276,18 +266,6 @@ void check_camera(const CameraModel& camera) {
     if (!(camera.vignetting >= 0.0 && camera.vignetting <= 1.0))
         throw InvalidArgument(concat("vignetting = ", number_text(camera.vignetting),
                                      " is outside the valid range [0, 1]"));
-}
-
-// IEC 61966-2-1: v = 12.92 u for u ≤ 0.0031308, else 1.055 u^(1/2.4) − 0.055.
-double srgb_encode(double linear) {
-    if (linear <= 0.0031308) return 12.92 * linear;
-    return 1.055 * std::pow(linear, 1.0 / 2.4) - 0.055;
-}
-
-// IEC 61966-2-1 inverse: u = v / 12.92 for v ≤ 0.04045, else ((v + 0.055)/1.055)^2.4.
-double srgb_decode(double encoded) {
-    if (encoded <= 0.04045) return encoded / 12.92;
-    return std::pow((encoded + 0.055) / 1.055, 2.4);
 }
 
 double surface_brightness(const SurfaceTruth& truth, const Geometry& geom) {

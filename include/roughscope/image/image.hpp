@@ -20,15 +20,9 @@
 #include <string_view>
 #include <vector>
 
-namespace roughscope::image {
+#include "roughscope/core/response.hpp"
 
-// How the stored code values relate to light (the camera's tone response).
-//   Linear: value ∝ light (RAW, linear 16-bit TIFF/PNG, float TIFF).
-//   Srgb:   IEC 61966-2-1 sRGB encoding (most JPEGs and 8-bit PNGs).
-//   Gamma:  value = light^(1/γ) (γ given).
-enum class ImageResponse { Linear, Srgb, Gamma };
-std::string_view to_string(ImageResponse response);  // "linear", "srgb", "gamma"
-ImageResponse parse_image_response(std::string_view name);
+namespace roughscope::image {
 
 enum PixelFlag : std::uint8_t {
     kPixelSaturated = 1,   // a channel at or above the white level (or clipped by the camera)
@@ -37,19 +31,19 @@ enum PixelFlag : std::uint8_t {
 
 // What the file said about itself and what reading it did.
 struct ImageInfo {
-    std::string source;             // the path (or the name given to decode_image)
-    std::string format;             // "png", "tiff", "jpeg", "raw" (any LibRaw format)
-    std::string raw_format;         // RAW only: LibRaw's make/model or format name; else empty
-    int bits_per_sample = 0;        // 8, 16, 32 (float) as stored; RAW: bits of the sensor data
-    bool is_float = false;          // float samples (TIFF)
-    double white_level_dn = 0.0;    // the stored code of full scale (float: 1)
-    std::vector<double> black_level_dn;  // per plane, subtracted (0 unless RAW or given)
-    ImageResponse response = ImageResponse::Linear;  // the response that was inverted
-    double gamma = 0.0;                              // ImageResponse::Gamma only
+    std::string source;           // the path (or the name given to decode_image)
+    std::string format;           // "png", "tiff", "jpeg", "raw" (any LibRaw format)
+    std::string raw_format;       // RAW only: LibRaw's make/model or format name; else empty
+    int bits_per_sample = 0;      // 8, 16, 32 (float) as stored; RAW: bits of the sensor data
+    bool is_float = false;        // float samples (TIFF)
+    double white_level_dn = 0.0;  // the stored code of full scale (float: 1)
+    std::vector<double> black_level_dn;    // per plane, subtracted (0 unless RAW or given)
+    Response response = Response::Linear;  // the response that was inverted
+    double gamma = 0.0;                    // Response::Gamma only
     // What the file's own metadata says of its response, when it says anything: an sRGB, gAMA or
     // iCCP chunk (PNG), a JPEG (sRGB unless stated otherwise), an EXIF colour space, a RAW
     // (linear). `file_response_evidence` names the evidence ("PNG sRGB chunk").
-    std::optional<ImageResponse> file_response;
+    std::optional<Response> file_response;
     std::string file_response_evidence;
     // From EXIF or the RAW metadata, when present.
     std::optional<double> exposure_s;
@@ -61,9 +55,9 @@ struct ImageInfo {
 struct LinearImage {
     std::size_t width = 0;
     std::size_t height = 0;
-    std::size_t channels = 0;           // 1 (grey) or 3 (R, G, B)
-    std::vector<float> values;          // channels · height · width, see the layout above
-    std::vector<std::uint8_t> flags;    // height · width, PixelFlag bits
+    std::size_t channels = 0;         // 1 (grey) or 3 (R, G, B)
+    std::vector<float> values;        // channels · height · width, see the layout above
+    std::vector<std::uint8_t> flags;  // height · width, PixelFlag bits
     ImageInfo info;
 
     std::size_t pixel_count() const { return width * height; }
@@ -74,5 +68,13 @@ struct LinearImage {
         return values.data() + channel * height * width;
     }
 };
+
+// Throws InvalidArgument (naming info.source) unless the image is consistent: width, height ≥ 1,
+// channels 1 or 3, values.size() = channels · height · width, flags.size() = height · width,
+// every value finite.
+void check_linear_image(const LinearImage& image);
+
+// Pixels whose flags have any bit of `mask` set.
+std::size_t count_flagged(const LinearImage& image, std::uint8_t mask);
 
 }  // namespace roughscope::image

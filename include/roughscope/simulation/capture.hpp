@@ -41,6 +41,7 @@
 
 #include <Eigen/Core>
 
+#include "roughscope/core/response.hpp"
 #include "roughscope/scattering/beckmann.hpp"
 #include "roughscope/scattering/factors.hpp"
 #include "roughscope/scattering/geometry.hpp"
@@ -133,9 +134,9 @@ std::function<double(const Geometry&)> table_brightness(BrightnessTable table);
 // ---------------------------------------------------------------------------------------------
 // Camera
 
-enum class Response { Linear, Srgb, Gamma };
-std::string_view to_string(Response response);  // "linear", "srgb", "gamma"
-Response parse_response(std::string_view name);
+// The tone response (core/response.hpp) applied to the linear signal.
+using roughscope::parse_response;
+using roughscope::Response;
 
 struct CameraModel {
     double electrons_per_unit_s = 20000.0;  // k: electrons per unit brightness per second (> 0)
@@ -157,9 +158,8 @@ struct CameraModel {
 void check_camera(const CameraModel& camera);
 void check_scene(const Scene& scene);
 
-// IEC 61966-2-1 sRGB transfer: encode u ∈ [0, 1] (linear) → v, decode v → u.
-double srgb_encode(double linear);
-double srgb_decode(double encoded);
+using roughscope::srgb_decode;
+using roughscope::srgb_encode;
 
 // ---------------------------------------------------------------------------------------------
 // Rendering
