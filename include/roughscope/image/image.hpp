@@ -24,10 +24,10 @@
 
 namespace roughscope::image {
 
-enum PixelFlag : std::uint8_t {
-    kPixelSaturated = 1,   // a channel at or above the white level (or clipped by the camera)
-    kPixelClippedLow = 2,  // a channel at or below code 0 after the black level
-};
+// Bits of LinearImage::flags.
+inline constexpr std::uint8_t kPixelSaturated = 1;   // a channel at or above the white level
+                                                     // (or clipped by the camera)
+inline constexpr std::uint8_t kPixelClippedLow = 2;  // a channel at or below the black level
 
 // What the file said about itself and what reading it did.
 struct ImageInfo {
