@@ -57,7 +57,7 @@ struct LinearImage {
     std::size_t height = 0;
     std::size_t channels = 0;         // 1 (grey) or 3 (R, G, B)
     std::vector<float> values;        // channels · height · width, see the layout above
-    std::vector<std::uint8_t> flags;  // height · width, PixelFlag bits
+    std::vector<std::uint8_t> flags;  // height · width, kPixel* bits
     ImageInfo info;
 
     std::size_t pixel_count() const { return width * height; }
