@@ -137,6 +137,7 @@ std::function<double(const Geometry&)> table_brightness(BrightnessTable table);
 // The tone response (core/response.hpp) applied to the linear signal.
 using roughscope::parse_response;
 using roughscope::Response;
+using roughscope::to_string;
 
 struct CameraModel {
     double electrons_per_unit_s = 20000.0;  // k: electrons per unit brightness per second (> 0)
