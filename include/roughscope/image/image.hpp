@@ -25,9 +25,12 @@
 namespace roughscope::image {
 
 // Bits of LinearImage::flags.
-inline constexpr std::uint8_t kPixelSaturated = 1;   // a channel at or above the white level
-                                                     // (or clipped by the camera)
-inline constexpr std::uint8_t kPixelClippedLow = 2;  // a channel at or below the black level
+inline constexpr std::uint8_t kPixelSaturated = 1;    // a channel at or above the white level
+                                                      // (or clipped by the camera)
+inline constexpr std::uint8_t kPixelClippedLow = 2;   // a channel at or below the black level
+inline constexpr std::uint8_t kPixelNoFlatField = 4;  // no usable flat-field value (the flat is
+                                                      // ≤ 0 or flagged there): not corrected
+                                                      // (image/radiometry.hpp)
 
 // What the file said about itself and what reading it did.
 struct ImageInfo {
