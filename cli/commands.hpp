@@ -12,5 +12,6 @@ void register_paper(CLI::App& app);     // cli/paper.cpp    — paper tables rec
 void register_curet(CLI::App& app);     // cli/curet.cpp    — CUReT comparison (§5.3)
 void register_surface(CLI::App& app);   // cli/surface.cpp  — height data (§3.1)
 void register_simulate(CLI::App& app);  // cli/simulate.cpp — simulations (ground truth)
+void register_measure(CLI::App& app);   // cli/measure.cpp  — roughness from photographs
 
 }  // namespace roughscope::cli

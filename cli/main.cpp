@@ -28,6 +28,7 @@ int main(int argc, char** argv) {
     roughscope::cli::register_curet(app);
     roughscope::cli::register_surface(app);
     roughscope::cli::register_simulate(app);
+    roughscope::cli::register_measure(app);
 
     return roughscope::cli::run_app(app, argc, argv);
 }

@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
+#include <functional>
 #include <set>
 #include <string>
 #include <vector>
@@ -127,18 +128,32 @@ Request request_from(const py::kwargs& kw) {
     truth.model_options.wavelength_um = real("wavelength_um", 0.555);
     truth.oren_nayar.sigma_rad = deg_to_rad(real("oren_nayar_sigma_deg", 20.0));
     truth.lafortune_n = real("lafortune_n", 1.0);
-    if (has_object("brightness")) {
-        py::object f = kw["brightness"];
+    // `brightness`: one callable (θi, θs, φs in degrees) → brightness for every label, or a list
+    // of callables, one per label (then sigma_over_T is not used).
+    auto tabulated = [](py::object f, const char* what) {
         if (!PyCallable_Check(f.ptr()))
-            throw py::type_error(
-                "brightness must be a callable (theta_i_deg, theta_s_deg, "
-                "phi_s_deg) -> float");
-        truth.model = simulation::BrightnessModel::Tabulated;
-        truth.tabulated = [f](const Geometry& g) {
+            throw py::type_error(concat(what,
+                                        " must be a callable (theta_i_deg, theta_s_deg, "
+                                        "phi_s_deg) -> float, or a list of them (one per "
+                                        "label)"));
+        return std::function<double(const Geometry&)>([f](const Geometry& g) {
             py::gil_scoped_acquire gil;
             return f(rad_to_deg(g.theta_i_rad), rad_to_deg(g.theta_s_rad), rad_to_deg(g.phi_s_rad))
                 .cast<double>();
-        };
+        });
+    };
+    std::vector<std::function<double(const Geometry&)>> per_label;
+    if (has_object("brightness")) {
+        py::object f = kw["brightness"];
+        truth.model = simulation::BrightnessModel::Tabulated;
+        if (py::isinstance<py::list>(f) || py::isinstance<py::tuple>(f)) {
+            for (py::handle item : f)
+                per_label.push_back(
+                    tabulated(py::reinterpret_borrow<py::object>(item), "brightness[k]"));
+            if (per_label.empty()) throw InvalidArgument("brightness: the list is empty");
+        } else {
+            truth.tabulated = tabulated(f, "brightness");
+        }
     }
     std::vector<double> ratios{0.2};
     if (has("sigma_over_T")) {
@@ -151,10 +166,22 @@ Request request_from(const py::kwargs& kw) {
         if (!(ratio > 0.0 && std::isfinite(ratio)))
             throw InvalidArgument(
                 concat("sigma_over_T = ", format_message(ratio), " must be finite and > 0"));
-        simulation::SurfaceTruth t = truth;
-        t.sigma_um = ratio * truth.T_um;
-        r.record.truths.push_back(t);
     }
+    if (!per_label.empty()) {
+        for (auto& f : per_label) {
+            simulation::SurfaceTruth t = truth;
+            t.sigma_um = ratios.front() * truth.T_um;
+            t.tabulated = std::move(f);
+            r.record.truths.push_back(std::move(t));
+        }
+    } else {
+        for (double ratio : ratios) {
+            simulation::SurfaceTruth t = truth;
+            t.sigma_um = ratio * truth.T_um;
+            r.record.truths.push_back(t);
+        }
+    }
+    const bool several = r.record.truths.size() > 1;
     if (has_object("labels")) {
         auto labels = py::array_t<std::int32_t, py::array::c_style | py::array::forcecast>::ensure(
             kw["labels"]);
@@ -166,9 +193,9 @@ Request request_from(const py::kwargs& kw) {
                        "= (",
                        std::to_string(s.height), ", ", std::to_string(s.width), ")"));
         r.record.labels.assign(labels.data(), labels.data() + labels.size());
-    } else if (ratios.size() > 1) {
+    } else if (several) {
         throw InvalidArgument(
-            "sigma_over_T: several values need labels (an integer array of "
+            "sigma_over_T or brightness: several values need labels (an integer array of "
             "shape (height, width) indexing them)");
     }
 

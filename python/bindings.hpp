@@ -20,6 +20,7 @@ void bind_curet(pybind11::module_& m);       // python/bind_curet.cpp: CUReT / B
 void bind_surface(pybind11::module_& m);     // python/bind_surface.cpp: height data (§3.1)
 void bind_simulation(pybind11::module_& m);  // python/bind_simulation.cpp: Kirchhoff Monte Carlo
 void bind_capture(pybind11::module_& m);     // python/bind_capture.cpp: synthetic captures
+void bind_image(pybind11::module_& m);       // python/bind_image.cpp: photographs to roughness
 
 // Results cross into Python as real objects, built from the library's serializer
 // (roughscope/serialize): objects → dict (key order kept), arrays → list, numbers → int/float,

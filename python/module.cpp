@@ -281,4 +281,5 @@ PYBIND11_MODULE(_core, m) {
     roughscope::python::bind_surface(m);
     roughscope::python::bind_simulation(m);
     roughscope::python::bind_capture(m);
+    roughscope::python::bind_image(m);
 }

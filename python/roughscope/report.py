@@ -4,6 +4,9 @@ Writes DIR/index.html — a self-contained page (inline CSS, figures as PNG file
 linked relatively) — with:
 
 * a header (library version, date);
+* first, the main job — :mod:`roughscope.report_measure`: synthetic photographs of samples of known
+  roughness written, measured (``roughscope measure``) and the recovered values set against the
+  truth;
 * "Models": the paper's Figs. 3 and 4 (retro-scattering, B–K and V–H) and a table checking the
   closed forms Eq. 7–11 against the library's general forms at the retro geometry;
 * the sections of :mod:`roughscope.report_estimation`, :mod:`roughscope.report_curet`,
@@ -146,7 +149,8 @@ def build_report(outdir):
     """Write the full report into `outdir` (an existing, empty folder); return index.html's path."""
     outdir = pathlib.Path(outdir)
     now = datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
-    sections = [models_section(outdir)]
+    sections = [_import_section_module("report_measure").section(outdir),
+                models_section(outdir)]
     for name in ("report_estimation", "report_curet", "report_surface", "report_simulation"):
         fragment = _import_section_module(name).section(outdir)
         if fragment is not None:

@@ -43,6 +43,17 @@ HEIGHTS = np.random.default_rng(1).normal(size=(16, 16))
 _HEIGHT_DIR = tempfile.mkdtemp(prefix="roughscope-inputs-")
 HEIGHT_FILE = _HEIGHT_DIR + "/h.x3p"
 rs.write_height_map(HEIGHTS, 1.0, 1.0, HEIGHT_FILE)
+# Two small 16-bit captures (30°, 45°) and their capture file, for the image functions.
+for _k, _theta in enumerate((30.0, 45.0)):
+    _core.write_capture(_HEIGHT_DIR, "png", f"cap{_k}", width=24, height=24, theta_i_deg=_theta,
+                        bits=16, sigma_over_T=0.3, keep_geometry=False, seed=5 + _k)
+CAPTURE_FILE = _HEIGHT_DIR + "/capture-file.json"
+with open(CAPTURE_FILE, "w", encoding="utf-8") as _f:
+    _f.write('{"response": "linear", "black_level_dn": 64, "roi": {"rect": [4, 4, 16, 16]}, '
+             '"captures": [{"image": "cap0.png", "theta_i_deg": 30}, '
+             '{"image": "cap1.png", "theta_i_deg": 45}]}')
+IMAGE_VALUES = np.random.default_rng(2).uniform(0.2, 0.3, size=(3, 12, 12))
+IMAGE_MASK = np.ones((12, 12), dtype=bool)
 LOBES = Lobes([{"Cx": -1.0, "Cy": -1.0, "Cz": 1.0, "n": 10.0, "albedo": 0.5}])
 COMPARISON_OPTIONS = dict(theta1_deg=20.0, theta2_deg=50.0, pair=(1, 2), on_sigma_rad=0.2,
                           on_albedo=0.5, fits=False)
@@ -133,6 +144,12 @@ GOOD_CALLS = {
     "shared_dir_candidates": [((), {})],
     "shared_search_description": [(("data/curet",), {})],
     "sigma_from_specular": [((0.5, 10.0), dict(wavelength_um=0.555, R0=1.0))],
+    "read_image": [((_HEIGHT_DIR + "/cap0.png",), dict(response="gamma", gamma=2.2,
+                                                         black_level_dn=64.0))],
+    "region_mask": [(({"circle": [6.0, 6.0, 4.0]}, 12, 12), {})],
+    "region_statistics": [((IMAGE_VALUES, IMAGE_MASK), dict(tile_size_px=4,
+                                                            max_excluded_fraction=0.5))],
+    "measure": [((CAPTURE_FILE,), {})],
     "render_capture": [((), dict(scene="sphere", width=9, height=7, theta_i_deg=30.0,
                                  theta_v_deg=10.0, sigma_over_T=0.3, T_um=5.0, bits=12, gain=0.25,
                                  black_level=64.0, read_noise_e=2.0, vignetting=0.1, seed=3))],

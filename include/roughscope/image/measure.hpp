@@ -1,0 +1,143 @@
+// Roughness from photographs (paper §2, §4, §5.1): a set of captures of one flat sample — their
+// files, the light and view directions of each, the exposure — and one region, to σ (specular
+// capture, Eq. 13), T given σ (Eq. 15 or the two-geometry solver) and σ/T (Eq. 17 / 19 or the
+// solver; a least-squares fit when there are more than two diffuse captures), each with its
+// standard error. Every definition is in docs/measure.md.
+//
+// Brightness of a diffuse capture k: Ẽ_k = mean_k / s_k over the region's pixels on the linear
+// scale of image/image.hpp (dark frame subtracted, flat field divided, saturated and clipped
+// pixels left out), with s_k the exposure scale: s_k = t_k (exposure time), times ISO_k/ISO_1 and
+// (N_1/N_k)² (f-number) when those are known for every capture. Its relative standard error is
+// ε_k = max(stderr_pixel, stderr_tiles)/mean (image/statistics.hpp): pixel noise or, when larger,
+// the spread between tiles of the region (texture).
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "roughscope/core/response.hpp"
+#include "roughscope/estimation/estimation.hpp"
+#include "roughscope/fit/fit.hpp"
+#include "roughscope/image/hdr.hpp"
+#include "roughscope/image/image.hpp"
+#include "roughscope/image/read.hpp"
+#include "roughscope/image/region.hpp"
+#include "roughscope/image/specular.hpp"
+#include "roughscope/image/statistics.hpp"
+#include "roughscope/scattering/geometry.hpp"
+
+namespace roughscope::image {
+
+enum class CaptureRole { Diffuse, Specular };
+std::string_view to_string(CaptureRole role);  // "diffuse", "specular"
+CaptureRole parse_capture_role(std::string_view name);
+
+// Default wavelengths of the R, G, B channels (µm): the centres of typical camera colour filters.
+// The RGB average (and a grey image) uses MeasureRequest::wavelength_um (the paper's 0.555 µm).
+inline constexpr std::array<double, 3> kDefaultChannelWavelengthsUm{0.600, 0.530, 0.460};
+
+// One photograph of an exposure bracket (8-bit files of one still scene, image/hdr.hpp).
+struct BracketShot {
+    std::string image;
+    double exposure_s = 0.0;
+};
+
+struct CaptureSpec {
+    std::string image;  // path of the image file (a bracket: its first file, for messages)
+    // Non-empty: the capture is this bracket merged into one HDR image (merge_hdr, values per
+    // second of exposure, so its exposure scale is 1), through the response curve of the
+    // request (recovered from response_bracket, or the declared response's).
+    std::vector<BracketShot> bracket;
+    Geometry geometry;  // (θi, θs, φs) in the paper's frame, radians
+    // Exposure time (s); when absent, the file's metadata (EXIF, RAW); when no capture has one,
+    // all are taken as equal (a warning says so).
+    std::optional<double> exposure_s;
+    CaptureRole role = CaptureRole::Diffuse;
+};
+
+struct MeasureRequest {
+    std::string source;            // the capture file (for messages); may be empty
+    double wavelength_um = 0.555;  // λ of the RGB average and of grey images
+    std::array<double, 3> channel_wavelengths_um = kDefaultChannelWavelengthsUm;
+    ReadOptions read;  // response (linear, srgb, gamma), black level
+    // Non-empty: the camera's response is unknown and recovered from this exposure bracket
+    // (Debevec–Malik, image/hdr.hpp); every capture (8-bit) is read through that curve.
+    std::vector<BracketShot> response_bracket;
+    std::optional<std::string> dark_frame;  // image subtracted from every capture
+    std::optional<std::string> flat_field;  // image every capture is divided by (mean 1)
+    Region roi;                             // the measured region (every capture)
+    std::vector<CaptureSpec> captures;
+    Correlation correlation = Correlation::Gaussian;  // for T given σ
+    // The diffuse term's regime for T given σ: SlightlyRough is the paper's Eq. 15 (§4.1.2,
+    // Table 1); Series the exact sum at any g; Auto chosen by g (scattering/beckmann.hpp).
+    Regime regime = Regime::SlightlyRough;
+    std::optional<double> sigma_um;  // known σ, µm (else from a specular capture)
+    double sigma_um_stderr = 0.0;
+    double R0 = kDefaultSmoothReflectanceR0;  // Eq. 13's smooth-surface reflectance
+    GeometricFactor factor = GeometricFactor::VernoldHarvey;
+    Radiometry radiometry = Radiometry::Radiance;
+    HighlightOptions highlight;
+    RegionStatisticsOptions statistics;
+};
+
+// One capture as measured.
+struct CaptureMeasurement {
+    CaptureSpec spec;
+    ImageInfo info;
+    double exposure_scale = 1.0;                    // s_k
+    std::string exposure_source;                    // "capture file", "metadata", "assumed equal"
+    RegionStatistics region;                        // diffuse: the region; specular: the core
+    std::optional<HighlightMeasurement> highlight;  // specular captures only
+    double brightness = 0.0;                        // Ẽ_k = region.average.mean / s_k (diffuse)
+    double brightness_relative_stderr = 0.0;
+};
+
+// σ from one specular capture in one channel (Eq. 13 at that channel's wavelength).
+struct ChannelSigma {
+    std::string channel;  // "R", "G", "B", "average" or "grey"
+    double wavelength_um = 0.0;
+    RoughnessEstimate estimate;
+};
+
+struct MeasureResult {
+    std::vector<CaptureMeasurement> captures;
+    std::size_t region_pixels = 0;
+    // Specular (§4.1.1): σ per channel and from the RGB average; the channels' agreement as
+    // χ² = Σ (σ_c − σ̄)²/sd_c² about their weighted mean, with its degrees of freedom.
+    std::vector<ChannelSigma> specular_sigma;
+    std::optional<RoughnessEstimate> sigma;  // the RGB average's (or grey) σ
+    std::optional<double> channel_sigma_chi2;
+    std::size_t channel_sigma_dof = 0;
+    // Two diffuse captures (§4.1.2, §4.2): E1/E2 of the first two, σ/T for both correlations,
+    // T given σ.
+    std::optional<Estimate> E1_over_E2;
+    std::optional<RoughnessEstimate> slope_gaussian;
+    std::optional<RoughnessEstimate> slope_exponential;
+    std::optional<RoughnessEstimate> correlation_length;
+    // More than two diffuse captures: the least-squares fits (both correlations).
+    std::optional<CorrelationComparison> fit;
+    std::vector<std::string> warnings;
+};
+
+// Reads every capture, measures the region and estimates what the captures allow. Throws
+// DataError (a file: missing, unreadable, sizes that differ) or InvalidArgument (angles, region
+// outside the image, a mostly saturated region, no diffuse pair and no specular capture),
+// NoSolution (a ratio no model produces), each naming the capture file and the input.
+MeasureResult measure(const MeasureRequest& request);
+
+// The capture file (JSON, docs/measure.md): keys wavelength_um, channel_wavelengths_um,
+// response ("linear", "srgb", {"gamma": γ} or {"bracket": [{image, exposure_s}, ...]}),
+// black_level_dn, dark_frame, flat_field, roi
+// ({"rect": [x, y, w, h]}, {"circle": [cx, cy, r]}, {"polygon": [[x, y], ...]} or
+// {"mask": FILE}), correlation, sigma_um, sigma_um_stderr, R0, factor, radiometry, highlight
+// {core_radius_px, annulus_inner_px, annulus_outer_px, smoothing_sigma_px, centre_px}, and
+// captures: [{image | bracket: [{image, exposure_s}, ...], theta_i_deg, theta_s_deg, phi_s_deg |
+// light, view (unit vectors, normal +Z), exposure_s, role}]. Paths are relative to the capture
+// file. DataError naming the file and the key for anything malformed or unknown.
+MeasureRequest read_capture_file(const std::string& path);
+MeasureRequest parse_capture_file(std::string_view text, const std::string& path);
+
+}  // namespace roughscope::image

@@ -1,0 +1,360 @@
+// The capture file of `roughscope measure` (measure.hpp, docs/measure.md): JSON to a
+// MeasureRequest. Every key is checked: an unknown key, a wrong type or a value out of range is a
+// DataError naming the file and the key.
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include <Eigen/Core>
+#include <nlohmann/json.hpp>
+
+#include "roughscope/core/errors.hpp"
+#include "roughscope/core/text.hpp"
+#include "roughscope/image/measure.hpp"
+#include "roughscope/scattering/beckmann.hpp"
+#include "roughscope/scattering/factors.hpp"
+#include "roughscope/scattering/geometry.hpp"
+
+namespace roughscope::image {
+namespace {
+
+using Json = nlohmann::json;
+
+struct Context {
+    std::string file;
+    std::filesystem::path dir;
+
+    [[noreturn]] void fail(const std::string& key, const std::string& reason) const {
+        throw DataError(concat(file, ": ", key, ": ", reason));
+    }
+    double number(const Json& j, const std::string& key) const {
+        if (!j.is_number()) fail(key, concat("must be a number, not ", j.dump()));
+        const double v = j.get<double>();
+        if (!std::isfinite(v)) fail(key, "must be finite");
+        return v;
+    }
+    double positive(const Json& j, const std::string& key) const {
+        const double v = number(j, key);
+        if (!(v > 0.0)) fail(key, concat(check::format_number(v), " must be > 0"));
+        return v;
+    }
+    std::string string(const Json& j, const std::string& key) const {
+        if (!j.is_string()) fail(key, concat("must be a string, not ", j.dump()));
+        return j.get<std::string>();
+    }
+    std::string path(const Json& j, const std::string& key) const {
+        const std::string p = string(j, key);
+        if (p.empty()) fail(key, "must name a file");
+        const std::filesystem::path fp(p);
+        return (fp.is_absolute() ? fp : dir / fp).lexically_normal().string();
+    }
+    std::vector<double> numbers(const Json& j, const std::string& key, std::size_t n) const {
+        if (!j.is_array() || j.size() != n)
+            fail(key,
+                 concat("must be an array of ", std::to_string(n), " numbers, not ", j.dump()));
+        std::vector<double> out;
+        for (std::size_t k = 0; k < n; ++k)
+            out.push_back(number(j[k], concat(key, "[", std::to_string(k), "]")));
+        return out;
+    }
+    template <class F>
+    auto named(const Json& j, const std::string& key, F parse) const {
+        const std::string name = string(j, key);
+        try {
+            return parse(name);
+        } catch (const InvalidArgument& e) {
+            fail(key, e.what());
+        }
+    }
+    void only(const Json& object, const std::string& key,
+              std::initializer_list<std::string_view> allowed) const {
+        if (!object.is_object()) fail(key, concat("must be an object, not ", object.dump()));
+        for (const auto& item : object.items()) {
+            bool ok = false;
+            for (const auto a : allowed) ok = ok || item.key() == a;
+            if (!ok) {
+                std::string valid;
+                for (const auto a : allowed) valid = concat(valid, valid.empty() ? "" : ", ", a);
+                fail(concat(key.empty() ? "" : concat(key, "."), item.key()),
+                     concat("unknown key; valid keys: ", valid));
+            }
+        }
+    }
+};
+
+Eigen::Vector3d unit_vector(const Context& ctx, const Json& j, const std::string& key) {
+    const auto v = ctx.numbers(j, key, 3);
+    Eigen::Vector3d d(v[0], v[1], v[2]);
+    const double n = d.norm();
+    if (!(n > 0.0)) ctx.fail(key, "must be a non-zero vector");
+    return d / n;
+}
+
+// [{"image": FILE, "exposure_s": t}, ...]: an exposure bracket (≥ 2 photographs).
+std::vector<BracketShot> parse_bracket(const Context& ctx, const Json& j, const std::string& key) {
+    if (!j.is_array() || j.size() < 2)
+        ctx.fail(key, concat("must be an array of at least 2 {\"image\": FILE, \"exposure_s\": "
+                             "t} photographs, not ",
+                             j.dump()));
+    std::vector<BracketShot> shots;
+    for (std::size_t k = 0; k < j.size(); ++k) {
+        const std::string name = concat(key, "[", std::to_string(k), "]");
+        ctx.only(j[k], name, {"image", "exposure_s"});
+        if (!j[k].contains("image") || !j[k].contains("exposure_s"))
+            ctx.fail(name, "needs \"image\" and \"exposure_s\"");
+        shots.push_back(BracketShot{ctx.path(j[k]["image"], concat(name, ".image")),
+                                    ctx.positive(j[k]["exposure_s"], concat(name, ".exposure_s"))});
+    }
+    return shots;
+}
+
+Region parse_roi(const Context& ctx, const Json& j) {
+    ctx.only(j, "roi", {"rect", "circle", "polygon", "mask"});
+    if (j.size() != 1) ctx.fail("roi", "must have exactly one of rect, circle, polygon, mask");
+    if (j.contains("rect")) {
+        const auto r = ctx.numbers(j["rect"], "roi.rect", 4);
+        return RectangleRegion{r[0], r[1], r[2], r[3]};
+    }
+    if (j.contains("circle")) {
+        const auto c = ctx.numbers(j["circle"], "roi.circle", 3);
+        return CircleRegion{c[0], c[1], c[2]};
+    }
+    if (j.contains("polygon")) {
+        const Json& p = j["polygon"];
+        if (!p.is_array()) ctx.fail("roi.polygon", "must be an array of [x, y] points");
+        std::vector<std::array<double, 2>> points;
+        for (std::size_t k = 0; k < p.size(); ++k) {
+            const auto xy = ctx.numbers(p[k], concat("roi.polygon[", std::to_string(k), "]"), 2);
+            points.push_back({xy[0], xy[1]});
+        }
+        return PolygonRegion{points};
+    }
+    const std::string file = ctx.path(j["mask"], "roi.mask");
+    return mask_region_from_image(read_image(file));
+}
+
+Geometry parse_capture_geometry(const Context& ctx, const Json& c, const std::string& key) {
+    const bool angles =
+        c.contains("theta_i_deg") || c.contains("theta_s_deg") || c.contains("phi_s_deg");
+    const bool vectors = c.contains("light") || c.contains("view");
+    if (angles && vectors)
+        ctx.fail(key,
+                 "give either theta_i_deg, theta_s_deg, phi_s_deg or light and view, not both");
+    if (vectors) {
+        if (!c.contains("light") || !c.contains("view"))
+            ctx.fail(key, "light and view must both be given");
+        const Eigen::Vector3d L = unit_vector(ctx, c["light"], concat(key, ".light"));
+        const Eigen::Vector3d V = unit_vector(ctx, c["view"], concat(key, ".view"));
+        const auto g = geometry_from_vectors(Eigen::Vector3d::UnitZ(), L, V);
+        if (!g)
+            ctx.fail(key,
+                     "the light or the view is at or below the sample's plane (z ≤ 0); the "
+                     "normal of the sample is +z");
+        return *g;
+    }
+    if (!c.contains("theta_i_deg"))
+        ctx.fail(key, "needs theta_i_deg (and theta_s_deg, phi_s_deg) or light and view");
+    Geometry g;
+    g.theta_i_rad = deg_to_rad(ctx.number(c["theta_i_deg"], concat(key, ".theta_i_deg")));
+    g.theta_s_rad = c.contains("theta_s_deg")
+                        ? deg_to_rad(ctx.number(c["theta_s_deg"], concat(key, ".theta_s_deg")))
+                        : 0.0;
+    g.phi_s_rad = c.contains("phi_s_deg")
+                      ? deg_to_rad(ctx.number(c["phi_s_deg"], concat(key, ".phi_s_deg")))
+                      : 0.0;
+    for (const auto& [name, value] :
+         {std::pair{"theta_i_deg", g.theta_i_rad}, std::pair{"theta_s_deg", g.theta_s_rad}}) {
+        if (!(value >= 0.0 && value < kPi / 2))
+            ctx.fail(concat(key, ".", name),
+                     concat(check::format_number(rad_to_deg(value)), " must be in [0, 90)"));
+    }
+    return g;
+}
+
+}  // namespace
+
+MeasureRequest parse_capture_file(std::string_view text, const std::string& path) {
+    Context ctx{path, std::filesystem::path(path).parent_path()};
+    Json doc;
+    try {
+        doc = Json::parse(text);
+    } catch (const Json::parse_error& e) {
+        throw DataError(concat(path, ": not valid JSON: ", e.what()));
+    }
+    ctx.only(doc, "",
+             {"format",
+              "version",
+              "wavelength_um",
+              "channel_wavelengths_um",
+              "response",
+              "black_level_dn",
+              "dark_frame",
+              "flat_field",
+              "roi",
+              "captures",
+              "correlation",
+              "sigma_um",
+              "sigma_um_stderr",
+              "R0",
+              "factor",
+              "radiometry",
+              "regime",
+              "highlight",
+              "statistics",
+              "white_balance",
+              "description"});
+    MeasureRequest request;
+    request.source = path;
+    if (doc.contains("format") && ctx.string(doc["format"], "format") != "roughscope-measure")
+        ctx.fail("format", "must be \"roughscope-measure\" when given");
+    if (doc.contains("wavelength_um"))
+        request.wavelength_um = ctx.positive(doc["wavelength_um"], "wavelength_um");
+    if (doc.contains("channel_wavelengths_um")) {
+        const auto w = ctx.numbers(doc["channel_wavelengths_um"], "channel_wavelengths_um", 3);
+        for (std::size_t k = 0; k < 3; ++k) {
+            if (!(w[k] > 0.0))
+                ctx.fail(concat("channel_wavelengths_um[", std::to_string(k), "]"), "must be > 0");
+            request.channel_wavelengths_um[k] = w[k];
+        }
+    }
+    if (doc.contains("response")) {
+        const Json& r = doc["response"];
+        if (r.is_object() && r.contains("bracket")) {
+            ctx.only(r, "response", {"bracket"});
+            request.response_bracket = parse_bracket(ctx, r["bracket"], "response.bracket");
+        } else if (r.is_object()) {
+            ctx.only(r, "response", {"gamma", "bracket"});
+            if (!r.contains("gamma"))
+                ctx.fail("response", "an object response needs \"gamma\" or \"bracket\"");
+            request.read.response = Response::Gamma;
+            request.read.gamma = ctx.positive(r["gamma"], "response.gamma");
+            if (request.read.gamma < 0.1 || request.read.gamma > 10.0)
+                ctx.fail("response.gamma",
+                         concat(check::format_number(request.read.gamma), " must be in [0.1, 10]"));
+        } else {
+            request.read.response = ctx.named(r, "response", parse_response);
+            if (request.read.response == Response::Gamma)
+                ctx.fail("response", "give the gamma as {\"gamma\": 2.2}");
+        }
+    }
+    if (doc.contains("black_level_dn")) {
+        // One value for every channel, or one per channel ([R, G, B]).
+        const Json& b = doc["black_level_dn"];
+        std::vector<double> levels = b.is_array()
+                                         ? ctx.numbers(b, "black_level_dn", b.size() == 3 ? 3 : 1)
+                                         : std::vector<double>{ctx.number(b, "black_level_dn")};
+        for (const double level : levels)
+            if (level < 0.0) ctx.fail("black_level_dn", "must be ≥ 0");
+        request.read.black_level_dn = std::move(levels);
+    }
+    if (doc.contains("white_balance")) {
+        if (!doc["white_balance"].is_boolean()) ctx.fail("white_balance", "must be true or false");
+        request.read.white_balance = doc["white_balance"].get<bool>();
+    }
+    if (doc.contains("dark_frame") && !doc["dark_frame"].is_null())
+        request.dark_frame = ctx.path(doc["dark_frame"], "dark_frame");
+    if (doc.contains("flat_field") && !doc["flat_field"].is_null())
+        request.flat_field = ctx.path(doc["flat_field"], "flat_field");
+    if (doc.contains("correlation"))
+        request.correlation = ctx.named(doc["correlation"], "correlation", parse_correlation);
+    if (doc.contains("regime")) request.regime = ctx.named(doc["regime"], "regime", parse_regime);
+    if (doc.contains("factor"))
+        request.factor = ctx.named(doc["factor"], "factor", parse_geometric_factor);
+    if (doc.contains("radiometry"))
+        request.radiometry = ctx.named(doc["radiometry"], "radiometry", parse_radiometry);
+    if (doc.contains("sigma_um") && !doc["sigma_um"].is_null())
+        request.sigma_um = ctx.positive(doc["sigma_um"], "sigma_um");
+    if (doc.contains("sigma_um_stderr")) {
+        request.sigma_um_stderr = ctx.number(doc["sigma_um_stderr"], "sigma_um_stderr");
+        if (request.sigma_um_stderr < 0.0) ctx.fail("sigma_um_stderr", "must be ≥ 0");
+    }
+    if (doc.contains("R0")) request.R0 = ctx.positive(doc["R0"], "R0");
+    if (doc.contains("highlight")) {
+        const Json& h = doc["highlight"];
+        ctx.only(h, "highlight",
+                 {"core_radius_px", "annulus_inner_px", "annulus_outer_px", "smoothing_sigma_px",
+                  "centre_px"});
+        if (h.contains("core_radius_px"))
+            request.highlight.core_radius_px =
+                ctx.positive(h["core_radius_px"], "highlight.core_radius_px");
+        if (h.contains("annulus_inner_px"))
+            request.highlight.annulus_inner_px =
+                ctx.positive(h["annulus_inner_px"], "highlight.annulus_inner_px");
+        if (h.contains("annulus_outer_px"))
+            request.highlight.annulus_outer_px =
+                ctx.positive(h["annulus_outer_px"], "highlight.annulus_outer_px");
+        if (h.contains("smoothing_sigma_px"))
+            request.highlight.smoothing_sigma_px =
+                ctx.positive(h["smoothing_sigma_px"], "highlight.smoothing_sigma_px");
+        if (h.contains("centre_px")) {
+            const auto c = ctx.numbers(h["centre_px"], "highlight.centre_px", 2);
+            request.highlight.centre_px = std::array<double, 2>{c[0], c[1]};
+        }
+    }
+    if (doc.contains("statistics")) {
+        const Json& s = doc["statistics"];
+        ctx.only(s, "statistics", {"tile_size_px", "max_excluded_fraction"});
+        if (s.contains("tile_size_px")) {
+            const double t = ctx.positive(s["tile_size_px"], "statistics.tile_size_px");
+            if (t != std::floor(t) || t > 1e6)
+                ctx.fail("statistics.tile_size_px", "must be a whole number of pixels ≤ 1e6");
+            request.statistics.tile_size_px = static_cast<std::size_t>(t);
+        }
+        if (s.contains("max_excluded_fraction")) {
+            const double f =
+                ctx.number(s["max_excluded_fraction"], "statistics.max_excluded_fraction");
+            if (!(f >= 0.0 && f <= 1.0))
+                ctx.fail("statistics.max_excluded_fraction", "must be in [0, 1]");
+            request.statistics.max_excluded_fraction = f;
+        }
+    }
+    if (!doc.contains("roi")) ctx.fail("roi", "missing: the region to measure is required");
+    request.roi = parse_roi(ctx, doc["roi"]);
+    if (!doc.contains("captures") || !doc["captures"].is_array() || doc["captures"].empty())
+        ctx.fail("captures", "must be a non-empty array of captures");
+    const Json& captures = doc["captures"];
+    for (std::size_t k = 0; k < captures.size(); ++k) {
+        const std::string key = concat("captures[", std::to_string(k), "]");
+        const Json& c = captures[k];
+        ctx.only(c, key,
+                 {"image", "bracket", "theta_i_deg", "theta_s_deg", "phi_s_deg", "light", "view",
+                  "exposure_s", "role", "description"});
+        CaptureSpec spec;
+        if (c.contains("image") == c.contains("bracket"))
+            ctx.fail(key,
+                     "needs \"image\" (a file) or \"bracket\" (an exposure bracket), one of them");
+        if (c.contains("bracket")) {
+            spec.bracket = parse_bracket(ctx, c["bracket"], concat(key, ".bracket"));
+            spec.image = spec.bracket.front().image;
+            if (c.contains("exposure_s"))
+                ctx.fail(concat(key, ".exposure_s"),
+                         "a bracket gives each photograph's exposure_s; a merged bracket is per "
+                         "second");
+        } else {
+            spec.image = ctx.path(c["image"], concat(key, ".image"));
+        }
+        spec.geometry = parse_capture_geometry(ctx, c, key);
+        if (c.contains("exposure_s") && !c["exposure_s"].is_null())
+            spec.exposure_s = ctx.positive(c["exposure_s"], concat(key, ".exposure_s"));
+        if (c.contains("role"))
+            spec.role = ctx.named(c["role"], concat(key, ".role"), parse_capture_role);
+        request.captures.push_back(std::move(spec));
+    }
+    return request;
+}
+
+MeasureRequest read_capture_file(const std::string& path) {
+    std::error_code ec;
+    if (std::filesystem::is_directory(path, ec))
+        throw DataError(concat(path, ": is a directory, not a capture file"));
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw DataError(concat(path, ": cannot open the capture file"));
+    std::ostringstream text;
+    text << in.rdbuf();
+    if (text.str().size() > (std::size_t{16} << 20))
+        throw DataError(concat(path, ": larger than 16 MiB: not a capture file"));
+    return parse_capture_file(text.str(), path);
+}
+
+}  // namespace roughscope::image

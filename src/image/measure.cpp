@@ -1,0 +1,448 @@
+// Roughness from photographs: captures → region brightness → the §4 estimators (measure.hpp).
+#include "roughscope/image/measure.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <utility>
+
+#include "roughscope/core/errors.hpp"
+#include "roughscope/core/names.hpp"
+#include "roughscope/core/text.hpp"
+#include "roughscope/image/radiometry.hpp"
+
+namespace roughscope::image {
+namespace {
+
+constexpr std::array<NameEntry<CaptureRole>, 2> kRoleNames{{
+    {"diffuse", CaptureRole::Diffuse},
+    {"specular", CaptureRole::Specular},
+}};
+
+std::string where(const MeasureRequest& request) {
+    return request.source.empty() ? std::string("measure") : request.source;
+}
+
+// Relative standard error of a region mean: pixel noise or, when larger, the spread between
+// tiles (texture).
+double relative_stderr(const ChannelStatistics& s) {
+    if (!(s.mean > 0.0)) return 0.0;
+    return std::max(s.stderr_pixel, s.stderr_tiles) / s.mean;
+}
+
+void check_request(const MeasureRequest& request) {
+    const std::string src = where(request);
+    if (request.captures.empty())
+        throw InvalidArgument(concat(src,
+                                     ": no captures; give at least one specular capture or "
+                                     "two diffuse captures"));
+    check::positive(concat(src, ": wavelength_um"), request.wavelength_um, " µm");
+    for (std::size_t c = 0; c < 3; ++c)
+        check::positive(concat(src, ": channel_wavelengths_um[", std::to_string(c), "]"),
+                        request.channel_wavelengths_um[c], " µm");
+    check::positive(concat(src, ": R0"), request.R0);
+    if (request.response_bracket.size() == 1)
+        throw InvalidArgument(concat(src, ": response.bracket needs at least 2 photographs"));
+    for (const BracketShot& shot : request.response_bracket)
+        check::positive(concat(src, ": response.bracket: ", shot.image, ": exposure_s"),
+                        shot.exposure_s, " s");
+    if (request.sigma_um) check::positive(concat(src, ": sigma_um"), *request.sigma_um, " µm");
+    check::non_negative(concat(src, ": sigma_um_stderr"), request.sigma_um_stderr, " µm");
+    for (std::size_t k = 0; k < request.captures.size(); ++k) {
+        const CaptureSpec& spec = request.captures[k];
+        const std::string name = concat(src, ": captures[", std::to_string(k), "]");
+        if (spec.image.empty()) throw InvalidArgument(concat(name, ": no image file given"));
+        if (spec.bracket.size() == 1)
+            throw InvalidArgument(concat(name, ": a bracket needs at least 2 photographs"));
+        for (const BracketShot& shot : spec.bracket)
+            check::positive(concat(name, ": ", shot.image, ": exposure_s"), shot.exposure_s, " s");
+        check::polar_angle(concat(name, ": theta_i"), spec.geometry.theta_i_rad);
+        check::polar_angle(concat(name, ": theta_s"), spec.geometry.theta_s_rad);
+        check::azimuth(concat(name, ": phi_s"), spec.geometry.phi_s_rad);
+        if (spec.exposure_s) check::positive(concat(name, ": exposure_s"), *spec.exposure_s, " s");
+    }
+    const auto diffuse =
+        std::count_if(request.captures.begin(), request.captures.end(),
+                      [](const CaptureSpec& s) { return s.role == CaptureRole::Diffuse; });
+    const auto specular = static_cast<std::ptrdiff_t>(request.captures.size()) - diffuse;
+    if (diffuse == 1 && specular == 0)
+        throw InvalidArgument(concat(src,
+                                     ": one diffuse capture gives no estimate; give a second "
+                                     "diffuse capture at another light or view direction, "
+                                     "or a specular capture"));
+}
+
+// The exposure scale s_k of every capture (measure.hpp) and where its time came from.
+void assign_exposures(std::vector<CaptureMeasurement>& captures, std::vector<std::string>& warnings,
+                      const std::string& src) {
+    std::size_t known = 0;
+    for (auto& c : captures) {
+        if (c.spec.exposure_s) {
+            c.exposure_scale = *c.spec.exposure_s;
+            c.exposure_source = "capture file";
+            ++known;
+        } else if (c.info.exposure_s && *c.info.exposure_s > 0.0) {
+            c.exposure_scale = *c.info.exposure_s;
+            c.exposure_source = "metadata";
+            ++known;
+        }
+    }
+    if (known == 0) {
+        for (auto& c : captures) {
+            c.exposure_scale = 1.0;
+            c.exposure_source = "assumed equal";
+        }
+        if (captures.size() > 1)
+            warnings.push_back(concat(src,
+                                      ": no capture gives an exposure time (exposure_s or "
+                                      "EXIF/RAW metadata): all are taken as equal"));
+        return;
+    }
+    if (known < captures.size()) {
+        // Only the diffuse captures are compared with each other: a specular capture's σ comes
+        // from a ratio within the one image (Eq. 13) and needs no exposure time.
+        for (std::size_t k = 0; k < captures.size(); ++k)
+            if (captures[k].exposure_source.empty() &&
+                captures[k].spec.role == CaptureRole::Specular) {
+                captures[k].exposure_scale = 1.0;
+                captures[k].exposure_source = "not needed (specular)";
+            }
+        for (std::size_t k = 0; k < captures.size(); ++k)
+            if (captures[k].exposure_source.empty())
+                throw DataError(concat(src, ": captures[", std::to_string(k), "] (",
+                                       captures[k].spec.image,
+                                       ") has no exposure time while others have one; give "
+                                       "exposure_s for it"));
+    }
+    // ISO and f-number: used when every capture's metadata gives them (s ∝ t · ISO / N²).
+    const bool all_iso = std::all_of(captures.begin(), captures.end(),
+                                     [](const auto& c) { return c.info.iso && *c.info.iso > 0.0; });
+    const bool all_f = std::all_of(captures.begin(), captures.end(), [](const auto& c) {
+        return c.info.f_number && *c.info.f_number > 0.0;
+    });
+    for (auto& c : captures) {
+        if (all_iso) c.exposure_scale *= *c.info.iso / *captures.front().info.iso;
+        if (all_f) {
+            const double ratio = *captures.front().info.f_number / *c.info.f_number;
+            c.exposure_scale *= ratio * ratio;
+        }
+    }
+}
+
+// 8-bit files on the code scale (value · 255 = the stored code), for response curves.
+ReadOptions code_scale() {
+    ReadOptions options;
+    options.response = Response::Linear;
+    options.black_level_dn = std::vector<double>{0.0};
+    return options;
+}
+
+// The images of a bracket on the code scale, and their exposure times.
+std::pair<std::vector<LinearImage>, std::vector<double>> read_bracket(
+    const std::vector<BracketShot>& shots) {
+    std::vector<LinearImage> images;
+    std::vector<double> times;
+    for (const BracketShot& shot : shots) {
+        images.push_back(read_image(shot.image, code_scale()));
+        times.push_back(shot.exposure_s);
+    }
+    return {std::move(images), std::move(times)};
+}
+
+// How the files become linear: the declared response (read_image), or a curve recovered from
+// the request's exposure bracket.
+class Loader {
+  public:
+    explicit Loader(const MeasureRequest& request) : request_(request) {
+        if (!request.response_bracket.empty()) {
+            const auto [images, times] = read_bracket(request.response_bracket);
+            curve_ = recover_response_debevec(images, times);
+        }
+    }
+    LinearImage image(const std::string& path) const {
+        if (!curve_) return read_image(path, request_.read);
+        LinearImage image = read_image(path, code_scale());
+        apply_response_curve(image, *curve_);
+        return image;
+    }
+    LinearImage capture(const CaptureSpec& spec) const {
+        if (spec.bracket.empty()) return image(spec.image);
+        const auto [images, times] = read_bracket(spec.bracket);
+        const ResponseCurve curve =
+            curve_ ? *curve_
+                   : response_curve_of(request_.read.response.value_or(Response::Srgb),
+                                       request_.read.gamma, images.front().channels);
+        return merge_hdr(images, times, curve);
+    }
+
+  private:
+    const MeasureRequest& request_;
+    std::optional<ResponseCurve> curve_;
+};
+
+void check_same_size(const LinearImage& image, const LinearImage& first, const std::string& src) {
+    if (image.width != first.width || image.height != first.height ||
+        image.channels != first.channels)
+        throw DataError(concat(src, ": ", image.info.source, " is ", std::to_string(image.width),
+                               " x ", std::to_string(image.height), " x ",
+                               std::to_string(image.channels), " but ", first.info.source, " is ",
+                               std::to_string(first.width), " x ", std::to_string(first.height),
+                               " x ", std::to_string(first.channels),
+                               ": every capture (and the dark frame and flat field) must have the "
+                               "same size and channels"));
+}
+
+// σ per channel from one specular capture (Eq. 13, with each channel's λ) and from the RGB
+// average (λ of the request); their agreement as χ² about the weighted mean.
+void estimate_specular(const CaptureMeasurement& capture, const MeasureRequest& request,
+                       MeasureResult& result) {
+    const HighlightMeasurement& h = *capture.highlight;
+    const Geometry& g = capture.spec.geometry;
+    const std::size_t channels = h.core.channels.size();
+    auto one = [&](const ChannelStatistics& tot, const ChannelStatistics& dif, double lambda_um,
+                   std::string channel) {
+        SpecularInput input;
+        input.E_tot = tot.mean;
+        input.E_dif = dif.mean;
+        input.theta_rad = g.theta_i_rad;
+        input.wavelength_um = lambda_um;
+        input.R0 = request.R0;
+        input.relative_noise_tot = relative_stderr(tot);
+        input.relative_noise_dif = relative_stderr(dif);
+        ChannelSigma cs;
+        cs.channel = std::move(channel);
+        cs.wavelength_um = lambda_um;
+        cs.estimate = estimate_sigma_specular(input);
+        return cs;
+    };
+    if (channels == 3) {
+        static constexpr std::array<const char*, 3> kNames{"R", "G", "B"};
+        for (std::size_t c = 0; c < 3; ++c) {
+            try {
+                result.specular_sigma.push_back(one(h.core.channels[c], h.annulus.channels[c],
+                                                    request.channel_wavelengths_um[c], kNames[c]));
+            } catch (const Error& e) {
+                result.warnings.push_back(
+                    concat(capture.spec.image, ": channel ", kNames[c], ": no σ: ", e.what()));
+            }
+        }
+    }
+    ChannelSigma average = one(h.core.average, h.annulus.average, request.wavelength_um,
+                               channels == 3 ? "average" : "grey");
+    result.sigma = average.estimate;
+    result.specular_sigma.push_back(std::move(average));
+    // Channel agreement: χ² of the per-channel σ about their inverse-variance weighted mean.
+    if (channels == 3 && result.specular_sigma.size() == 4) {
+        double sw = 0.0, swx = 0.0;
+        bool have_errors = true;
+        for (std::size_t c = 0; c < 3; ++c) {
+            const Estimate& s = *result.specular_sigma[c].estimate.sigma_um;
+            if (!(s.std_error > 0.0)) have_errors = false;
+            if (!have_errors) break;
+            const double w = 1.0 / (s.std_error * s.std_error);
+            sw += w;
+            swx += w * s.value;
+        }
+        if (have_errors) {
+            const double mean = swx / sw;
+            double chi2 = 0.0;
+            for (std::size_t c = 0; c < 3; ++c) {
+                const Estimate& s = *result.specular_sigma[c].estimate.sigma_um;
+                chi2 += (s.value - mean) * (s.value - mean) / (s.std_error * s.std_error);
+            }
+            result.channel_sigma_chi2 = chi2;
+            result.channel_sigma_dof = 2;
+            // χ²(2) exceeds 9.21 with probability 1 %.
+            if (chi2 > 9.21)
+                result.warnings.push_back(concat(
+                    capture.spec.image,
+                    ": σ differs between the R, G and B channels beyond their "
+                    "standard errors (χ² = ",
+                    check::format_number(chi2),
+                    " with 2 degrees of freedom): the σ–λ scaling of Eq. 13 does not hold; check "
+                    "the channel wavelengths, the response and the highlight regions"));
+        }
+    }
+}
+
+void estimate_diffuse(const std::vector<const CaptureMeasurement*>& diffuse,
+                      const MeasureRequest& request, std::optional<double> sigma_um,
+                      double sigma_um_stderr, MeasureResult& result) {
+    const CaptureMeasurement& c1 = *diffuse[0];
+    const CaptureMeasurement& c2 = *diffuse[1];
+    const double ratio = c1.brightness / c2.brightness;
+    const double e1 = c1.brightness_relative_stderr;
+    const double e2 = c2.brightness_relative_stderr;
+    result.E1_over_E2 = Estimate{ratio, ratio * std::hypot(e1, e2)};
+
+    TwoGeometryOptions options;
+    options.factor = request.factor;
+    options.radiometry = request.radiometry;
+    options.wavelength_um = request.wavelength_um;
+    options.regime = request.regime;
+    std::vector<std::string> failures;
+    for (const Correlation correlation : {Correlation::Gaussian, Correlation::Exponential}) {
+        SlopeInput input;
+        input.E1_over_E2 = ratio;
+        input.geom1 = c1.spec.geometry;
+        input.geom2 = c2.spec.geometry;
+        input.correlation = correlation;
+        input.options = options;
+        input.noise = BrightnessNoise{e1, e2};
+        input.sigma_um = sigma_um;
+        try {
+            RoughnessEstimate estimate = estimate_slope(input);
+            (correlation == Correlation::Gaussian ? result.slope_gaussian
+                                                  : result.slope_exponential) = std::move(estimate);
+        } catch (const NoSolution& e) {
+            failures.push_back(concat("σ/T (", to_string(correlation), "): ", e.what()));
+        }
+    }
+    if (sigma_um) {
+        CorrelationLengthInput input;
+        input.E1_over_E2 = ratio;
+        input.sigma_um = *sigma_um;
+        input.sigma_um_std_error = sigma_um_stderr;
+        input.geom1 = c1.spec.geometry;
+        input.geom2 = c2.spec.geometry;
+        input.correlation = request.correlation;
+        input.options = options;
+        input.noise = BrightnessNoise{e1, e2};
+        try {
+            result.correlation_length = estimate_correlation_length(input);
+        } catch (const NoSolution& e) {
+            failures.push_back(concat("T given σ: ", e.what()));
+        }
+    }
+    if (!result.slope_gaussian && !result.slope_exponential && !result.correlation_length) {
+        std::string message =
+            concat(where(request), ": E1/E2 = ", check::format_number(ratio), " of ", c1.spec.image,
+                   " and ", c2.spec.image, " has no solution:");
+        for (const auto& f : failures) message = concat(message, " ", f, ";");
+        throw NoSolution(message);
+    }
+    for (const auto& f : failures) result.warnings.push_back(concat(where(request), ": ", f));
+    for (const auto* e :
+         {&result.slope_gaussian, &result.slope_exponential, &result.correlation_length})
+        if (*e)
+            for (const auto& w : (*e)->warnings) result.warnings.push_back(w);
+
+    if (diffuse.size() >= 3) {
+        std::vector<Measurement> measurements;
+        for (const CaptureMeasurement* c : diffuse) {
+            Measurement m;
+            m.geometry = c->spec.geometry;
+            m.brightness = c->brightness;
+            const double e = c->brightness_relative_stderr;
+            m.weight = e > 0.0 ? 1.0 / (e * e) : 1.0;
+            measurements.push_back(m);
+        }
+        FitOptions fit_options;
+        fit_options.factor = request.factor;
+        fit_options.radiometry = request.radiometry;
+        fit_options.wavelength_um = request.wavelength_um;
+        result.fit = compare_correlations(measurements, fit_options);
+    }
+}
+
+}  // namespace
+
+std::string_view to_string(CaptureRole role) { return name_of(kRoleNames, role); }
+
+CaptureRole parse_capture_role(std::string_view name) {
+    return parse_name(kRoleNames, "capture role", name);
+}
+
+MeasureResult measure(const MeasureRequest& request) {
+    check_request(request);
+    const std::string src = where(request);
+    MeasureResult result;
+
+    const Loader loader(request);
+    std::optional<LinearImage> dark, flat;
+    if (request.dark_frame) dark = loader.image(*request.dark_frame);
+    if (request.flat_field) flat = loader.image(*request.flat_field);
+
+    std::vector<std::uint8_t> mask;
+    std::optional<LinearImage> first;
+    for (const CaptureSpec& spec : request.captures) {
+        CaptureMeasurement capture;
+        capture.spec = spec;
+        // A merged bracket is per second of exposure.
+        if (!spec.bracket.empty()) capture.spec.exposure_s = 1.0;
+        LinearImage image = loader.capture(spec);
+        if (!first) {
+            first = LinearImage{};
+            first->width = image.width;
+            first->height = image.height;
+            first->channels = image.channels;
+            first->info.source = image.info.source;
+            mask = rasterize(request.roi, image.width, image.height);
+            result.region_pixels = static_cast<std::size_t>(
+                std::count_if(mask.begin(), mask.end(), [](std::uint8_t m) { return m != 0; }));
+        }
+        check_same_size(image, *first, src);
+        if (dark) {
+            check_same_size(*dark, *first, src);
+            subtract_dark_frame(image, *dark);
+        }
+        if (flat) {
+            check_same_size(*flat, *first, src);
+            divide_flat_field(image, *flat);
+        }
+        for (const auto& w : image.info.warnings)
+            result.warnings.push_back(concat(spec.image, ": ", w));
+        if (spec.role == CaptureRole::Specular) {
+            capture.highlight = measure_highlight(image, mask, request.highlight);
+            capture.region = capture.highlight->core;
+            for (const auto& w : capture.highlight->warnings)
+                result.warnings.push_back(concat(spec.image, ": ", w));
+        } else {
+            capture.region = region_statistics(image, mask, request.statistics);
+            for (const auto& w : capture.region.warnings)
+                result.warnings.push_back(concat(spec.image, ": ", w));
+        }
+        capture.info = std::move(image.info);
+        result.captures.push_back(std::move(capture));
+    }
+    assign_exposures(result.captures, result.warnings, src);
+    std::vector<const CaptureMeasurement*> diffuse;
+    for (CaptureMeasurement& c : result.captures) {
+        if (c.spec.role != CaptureRole::Diffuse) continue;
+        const ChannelStatistics& avg = c.region.average;
+        if (!(avg.mean > 0.0))
+            throw InvalidArgument(concat(src, ": ", c.spec.image, ": the region's mean brightness ",
+                                         check::format_number(avg.mean),
+                                         " is not above the black level (after the dark frame): "
+                                         "nothing to measure; check the exposure and the region"));
+        c.brightness = avg.mean / c.exposure_scale;
+        c.brightness_relative_stderr = relative_stderr(avg);
+        diffuse.push_back(&c);
+    }
+
+    std::optional<double> sigma_um = request.sigma_um;
+    double sigma_um_stderr = request.sigma_um_stderr;
+    for (const CaptureMeasurement& c : result.captures) {
+        if (c.spec.role != CaptureRole::Specular) continue;
+        const Geometry& g = c.spec.geometry;
+        if (std::abs(g.theta_i_rad - g.theta_s_rad) > 1e-9 ||
+            std::abs(std::remainder(g.phi_s_rad, 2 * kPi)) > 1e-9)
+            throw InvalidArgument(
+                concat(src, ": ", c.spec.image,
+                       ": a specular capture must be taken in the specular "
+                       "direction (theta_s = theta_i, phi_s = 0); got theta_i = ",
+                       check::format_number(rad_to_deg(g.theta_i_rad)),
+                       "°, theta_s = ", check::format_number(rad_to_deg(g.theta_s_rad)),
+                       "°, phi_s = ", check::format_number(rad_to_deg(g.phi_s_rad)), "°"));
+        estimate_specular(c, request, result);
+        break;  // the first specular capture gives σ
+    }
+    if (!sigma_um && result.sigma && result.sigma->sigma_um) {
+        sigma_um = result.sigma->sigma_um->value;
+        sigma_um_stderr = result.sigma->sigma_um->std_error;
+    }
+    if (diffuse.size() >= 2) estimate_diffuse(diffuse, request, sigma_um, sigma_um_stderr, result);
+    return result;
+}
+
+}  // namespace roughscope::image

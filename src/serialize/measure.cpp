@@ -1,0 +1,173 @@
+// A measurement from photographs as JSON (serialize/measure.hpp).
+#include "roughscope/serialize/measure.hpp"
+
+#include <string>
+
+#include "roughscope/scattering/beckmann.hpp"
+#include "roughscope/scattering/validity.hpp"
+#include "roughscope/serialize/estimation.hpp"
+
+namespace roughscope::serialize {
+namespace {
+
+Json channel_json(const image::ChannelStatistics& s) {
+    Json out;
+    out["mean"] = number(s.mean);
+    out["robust_mean"] = number(s.robust_mean);
+    out["std"] = number(s.std_dev);
+    out["stderr_pixel"] = number(s.stderr_pixel);
+    out["stderr_tiles"] = number(s.stderr_tiles);
+    out["count"] = s.count;
+    out["tiles"] = s.tiles;
+    return out;
+}
+
+void put(Json& out, const std::string& key, const std::optional<Estimate>& e) {
+    out[key] = e ? number(e->value) : Json();
+    out[key + "_stderr"] = e ? number(e->std_error) : Json();
+}
+
+std::optional<Estimate> degrees_of(const std::optional<Estimate>& e) {
+    if (!e) return std::nullopt;
+    return Estimate{rad_to_deg(e->value), rad_to_deg(e->std_error)};
+}
+
+Json optional_estimate(const std::optional<RoughnessEstimate>& e) {
+    return e ? to_json(*e, true) : Json();
+}
+
+Json capture_json(const image::CaptureMeasurement& c) {
+    Json out;
+    out["image"] = c.spec.image;
+    out["role"] = std::string(image::to_string(c.spec.role));
+    out["theta_i_deg"] = degrees(c.spec.geometry.theta_i_rad);
+    out["theta_s_deg"] = degrees(c.spec.geometry.theta_s_rad);
+    out["phi_s_deg"] = degrees(c.spec.geometry.phi_s_rad);
+    out["exposure_scale"] = number(c.exposure_scale);
+    out["exposure_source"] = c.exposure_source;
+    out["format"] = c.info.format;
+    out["bits_per_sample"] = c.info.bits_per_sample;
+    out["response"] = std::string(to_string(c.info.response));
+    out["file_response"] =
+        c.info.file_response ? Json(std::string(to_string(*c.info.file_response))) : Json();
+    out["file_response_evidence"] = text_or_null(c.info.file_response_evidence);
+    out["exposure_s_metadata"] = number(c.info.exposure_s);
+    out["iso_metadata"] = number(c.info.iso);
+    out["f_number_metadata"] = number(c.info.f_number);
+    if (c.spec.role == image::CaptureRole::Diffuse) {
+        out["brightness"] = number(c.brightness);
+        out["brightness_relative_stderr"] = number(c.brightness_relative_stderr);
+    } else {
+        out["brightness"] = Json();
+        out["brightness_relative_stderr"] = Json();
+    }
+    out["region"] = to_json(c.region);
+    if (c.highlight) {
+        const image::HighlightMeasurement& h = *c.highlight;
+        Json hj;
+        hj["centre_px"] = Json::array({number(h.centre_x_px), number(h.centre_y_px)});
+        hj["width_px"] = number(h.width_px);
+        hj["core_radius_px"] = number(h.core_radius_px);
+        hj["annulus_inner_px"] = number(h.annulus_inner_px);
+        hj["annulus_outer_px"] = number(h.annulus_outer_px);
+        hj["E_tot"] = number(h.E_tot);
+        hj["E_tot_relative_stderr"] = number(h.E_tot_relative_stderr);
+        hj["E_dif"] = number(h.E_dif);
+        hj["E_dif_relative_stderr"] = number(h.E_dif_relative_stderr);
+        hj["R_spec"] = h.E_tot > 0.0 ? number(1.0 - h.E_dif / h.E_tot) : Json();
+        hj["core"] = to_json(h.core);
+        hj["annulus"] = to_json(h.annulus);
+        out["highlight"] = hj;
+    } else {
+        out["highlight"] = Json();
+    }
+    return out;
+}
+
+}  // namespace
+
+Json to_json(const image::RegionStatistics& s) {
+    Json out;
+    out["pixels_in_region"] = s.pixels_in_region;
+    out["pixels_used"] = s.pixels_used;
+    out["pixels_saturated"] = s.pixels_saturated;
+    out["pixels_clipped_low"] = s.pixels_clipped_low;
+    Json channels = Json::array();
+    for (const auto& c : s.channels) channels.push_back(channel_json(c));
+    out["channels"] = channels;
+    out["average"] = channel_json(s.average);
+    out["warnings"] = s.warnings;
+    return out;
+}
+
+Json to_json(const image::MeasureResult& r, const image::MeasureRequest& request) {
+    Json out;
+    out["format"] = "roughscope-measurement";
+    out["version"] = 1;
+    out["capture_file"] = text_or_null(request.source);
+    put(out, "E1_over_E2", r.E1_over_E2);
+    // σ/T of both correlations; σ and T where the captures give them.
+    put(out, "sigma_over_T_gaussian",
+        r.slope_gaussian ? r.slope_gaussian->sigma_over_T : std::nullopt);
+    put(out, "sigma_over_T_exponential",
+        r.slope_exponential ? r.slope_exponential->sigma_over_T : std::nullopt);
+    std::optional<Estimate> sigma;
+    if (request.sigma_um)
+        sigma = Estimate{*request.sigma_um, request.sigma_um_stderr};
+    else if (r.sigma && r.sigma->sigma_um)
+        sigma = r.sigma->sigma_um;
+    put(out, "sigma_um", sigma);
+    std::optional<Estimate> T;
+    if (r.correlation_length && r.correlation_length->T_um)
+        T = r.correlation_length->T_um;
+    else if (r.slope_gaussian && r.slope_gaussian->T_um)
+        T = r.slope_gaussian->T_um;
+    put(out, "T_um", T);
+    // Derived quantities (§3.5) and the class: from the Gaussian σ/T when there is one, else from
+    // T given σ, else from the specular σ.
+    const RoughnessEstimate* derived = r.slope_gaussian       ? &*r.slope_gaussian
+                                       : r.correlation_length ? &*r.correlation_length
+                                       : r.sigma              ? &*r.sigma
+                                                              : nullptr;
+    put(out, "rms_slope", derived ? derived->rms_slope : std::nullopt);
+    put(out, "theta_K_deg", derived ? degrees_of(derived->theta_K_rad) : std::nullopt);
+    put(out, "xi_K", derived ? derived->xi_K : std::nullopt);
+    // The class: from g when σ is known (the specular estimate or T given σ), else assumed.
+    const RoughnessEstimate* classed = r.correlation_length ? &*r.correlation_length
+                                       : r.sigma            ? &*r.sigma
+                                                            : derived;
+    out["roughness_class"] =
+        classed ? Json(std::string(to_string(classed->roughness_class))) : Json();
+    out["roughness_class_assumed"] = classed ? Json(classed->roughness_class_assumed) : Json();
+    Json specular;
+    if (!r.specular_sigma.empty()) {
+        Json channels = Json::array();
+        for (const auto& c : r.specular_sigma) {
+            Json cj;
+            cj["channel"] = c.channel;
+            cj["wavelength_um"] = number(c.wavelength_um);
+            put(cj, "sigma_um", c.estimate.sigma_um);
+            cj["roughness_class"] = std::string(to_string(c.estimate.roughness_class));
+            channels.push_back(cj);
+        }
+        specular["channels"] = channels;
+        specular["channel_chi2"] = number(r.channel_sigma_chi2);
+        specular["channel_dof"] = r.channel_sigma_dof;
+    }
+    out["specular"] = specular;
+    out["slope_gaussian"] = optional_estimate(r.slope_gaussian);
+    out["slope_exponential"] = optional_estimate(r.slope_exponential);
+    out["correlation_length"] = optional_estimate(r.correlation_length);
+    out["fit"] = r.fit ? to_json(*r.fit, false) : Json();
+    Json region;
+    region["description"] = image::describe(request.roi);
+    region["pixels"] = r.region_pixels;
+    out["region"] = region;
+    Json captures = Json::array();
+    for (const auto& c : r.captures) captures.push_back(capture_json(c));
+    out["captures"] = captures;
+    out["warnings"] = r.warnings;
+    return out;
+}
+
+}  // namespace roughscope::serialize
