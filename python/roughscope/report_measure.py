@@ -359,8 +359,11 @@ def write_demo_sample(sample, folder):
             "roi": {"rect": [margin, margin, DEMO_SIZE - 2 * margin, DEMO_SIZE - 2 * margin]},
             "captures": captures}
     if "sigma_um" in sample:
+        # T given σ from the exact series (the pair is rendered with it; at this sample's
+        # g ≈ 4 the paper's Eq. 15, "regime": "slightly_rough", reads T about 25 % high).
         spec["wavelength_um"] = DEMO_WAVELENGTH_UM
         spec["correlation"] = sample["correlation"]
+        spec["regime"] = "series"
     if sample["fmt"] != "dng":  # a RAW file carries its own black level
         spec["black_level_dn"] = _demo_black_level(sample)
     path = folder / "capture-file.json"

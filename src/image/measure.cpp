@@ -322,10 +322,14 @@ void estimate_diffuse(const std::vector<const CaptureMeasurement*>& diffuse,
         throw NoSolution(message);
     }
     for (const auto& f : failures) result.warnings.push_back(concat(where(request), ": ", f));
-    for (const auto* e :
-         {&result.slope_gaussian, &result.slope_exponential, &result.correlation_length})
-        if (*e)
-            for (const auto& w : (*e)->warnings) result.warnings.push_back(w);
+    // The warnings of the estimates behind the headline values (σ/T Gaussian gives θK, ξK and
+    // the slope; T given σ): the exponential estimate keeps its own in its object.
+    const std::array<std::pair<const char*, const std::optional<RoughnessEstimate>*>, 2> estimates{
+        {{"σ/T", &result.slope_gaussian}, {"T given σ", &result.correlation_length}}};
+    for (const auto& [label, estimate] : estimates)
+        if (*estimate)
+            for (const auto& w : (*estimate)->warnings)
+                result.warnings.push_back(concat(label, ": ", w));
 
     if (diffuse.size() >= 3) {
         std::vector<Measurement> measurements;
@@ -442,6 +446,12 @@ MeasureResult measure(const MeasureRequest& request) {
         sigma_um_stderr = result.sigma->sigma_um->std_error;
     }
     if (diffuse.size() >= 2) estimate_diffuse(diffuse, request, sigma_um, sigma_um_stderr, result);
+    // Each warning once, in the order first given.
+    std::vector<std::string> unique;
+    for (auto& w : result.warnings)
+        if (std::find(unique.begin(), unique.end(), w) == unique.end())
+            unique.push_back(std::move(w));
+    result.warnings = std::move(unique);
     return result;
 }
 
