@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cassert>
 #include <cmath>
+#include <cstdint>
+#include <limits>
 
 #include "roughscope/core/errors.hpp"
 #include "roughscope/core/text.hpp"
@@ -18,6 +20,9 @@ constexpr std::size_t kMinTileSizePx = 4;
 constexpr std::size_t kTargetTiles = 32;  // t0 = ⌊√(n / 32)⌋
 constexpr std::size_t kMinAutoTiles = 16;
 
+// Pixel indices are 32-bit (region_statistics).
+constexpr std::size_t kMaxImagePixelsForStatistics = std::numeric_limits<std::uint32_t>::max();
+
 std::string image_name(const LinearImage& image) {
     return image.info.source.empty() ? std::string("image") : image.info.source;
 }
@@ -25,7 +30,7 @@ std::string image_name(const LinearImage& image) {
 std::string fraction_text(double f) { return check::format_number(f); }
 
 // Median of `v` (reorders it); v not empty.
-double median_of(std::vector<double>& v) {
+double median_of(std::vector<float>& v) {
     assert(!v.empty());
     const std::size_t mid = v.size() / 2;
     std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(mid), v.end());
@@ -38,13 +43,14 @@ double median_of(std::vector<double>& v) {
 // Huber M-estimate of location with a fixed scale s = 1.4826 · MAD (iteratively reweighted mean,
 // w = min(1, k s / |v − μ|), from the median). MAD = 0 (more than half the values equal): s from
 // the mean absolute deviation √(π/2) · mean |v − median|; all values equal: the median.
-double huber_mean(const std::vector<double>& values) {
-    std::vector<double> work = values;
+double huber_mean(const std::vector<float>& values) {
+    std::vector<float> work = values;
     const double med = median_of(work);
     double mean_abs = 0.0;
     for (std::size_t i = 0; i < values.size(); ++i) {
-        work[i] = std::abs(values[i] - med);
-        mean_abs += work[i];
+        const double d = std::abs(static_cast<double>(values[i]) - med);
+        work[i] = static_cast<float>(d);
+        mean_abs += d;
     }
     mean_abs /= static_cast<double>(values.size());
     double scale = kMadToSigma * median_of(work);
@@ -54,7 +60,8 @@ double huber_mean(const std::vector<double>& values) {
     double mu = med;
     for (int iteration = 0; iteration < kHuberMaxIterations; ++iteration) {
         double sum_w = 0.0, sum_wv = 0.0;
-        for (const double v : values) {
+        for (const float value : values) {
+            const double v = value;
             const double d = std::abs(v - mu);
             const double w = d <= cut ? 1.0 : cut / d;
             sum_w += w;
@@ -68,16 +75,16 @@ double huber_mean(const std::vector<double>& values) {
     return mu;
 }
 
-ChannelStatistics series_statistics(const std::vector<double>& values) {
+ChannelStatistics series_statistics(const std::vector<float>& values) {
     ChannelStatistics s;
     s.count = values.size();
     assert(s.count > 0);
     double sum = 0.0;
-    for (const double v : values) sum += v;
+    for (const float v : values) sum += v;
     s.mean = sum / static_cast<double>(s.count);
     if (s.count > 1) {
         double ss = 0.0;
-        for (const double v : values) ss += (v - s.mean) * (v - s.mean);
+        for (const float v : values) ss += (v - s.mean) * (v - s.mean);
         s.std_dev = std::sqrt(ss / static_cast<double>(s.count - 1));
     }
     s.stderr_pixel = s.std_dev / std::sqrt(static_cast<double>(s.count));
@@ -106,16 +113,16 @@ TileGrid tile_grid(const Box& box, std::size_t t) {
 
 bool tile_counts(std::size_t used, std::size_t t) { return 2 * used >= t * t; }
 
-std::size_t counting_tiles(const std::vector<std::size_t>& used, const Box& box, std::size_t width,
+std::size_t counting_tiles(const std::vector<std::uint32_t>& used, const Box& box, std::size_t width,
                            std::size_t t) {
     const TileGrid g = tile_grid(box, t);
     std::vector<std::size_t> n(g.ntx * g.nty, 0);
-    for (const std::size_t k : used) ++n[g.index(k % width, k / width)];
+    for (const std::uint32_t k : used) ++n[g.index(k % width, k / width)];
     return static_cast<std::size_t>(
         std::count_if(n.begin(), n.end(), [t](std::size_t c) { return tile_counts(c, t); }));
 }
 
-std::size_t choose_tile_size(const std::vector<std::size_t>& used, const Box& box,
+std::size_t choose_tile_size(const std::vector<std::uint32_t>& used, const Box& box,
                              std::size_t width) {
     const auto t0 = static_cast<std::size_t>(
         std::floor(std::sqrt(static_cast<double>(used.size()) / kTargetTiles)));
@@ -129,7 +136,7 @@ std::size_t choose_tile_size(const std::vector<std::size_t>& used, const Box& bo
 }
 
 // std of the tile means / √tiles for each series (the planes, then the average).
-void tile_errors(const LinearImage& image, const std::vector<std::size_t>& used, const Box& box,
+void tile_errors(const LinearImage& image, const std::vector<std::uint32_t>& used, const Box& box,
                  std::size_t t, RegionStatistics& out) {
     const std::size_t planes = image.channels;
     const std::size_t pixels = image.pixel_count();
@@ -137,7 +144,7 @@ void tile_errors(const LinearImage& image, const std::vector<std::size_t>& used,
     const std::size_t cells = g.ntx * g.nty;
     std::vector<std::size_t> n(cells, 0);
     std::vector<double> sums(cells * (planes + 1), 0.0);  // per tile: planes, then the average
-    for (const std::size_t k : used) {
+    for (const std::uint32_t k : used) {
         const std::size_t cell = g.index(k % image.width, k / image.width);
         ++n[cell];
         double average = 0.0;
@@ -194,7 +201,14 @@ RegionStatistics region_statistics(const LinearImage& image, const std::vector<s
                                      " pixels; the sizes must be equal"));
 
     RegionStatistics out;
-    std::vector<std::size_t> used;
+    // Pixel indices as 32 bits and the series as float (the image's own precision; sums are
+    // double): the memory of a measurement stays a few times one decoded image.
+    static_assert(kMaxImagePixelsForStatistics <= std::numeric_limits<std::uint32_t>::max());
+    if (pixels > kMaxImagePixelsForStatistics)
+        throw InvalidArgument(concat(name, ": ", std::to_string(pixels), " pixels, more than the ",
+                                     std::to_string(kMaxImagePixelsForStatistics),
+                                     " region statistics handle"));
+    std::vector<std::uint32_t> used;
     Box box{image.width, image.height, 0, 0};
     for (std::size_t k = 0; k < pixels; ++k) {
         if (mask[k] == 0) continue;
@@ -203,7 +217,7 @@ RegionStatistics region_statistics(const LinearImage& image, const std::vector<s
         if (f & kPixelSaturated) ++out.pixels_saturated;
         if (f & kPixelClippedLow) ++out.pixels_clipped_low;
         if (f != 0) continue;
-        used.push_back(k);
+        used.push_back(static_cast<std::uint32_t>(k));
         const std::size_t x = k % image.width, y = k / image.width;
         box.x0 = std::min(box.x0, x);
         box.y0 = std::min(box.y0, y);
@@ -233,7 +247,7 @@ RegionStatistics region_statistics(const LinearImage& image, const std::vector<s
         out.warnings.push_back(concat(counts, " and left out"));
 
     // Per plane and for the per-pixel channel average.
-    std::vector<double> series(used.size());
+    std::vector<float> series(used.size());
     for (std::size_t c = 0; c < image.channels; ++c) {
         const float* plane = image.plane(c);
         for (std::size_t i = 0; i < used.size(); ++i) series[i] = plane[used[i]];
@@ -245,7 +259,7 @@ RegionStatistics region_statistics(const LinearImage& image, const std::vector<s
         for (std::size_t i = 0; i < used.size(); ++i) {
             double sum = 0.0;
             for (std::size_t c = 0; c < image.channels; ++c) sum += image.plane(c)[used[i]];
-            series[i] = sum / static_cast<double>(image.channels);
+            series[i] = static_cast<float>(sum / static_cast<double>(image.channels));
         }
         out.average = series_statistics(series);
     }
