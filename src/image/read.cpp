@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstring>
 #include <filesystem>
+#include <limits>
 #include <string>
 #include <string_view>
 #include <type_traits>
@@ -272,6 +273,21 @@ Linearizer::Linearizer(LinearImage& image, const Layout& layout, const Evidence&
             throw InvalidArgument(concat(name, ": ", text));
         throw DataError(concat(name, ": ", text, " (corrupt levels)"));
     }
+    if (!layout.is_float) {
+        // The extreme codes (the response is monotonic) must give values a float holds.
+        const double largest =
+            layout.largest_code > 0.0 ? layout.largest_code : std::ldexp(1.0, layout.bits) - 1.0;
+        for (std::size_t c = 0; c < planes; ++c) {
+            const double range = white_ - black_[c];
+            const double extreme = std::max(std::abs(linear_code(largest) - black_[c]),
+                                            std::abs(linear_code(0.0) - black_[c])) /
+                                   range;
+            if (extreme <= std::numeric_limits<float>::max()) continue;
+            throw InvalidArgument(concat(name, ": black level ", number(black_[c]),
+                                         " DN and white level ", number(white_),
+                                         " DN give linear values beyond the float range"));
+        }
+    }
 
     info.bits_per_sample = layout.bits;
     info.is_float = layout.is_float;
@@ -340,7 +356,13 @@ void Linearizer::put(const T* samples, std::size_t row, std::size_t stride, std:
                                        std::to_string(row), ", column ", std::to_string(x),
                                        " of plane ", std::to_string(plane), " is not finite"));
             const double s = response_ == Response::Linear ? q : linear_code(q);
-            out[x] = static_cast<float>((s - black) * inverse_range);
+            const double value = (s - black) * inverse_range;
+            if (!(std::abs(value) <= std::numeric_limits<float>::max()))
+                throw DataError(concat(
+                    image_.info.source, ": sample ", number(q), " at row ", std::to_string(row),
+                    ", column ", std::to_string(x), " of plane ", std::to_string(plane),
+                    " gives the linear value ", number(value), ", beyond the float range"));
+            out[x] = static_cast<float>(value);
             std::uint8_t f = 0;
             if (s >= white_) f |= kPixelSaturated;
             if (s <= black) f |= kPixelClippedLow;
