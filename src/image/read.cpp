@@ -196,28 +196,6 @@ void check_expansion(const std::string& name, std::uint64_t decoded_bytes, std::
 
 // ---- Linearizer --------------------------------------------------------------------------------
 
-namespace {
-
-// `values` sized to n (zeros). A large buffer is offered to the kernel for transparent huge pages
-// first: a 24-MP RGB image is 288 MB of floats, and faulting it in 2-MB pages instead of 4-kB
-// ones saves a good part of the reading time (nothing changes where huge pages are off).
-void allocate_values(std::vector<float>& values, std::size_t n) {
-    values.clear();
-    values.reserve(n);
-    constexpr std::size_t kHugePage = std::size_t{2} << 20;
-    const std::size_t bytes = n * sizeof(float);
-    if (bytes >= 4 * kHugePage) {
-        auto* begin = reinterpret_cast<char*>(values.data());
-        const std::size_t misalignment = reinterpret_cast<std::uintptr_t>(begin) % kHugePage;
-        const std::size_t skip = misalignment == 0 ? 0 : kHugePage - misalignment;
-        const std::size_t length = (bytes - skip) / kHugePage * kHugePage;
-        if (length > 0) ::madvise(begin + skip, length, MADV_HUGEPAGE);
-    }
-    values.resize(n, 0.0F);
-}
-
-}  // namespace
-
 Linearizer::Linearizer(LinearImage& image, const Layout& layout, const Evidence& evidence,
                        const ReadOptions& options)
     : image_(image), full_scale_(layout.full_scale) {
@@ -299,7 +277,7 @@ Linearizer::Linearizer(LinearImage& image, const Layout& layout, const Evidence&
     image.width = layout.width;
     image.height = layout.height;
     image.channels = planes;
-    allocate_values(image.values, planes * layout.width * layout.height);
+    image.values.assign(planes * layout.width * layout.height, 0.0F);
     image.flags.assign(layout.width * layout.height, 0);
     bits_ = layout.bits;
 }
