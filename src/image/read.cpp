@@ -43,7 +43,8 @@ std::string response_name(Response response, double gamma) {
 
 // A whole file's bytes: a read-only memory map of a regular file (no copy: the page cache's pages
 // are the bytes), else (a pipe, a device, a file system that cannot map) the bytes read into
-// memory. DataError naming the file when it cannot be read.
+// memory. DataError naming the file when it cannot be read. (As with any memory-mapped reader, a
+// file truncated by another process while it is being decoded ends the process with SIGBUS.)
 class FileBytes {
   public:
     explicit FileBytes(const std::string& path) {
