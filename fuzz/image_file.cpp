@@ -1,5 +1,5 @@
 // Fuzz target: the photograph reader (image/read.hpp: PNG through libpng, TIFF through libtiff,
-// JPEG through OpenCV, camera RAW through LibRaw, EXIF through libexif, ICC profiles), chosen by
+// JPEG through libjpeg, camera RAW through LibRaw, EXIF through libexif, ICC profiles), chosen by
 // the input's first bytes, with the default options and again with explicit levels, response and
 // white balance. An image that reads must be consistent (check_linear_image) and carry the flags
 // and levels it reports.

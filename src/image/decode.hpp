@@ -38,6 +38,7 @@ struct Layout {
     bool is_float = false;
     double full_scale = 0.0;            // F: the code of full scale (2^bits − 1, 1 for float)
     std::vector<double> default_black;  // per plane when the file has black levels (RAW)
+    double largest_code = 0.0;          // integer codes: the largest stored (0: 2^bits − 1)
 };
 
 // Throws DataError unless width, height ≥ 1 and width · height ≤ kMaxImagePixels.

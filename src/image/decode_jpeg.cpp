@@ -1,11 +1,20 @@
-// JPEG photographs through OpenCV's decoder (cv::imdecode; read.hpp, docs/image.md "JPEG").
-// Before OpenCV sees the bytes, the marker segments are walked here: the frame header (SOF) gives
-// the size, precision and components, which are checked (so a lying header allocates nothing), an
-// APP1 "Exif" segment goes to libexif and APP2 "ICC_PROFILE" segments to the ICC reader. The
-// pixels are kept in their stored orientation (IMREAD_IGNORE_ORIENTATION).
+// JPEG photographs through libjpeg(-turbo) (read.hpp, docs/image.md "JPEG"). Before the decoder
+// sees the bytes, the marker segments are walked here: the frame header (SOF) gives the size,
+// precision and components, which are checked (so a lying header allocates nothing), an APP1
+// "Exif" segment goes to libexif and APP2 "ICC_PROFILE" segments to the ICC reader. The pixels
+// stay in their stored orientation.
+//
+// libjpeg is driven directly rather than through OpenCV's cv::imdecode, whose libjpeg error
+// manager prints corrupt-data warnings to stderr: here every message goes to the decoder's own
+// handler (nothing printed) and a warning about corrupt data makes the file a DataError.
+// libjpeg reports fatal errors by longjmp: as for PNG, everything with a destructor lives in a
+// JpegState owned by decode_jpeg, and jpeg_body (the only function libjpeg jumps into) has
+// trivial locals.
 #include <algorithm>
+#include <csetjmp>
 #include <cstddef>
 #include <cstdint>
+#include <cstdio>
 #include <cstring>
 #include <optional>
 #include <string>
@@ -13,8 +22,7 @@
 #include <utility>
 #include <vector>
 
-#include <opencv2/core.hpp>
-#include <opencv2/imgcodecs.hpp>
+#include <jpeglib.h>
 
 #include "decode.hpp"
 #include "roughscope/core/errors.hpp"
@@ -95,6 +103,74 @@ JpegHeader read_header(Bytes bytes, const std::string& name) {
 
 }  // namespace
 
+namespace {
+
+struct JpegError {
+    jpeg_error_mgr manager{};  // first member: libjpeg's cinfo->err points here
+    std::jmp_buf jump{};
+    char message[JMSG_LENGTH_MAX] = {};
+};
+
+[[noreturn]] void jpeg_fail(j_common_ptr cinfo) {
+    auto* error = reinterpret_cast<JpegError*>(cinfo->err);
+    (*cinfo->err->format_message)(cinfo, error->message);
+    std::longjmp(error->jump, 1);
+}
+
+// Warnings (level −1: corrupt data) are counted and the first one kept; trace messages dropped.
+void jpeg_message(j_common_ptr cinfo, int level) {
+    auto* error = reinterpret_cast<JpegError*>(cinfo->err);
+    if (level >= 0) return;
+    if (error->manager.num_warnings++ == 0) (*cinfo->err->format_message)(cinfo, error->message);
+}
+
+void jpeg_no_output(j_common_ptr) {}
+
+struct JpegState {
+    const std::string* name = nullptr;
+    const ReadOptions* options = nullptr;
+    Bytes bytes;
+    jpeg_decompress_struct cinfo{};
+    JpegError error;
+    bool created = false;
+    LinearImage image;
+    Layout layout;
+    Evidence evidence;
+    std::optional<Linearizer> linearizer;
+    std::vector<std::uint8_t> row;
+    JpegState() = default;
+    JpegState(const JpegState&) = delete;
+    JpegState& operator=(const JpegState&) = delete;
+    ~JpegState() {
+        if (created) jpeg_destroy_decompress(&cinfo);
+    }
+};
+
+bool jpeg_body(JpegState& st) {
+    if (setjmp(st.error.jump) != 0) return false;
+    jpeg_create_decompress(&st.cinfo);
+    st.created = true;
+    jpeg_mem_src(&st.cinfo, st.bytes.data(), static_cast<unsigned long>(st.bytes.size()));
+    jpeg_read_header(&st.cinfo, TRUE);
+    st.cinfo.out_color_space = st.layout.channels == 1 ? JCS_GRAYSCALE : JCS_RGB;
+    jpeg_start_decompress(&st.cinfo);
+    if (st.cinfo.output_width != st.layout.width || st.cinfo.output_height != st.layout.height ||
+        static_cast<std::size_t>(st.cinfo.output_components) != st.layout.channels)
+        throw DataError(concat(*st.name, ": JPEG decoded to an unexpected layout (corrupt)"));
+    st.linearizer.emplace(st.image, st.layout, st.evidence, *st.options);
+    st.row.resize(st.layout.width * st.layout.channels);
+    while (st.cinfo.output_scanline < st.cinfo.output_height) {
+        const std::size_t r = st.cinfo.output_scanline;
+        JSAMPROW rows[1] = {st.row.data()};
+        if (jpeg_read_scanlines(&st.cinfo, rows, 1) != 1) break;  // suspended: cannot happen
+        st.linearizer->put_pixels(st.row.data(), r, st.layout.channels, {0, 1, 2});
+    }
+    jpeg_finish_decompress(&st.cinfo);
+    return true;
+}
+
+}  // namespace
+
 LinearImage decode_jpeg(Bytes bytes, const std::string& name, const ReadOptions& options) {
     const JpegHeader header = read_header(bytes, name);
     if (header.precision != 8)
@@ -111,54 +187,41 @@ LinearImage decode_jpeg(Bytes bytes, const std::string& name, const ReadOptions&
     check_expansion(name, std::uint64_t{header.width} * header.height, bytes.size(),
                     kJpegMaxPixelsPerByte, "JPEG frame header");
 
-    LinearImage image;
-    image.info.source = name;
-    image.info.format = "jpeg";
+    JpegState st;
+    st.name = &name;
+    st.options = &options;
+    st.bytes = bytes;
+    st.image.info.source = name;
+    st.image.info.format = "jpeg";
     const ExifFields exif = header.exif.empty() ? ExifFields{} : parse_exif(header.exif);
-    Evidence evidence;
-    if (!header.icc.empty()) evidence = icc_evidence(header.icc, "JPEG ICC profile");
-    if (!evidence.known()) {
+    if (!header.icc.empty()) st.evidence = icc_evidence(header.icc, "JPEG ICC profile");
+    if (!st.evidence.known()) {
         if (exif.color_space == 0xffff)
-            evidence.text = "EXIF ColorSpace uncalibrated";
+            st.evidence.text = "EXIF ColorSpace uncalibrated";
         else if (exif.color_space == 1)
-            evidence = exif_color_space_evidence(exif);
+            st.evidence = exif_color_space_evidence(exif);
         else
-            evidence = {Response::Srgb, 0.0, "JPEG (sRGB unless stated otherwise)"};
+            st.evidence = {Response::Srgb, 0.0, "JPEG (sRGB unless stated otherwise)"};
     }
-    apply_exif_exposure(exif, image.info);
-    warn_orientation(exif.orientation, "EXIF", image.info);
+    apply_exif_exposure(exif, st.image.info);
+    warn_orientation(exif.orientation, "EXIF", st.image.info);
+    st.layout.width = header.width;
+    st.layout.height = header.height;
+    st.layout.channels = static_cast<std::size_t>(header.components);
+    st.layout.bits = 8;
+    st.layout.full_scale = 255.0;
 
-    cv::Mat decoded;
-    try {
-        const cv::Mat buffer(1, static_cast<int>(std::min<std::size_t>(bytes.size(), 0x7fffffff)),
-                             CV_8UC1, const_cast<std::uint8_t*>(bytes.data()));
-        decoded = cv::imdecode(buffer, cv::IMREAD_ANYCOLOR | cv::IMREAD_IGNORE_ORIENTATION);
-    } catch (const cv::Exception& e) {
-        throw DataError(concat(name, ": corrupt JPEG (OpenCV: ", e.what(), ")"));
-    }
-    if (decoded.empty())
-        throw DataError(concat(name, ": corrupt or truncated JPEG (OpenCV could not decode it)"));
-    const std::size_t channels = static_cast<std::size_t>(decoded.channels());
-    if (decoded.depth() != CV_8U || (channels != 1 && channels != 3) ||
-        static_cast<std::size_t>(decoded.cols) != header.width ||
-        static_cast<std::size_t>(decoded.rows) != header.height)
-        throw DataError(concat(name, ": JPEG decoded to an unexpected layout (corrupt)"));
-
-    Layout layout;
-    layout.width = header.width;
-    layout.height = header.height;
-    layout.channels = channels;
-    layout.bits = 8;
-    layout.full_scale = 255.0;
-    Linearizer lin(image, layout, evidence, options);
-    for (std::size_t r = 0; r < header.height; ++r) {
-        const std::uint8_t* row = decoded.ptr<std::uint8_t>(static_cast<int>(r));
-        if (channels == 1)
-            lin.put_pixels(row, r, 1, {0, 0, 0});
-        else
-            lin.put_pixels(row, r, 3, {2, 1, 0});  // BGR → RGB
-    }
-    return image;
+    st.cinfo.err = jpeg_std_error(&st.error.manager);
+    st.error.manager.error_exit = jpeg_fail;
+    st.error.manager.emit_message = jpeg_message;
+    st.error.manager.output_message = jpeg_no_output;
+    if (!jpeg_body(st))
+        throw DataError(
+            concat(name, ": corrupt or truncated JPEG (libjpeg: ", st.error.message, ")"));
+    if (st.error.manager.num_warnings > 0)
+        throw DataError(
+            concat(name, ": corrupt or truncated JPEG (libjpeg: ", st.error.message, ")"));
+    return std::move(st.image);
 }
 
 }  // namespace roughscope::image::detail

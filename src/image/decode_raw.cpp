@@ -14,6 +14,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
@@ -138,6 +139,12 @@ LinearImage decode_raw(Bytes bytes, const std::string& name, const ReadOptions& 
         throw DataError(concat(name, ": camera RAW with ", std::to_string(id.colors),
                                " colours per pixel is not supported"));
     }
+    // LibRaw's rows hold raw_pitch bytes: the visible area must lie inside them.
+    const std::size_t values_per_site = data.raw_image != nullptr      ? 1
+                                        : data.color4_image != nullptr ? 4
+                                                                       : 3;
+    if (sizes.raw_pitch / 2 < (left + width) * values_per_site)
+        throw DataError(concat(name, ": camera RAW rows shorter than the visible area (corrupt)"));
     const std::size_t out_width = width / block;
     const std::size_t out_height = height / block;
     if (out_width == 0 || out_height == 0)
@@ -162,6 +169,7 @@ LinearImage decode_raw(Bytes bytes, const std::string& name, const ReadOptions& 
     layout.channels = channels;
     layout.bits = std::max(1, static_cast<int>(std::bit_width(color.maximum)));
     layout.full_scale = static_cast<double>(color.maximum);
+    layout.largest_code = 65535.0;  // values above the white level occur
     if (!(layout.full_scale > 0.0))
         throw DataError(concat(name, ": camera RAW white level (LibRaw maximum) is 0 (corrupt)"));
     {
@@ -212,14 +220,26 @@ LinearImage decode_raw(Bytes bytes, const std::string& name, const ReadOptions& 
     std::vector<double> balance(channels, 1.0);
     if (options.white_balance && channels == 3) {
         const float* mul = color.cam_mul;
-        if (mul[0] > 0.0F && mul[1] > 0.0F && mul[2] > 0.0F && std::isfinite(mul[0]) &&
-            std::isfinite(mul[1]) && std::isfinite(mul[2])) {
-            for (std::size_t p = 0; p < 3; ++p) balance[p] = mul[p] / mul[1];
+        // Multipliers beyond 1e-4 .. 1e4 of green are no white balance a camera records.
+        bool usable = std::isfinite(mul[1]) && mul[1] > 0.0F;
+        for (std::size_t p = 0; usable && p < 3; ++p) {
+            const double ratio = static_cast<double>(mul[p]) / mul[1];
+            usable = std::isfinite(ratio) && ratio >= 1e-4 && ratio <= 1e4;
+        }
+        if (usable) {
+            for (std::size_t p = 0; p < 3; ++p) balance[p] = static_cast<double>(mul[p]) / mul[1];
         } else {
             image.info.warnings.push_back(
-                "white_balance: the file has no camera white balance; values left as stored");
+                "white_balance: the file has no usable camera white balance; values left as "
+                "stored");
         }
     }
+
+    for (std::size_t p = 0; p < channels; ++p)
+        if (!(65535.0 * inverse_range[p] * balance[p] <= std::numeric_limits<float>::max()))
+            throw InvalidArgument(concat(name,
+                                         ": the levels and white balance give linear "
+                                         "values beyond the float range"));
 
     const std::size_t pitch = sizes.raw_pitch;  // bytes per raw row
     float* values = image.values.data();
@@ -318,9 +338,7 @@ LinearImage decode_raw(Bytes bytes, const std::string& name, const ReadOptions& 
             }
         }
     } else {
-        const std::size_t stride = data.raw_image != nullptr      ? 1
-                                   : data.color4_image != nullptr ? 4
-                                                                  : 3;
+        const std::size_t stride = values_per_site;
         const std::uint16_t* base = data.raw_image != nullptr      ? data.raw_image
                                     : data.color4_image != nullptr ? &data.color4_image[0][0]
                                                                    : &data.color3_image[0][0];

@@ -201,12 +201,72 @@ void put_row(Linearizer& lin, int bits, bool is_float, const std::uint8_t* row, 
         lin.put_pixels(row, r, stride, {0, 1, 2});
 }
 
+// A TIFF-structured camera RAW goes to LibRaw, whose TIFF parser trusts the file (Debian's LibRaw
+// 0.20 reads out of bounds on some malformed directories). Its structure is checked here first:
+// every directory reachable from the header (the IFD chain, SubIFDs, the EXIF and GPS IFDs) lies
+// inside the file, has at most 1000 entries of a known type (1 to 13) whose values lie inside the
+// file. Classic TIFF only.
+void check_raw_structure(Bytes bytes, const std::string& name) {
+    auto fail = [&](const std::string& what) {
+        throw DataError(concat(name, ": camera RAW with a corrupt TIFF structure (", what, ")"));
+    };
+    if (bytes.size() < 8) fail("no header");
+    const bool little = bytes[0] == 'I';
+    auto u16 = [&](std::size_t at) {
+        return little ? static_cast<std::uint32_t>(bytes[at] | (bytes[at + 1] << 8))
+                      : static_cast<std::uint32_t>((bytes[at] << 8) | bytes[at + 1]);
+    };
+    auto u32 = [&](std::size_t at) {
+        return little ? (std::uint32_t{bytes[at]} | std::uint32_t{bytes[at + 1]} << 8 |
+                         std::uint32_t{bytes[at + 2]} << 16 | std::uint32_t{bytes[at + 3]} << 24)
+                      : (std::uint32_t{bytes[at]} << 24 | std::uint32_t{bytes[at + 1]} << 16 |
+                         std::uint32_t{bytes[at + 2]} << 8 | std::uint32_t{bytes[at + 3]});
+    };
+    if (u16(2) != 42) fail("BigTIFF or an unknown version");
+    static constexpr std::uint32_t kTypeBytes[14] = {0, 1, 1, 2, 4, 8, 1, 1, 2, 4, 8, 4, 8, 4};
+    std::vector<std::uint32_t> pending = {u32(4)};
+    std::vector<std::uint32_t> seen;
+    while (!pending.empty()) {
+        const std::uint32_t at = pending.back();
+        pending.pop_back();
+        if (at == 0 || std::find(seen.begin(), seen.end(), at) != seen.end()) continue;
+        if (seen.size() >= 64) fail("more than 64 directories");
+        seen.push_back(at);
+        if (std::uint64_t{at} + 2 > bytes.size()) fail("a directory outside the file");
+        const std::uint32_t entries = u16(at);
+        if (entries > 1000) fail("a directory of more than 1000 entries");
+        if (std::uint64_t{at} + 2 + 12ULL * entries + 4 > bytes.size())
+            fail("a directory running past the end of the file");
+        for (std::uint32_t k = 0; k < entries; ++k) {
+            const std::size_t entry = at + 2 + 12 * std::size_t{k};
+            const std::uint32_t tag = u16(entry);
+            const std::uint32_t type = u16(entry + 2);
+            const std::uint32_t count = u32(entry + 4);
+            if (type == 0 || type > 13)
+                fail(
+                    concat("tag ", std::to_string(tag), " of unknown type ", std::to_string(type)));
+            const std::uint64_t size = std::uint64_t{count} * kTypeBytes[type];
+            const std::uint64_t value_at = size <= 4 ? entry + 8 : u32(entry + 8);
+            if (value_at + size > bytes.size())
+                fail(concat("tag ", std::to_string(tag), " values outside the file"));
+            const bool is_ifd = tag == 330 || tag == 34665 || tag == 34853;  // SubIFDs, EXIF, GPS
+            if (is_ifd && (type == 4 || type == 13))
+                for (std::uint32_t i = 0; i < std::min<std::uint32_t>(count, 64); ++i)
+                    pending.push_back(u32(static_cast<std::size_t>(value_at) + 4 * std::size_t{i}));
+        }
+        pending.push_back(u32(at + 2 + 12 * std::size_t{entries}));  // the next IFD
+    }
+}
+
 }  // namespace
 
 std::optional<LinearImage> decode_tiff(Bytes bytes, const std::string& name,
                                        const ReadOptions& options) {
     // Canon CR2: a TIFF header followed by "CR" and the format's version.
-    if (bytes.size() >= 10 && bytes[8] == 'C' && bytes[9] == 'R') return std::nullopt;
+    if (bytes.size() >= 10 && bytes[8] == 'C' && bytes[9] == 'R') {
+        check_raw_structure(bytes, name);
+        return std::nullopt;
+    }
     TiffMemory memory{bytes, 0};
     TiffError error;
     TiffFile file(name, memory, error);
@@ -222,8 +282,10 @@ std::optional<LinearImage> decode_tiff(Bytes bytes, const std::string& name,
     if (TIFFGetField(tif, TIFFTAG_DNGVERSION, &dng_version) == 1 ||
         (has_photometric &&
          (photometric == PHOTOMETRIC_CFA || photometric == kPhotometricLinearRaw)) ||
-        (subfile & FILETYPE_REDUCEDIMAGE) != 0)
+        (subfile & FILETYPE_REDUCEDIMAGE) != 0) {
+        check_raw_structure(bytes, name);
         return std::nullopt;
+    }
 
     std::uint32_t width = 0;
     std::uint32_t height = 0;

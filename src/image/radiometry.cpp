@@ -40,6 +40,14 @@ void check_same_shape(const LinearImage& image, const LinearImage& other, std::s
 void subtract_dark_frame(LinearImage& image, const LinearImage& dark) {
     check_same_shape(image, dark, "dark frame");
     const std::size_t pixels = image.pixel_count();
+    for (std::size_t i = 0; i < image.values.size(); ++i) {
+        const double difference =
+            static_cast<double>(image.values[i]) - static_cast<double>(dark.values[i]);
+        if (!(std::abs(difference) <= std::numeric_limits<float>::max()))
+            throw InvalidArgument(concat("dark frame ", source_of(dark), ": sample ",
+                                         std::to_string(i), " of the image ", source_of(image),
+                                         " minus the dark frame is beyond the float range"));
+    }
     for (std::size_t i = 0; i < image.values.size(); ++i) image.values[i] -= dark.values[i];
     for (std::size_t i = 0; i < pixels; ++i) {
         std::uint8_t f = image.flags[i] | dark.flags[i];

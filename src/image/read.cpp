@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstring>
 #include <filesystem>
+#include <limits>
 #include <string>
 #include <string_view>
 #include <type_traits>
@@ -42,7 +43,8 @@ std::string response_name(Response response, double gamma) {
 
 // A whole file's bytes: a read-only memory map of a regular file (no copy: the page cache's pages
 // are the bytes), else (a pipe, a device, a file system that cannot map) the bytes read into
-// memory. DataError naming the file when it cannot be read.
+// memory. DataError naming the file when it cannot be read. (As with any memory-mapped reader, a
+// file truncated by another process while it is being decoded ends the process with SIGBUS.)
 class FileBytes {
   public:
     explicit FileBytes(const std::string& path) {
@@ -195,28 +197,6 @@ void check_expansion(const std::string& name, std::uint64_t decoded_bytes, std::
 
 // ---- Linearizer --------------------------------------------------------------------------------
 
-namespace {
-
-// `values` sized to n (zeros). A large buffer is offered to the kernel for transparent huge pages
-// first: a 24-MP RGB image is 288 MB of floats, and faulting it in 2-MB pages instead of 4-kB
-// ones saves a good part of the reading time (nothing changes where huge pages are off).
-void allocate_values(std::vector<float>& values, std::size_t n) {
-    values.clear();
-    values.reserve(n);
-    constexpr std::size_t kHugePage = std::size_t{2} << 20;
-    const std::size_t bytes = n * sizeof(float);
-    if (bytes >= 4 * kHugePage) {
-        auto* begin = reinterpret_cast<char*>(values.data());
-        const std::size_t misalignment = reinterpret_cast<std::uintptr_t>(begin) % kHugePage;
-        const std::size_t skip = misalignment == 0 ? 0 : kHugePage - misalignment;
-        const std::size_t length = (bytes - skip) / kHugePage * kHugePage;
-        if (length > 0) ::madvise(begin + skip, length, MADV_HUGEPAGE);
-    }
-    values.resize(n, 0.0F);
-}
-
-}  // namespace
-
 Linearizer::Linearizer(LinearImage& image, const Layout& layout, const Evidence& evidence,
                        const ReadOptions& options)
     : image_(image), full_scale_(layout.full_scale) {
@@ -272,6 +252,21 @@ Linearizer::Linearizer(LinearImage& image, const Layout& layout, const Evidence&
             throw InvalidArgument(concat(name, ": ", text));
         throw DataError(concat(name, ": ", text, " (corrupt levels)"));
     }
+    if (!layout.is_float) {
+        // The extreme codes (the response is monotonic) must give values a float holds.
+        const double largest =
+            layout.largest_code > 0.0 ? layout.largest_code : std::ldexp(1.0, layout.bits) - 1.0;
+        for (std::size_t c = 0; c < planes; ++c) {
+            const double range = white_ - black_[c];
+            const double extreme = std::max(std::abs(linear_code(largest) - black_[c]),
+                                            std::abs(linear_code(0.0) - black_[c])) /
+                                   range;
+            if (extreme <= std::numeric_limits<float>::max()) continue;
+            throw InvalidArgument(concat(name, ": black level ", number(black_[c]),
+                                         " DN and white level ", number(white_),
+                                         " DN give linear values beyond the float range"));
+        }
+    }
 
     info.bits_per_sample = layout.bits;
     info.is_float = layout.is_float;
@@ -283,7 +278,7 @@ Linearizer::Linearizer(LinearImage& image, const Layout& layout, const Evidence&
     image.width = layout.width;
     image.height = layout.height;
     image.channels = planes;
-    allocate_values(image.values, planes * layout.width * layout.height);
+    image.values.assign(planes * layout.width * layout.height, 0.0F);
     image.flags.assign(layout.width * layout.height, 0);
     bits_ = layout.bits;
 }
@@ -340,7 +335,13 @@ void Linearizer::put(const T* samples, std::size_t row, std::size_t stride, std:
                                        std::to_string(row), ", column ", std::to_string(x),
                                        " of plane ", std::to_string(plane), " is not finite"));
             const double s = response_ == Response::Linear ? q : linear_code(q);
-            out[x] = static_cast<float>((s - black) * inverse_range);
+            const double value = (s - black) * inverse_range;
+            if (!(std::abs(value) <= std::numeric_limits<float>::max()))
+                throw DataError(concat(
+                    image_.info.source, ": sample ", number(q), " at row ", std::to_string(row),
+                    ", column ", std::to_string(x), " of plane ", std::to_string(plane),
+                    " gives the linear value ", number(value), ", beyond the float range"));
+            out[x] = static_cast<float>(value);
             std::uint8_t f = 0;
             if (s >= white_) f |= kPixelSaturated;
             if (s <= black) f |= kPixelClippedLow;

@@ -4,7 +4,7 @@
 //   PNG   8/16-bit grey, grey + alpha, RGB, RGBA (alpha dropped), through libpng;
 //   TIFF  8/16-bit unsigned and 32-bit float, grey or RGB (extra samples dropped), strips or
 //         tiles, contiguous or separate planes, through libtiff;
-//   JPEG  8-bit grey or colour, through OpenCV (cv::imdecode);
+//   JPEG  8-bit grey or colour (baseline or progressive), through libjpeg;
 //   RAW   camera RAW files (DNG, CR2, NEF, ARW, ...) through LibRaw: the sensor values, linear,
 //         without demosaicing: a colour-filter-array sensor gives a half-size RGB image (each 2 x 2
 //         Bayer block, or 3 x 3 X-Trans block, one pixel: the mean of its sites of each colour).

@@ -79,6 +79,16 @@ TEST(DarkFrame, SizeOrChannelMismatchIsAnInvalidArgumentNamingBoth) {
     EXPECT_EQ(image.values, std::vector<float>(6, 1.0F));  // untouched
 }
 
+TEST(DarkFrame, DifferencesBeyondTheFloatRangeAreRefusedBeforeAnyChange) {
+    LinearImage image = make(2, 1, 1, "light.tif",
+                             [](std::size_t, std::size_t i) { return i == 0 ? 1.0F : 3e38F; });
+    const LinearImage dark = make(
+        2, 1, 1, "dark.tif", [](std::size_t, std::size_t i) { return i == 0 ? 0.5F : -3e38F; });
+    expect_invalid([&] { subtract_dark_frame(image, dark); },
+                   {"dark.tif", "light.tif", "sample 1", "float range"});
+    EXPECT_EQ(image.values[0], 1.0F);
+}
+
 TEST(FlatField, DividesByTheFlatOverItsMeanAndMarksUnusablePixels) {
     LinearImage image = make(4, 1, 1, "light.tif", [](std::size_t, std::size_t) { return 1.0F; });
     LinearImage flat = make(4, 1, 1, "flat.tif", [](std::size_t, std::size_t i) {

@@ -635,6 +635,24 @@ TEST(ReadJpeg, ExifExposureAndSrgbValuesToAFewCodes) {
         }
 }
 
+TEST(ReadJpeg, CorruptDataIsADataErrorAndNothingIsPrinted) {
+    const ByteVector good = jpeg_with_exif(cv::Scalar(10, 20, 30), testing::tiff_file({}, {}, {}));
+    // Three stray bytes before the start-of-scan marker: libjpeg warns ("extraneous bytes").
+    ByteVector stray;
+    for (std::size_t i = 0; i < good.size(); ++i) {
+        if (i + 1 < good.size() && good[i] == 0xff && good[i + 1] == 0xda)
+            for (int k = 0; k < 3; ++k) stray.push_back(0);
+        stray.push_back(good[i]);
+    }
+    ByteVector truncated(good.begin(),
+                         good.begin() + static_cast<std::ptrdiff_t>(good.size() - 40));
+    ::testing::internal::CaptureStderr();
+    expect_error<DataError>([&] { decode(stray, {}, "stray.jpg"); }, {"stray.jpg", "libjpeg"});
+    expect_error<DataError>([&] { decode(truncated, {}, "cut.jpg"); }, {"cut.jpg", "libjpeg"});
+    EXPECT_EQ(::testing::internal::GetCapturedStderr(), "");
+    EXPECT_NO_THROW(decode(good));
+}
+
 TEST(ReadPng, ExifChunkGivesTheExposure) {
     testing::PngSpec spec;
     spec.samples = {90};
@@ -725,6 +743,25 @@ TEST(ReadImage, NonFiniteFloatSamplesAreDataErrors) {
     const ByteVector file = testing::tiff_image(2, 1, 1, 32, 3, testing::raw_bytes(samples));
     expect_error<DataError>([&] { decode(file, {}, "nan.tif"); },
                             {"nan.tif", "column 1", "not finite"});
+}
+
+TEST(ReadImage, ValuesBeyondTheFloatRangeAreRefused) {
+    // A float sample of 1e30 through gamma 2.2 is 1e66: a DataError naming the sample.
+    const std::vector<float> samples = {0.5F, 1e30F};
+    ReadOptions gamma;
+    gamma.response = Response::Gamma;
+    gamma.gamma = 2.2;
+    const ByteVector file = testing::tiff_image(2, 1, 1, 32, 3, testing::raw_bytes(samples));
+    EXPECT_NO_THROW(decode(file));  // linear: 1e30 fits a float
+    expect_error<DataError>([&] { decode(file, gamma, "big.tif"); },
+                            {"big.tif", "column 1", "beyond the float range"});
+    // Integer codes: a white level of 1e-40 DN would make 255 into 2.55e42.
+    testing::PngSpec spec;
+    spec.samples = {255};
+    ReadOptions tiny_white;
+    tiny_white.white_level_dn = 1e-40;
+    expect_error<InvalidArgument>([&] { decode(testing::png_bytes(spec), tiny_white, "w.png"); },
+                                  {"w.png", "white level 1e-40", "beyond the float range"});
 }
 
 TEST(ReadOptionsCheck, BadOptionsAreInvalidArgumentsNamingTheField) {
