@@ -44,11 +44,23 @@
 #include "roughscope/surface/statistics.hpp"
 
 // simulation: numerical Kirchhoff scattering and synthetic camera captures (ground truth)
+#include "roughscope/simulation/capture.hpp"
 #include "roughscope/simulation/kirchhoff.hpp"
+
+// image: photographs on a linear scale, regions, the highlight, response curves, measurements
+#include "roughscope/image/hdr.hpp"
+#include "roughscope/image/image.hpp"
+#include "roughscope/image/measure.hpp"
+#include "roughscope/image/radiometry.hpp"
+#include "roughscope/image/read.hpp"
+#include "roughscope/image/region.hpp"
+#include "roughscope/image/specular.hpp"
+#include "roughscope/image/statistics.hpp"
 
 // serialize: every result type to JSON, CSV and Markdown
 #include "roughscope/serialize/comparison.hpp"
 #include "roughscope/serialize/estimation.hpp"
 #include "roughscope/serialize/json.hpp"
+#include "roughscope/serialize/measure.hpp"
 #include "roughscope/serialize/model.hpp"
 #include "roughscope/serialize/paper_tables.hpp"

@@ -113,8 +113,8 @@ TileGrid tile_grid(const Box& box, std::size_t t) {
 
 bool tile_counts(std::size_t used, std::size_t t) { return 2 * used >= t * t; }
 
-std::size_t counting_tiles(const std::vector<std::uint32_t>& used, const Box& box, std::size_t width,
-                           std::size_t t) {
+std::size_t counting_tiles(const std::vector<std::uint32_t>& used, const Box& box,
+                           std::size_t width, std::size_t t) {
     const TileGrid g = tile_grid(box, t);
     std::vector<std::size_t> n(g.ntx * g.nty, 0);
     for (const std::uint32_t k : used) ++n[g.index(k % width, k / width)];
@@ -262,6 +262,26 @@ RegionStatistics region_statistics(const LinearImage& image, const std::vector<s
             series[i] = static_cast<float>(sum / static_cast<double>(image.channels));
         }
         out.average = series_statistics(series);
+        // Mean and spread of the average in double from the planes (the float series above,
+        // rounded per pixel, serves the robust mean only).
+        const auto average_of = [&](std::size_t i) {
+            double sum = 0.0;
+            for (std::size_t c = 0; c < image.channels; ++c) sum += image.plane(c)[used[i]];
+            return sum / static_cast<double>(image.channels);
+        };
+        double sum = 0.0;
+        for (std::size_t i = 0; i < used.size(); ++i) sum += average_of(i);
+        out.average.mean = sum / static_cast<double>(used.size());
+        if (used.size() > 1) {
+            double ss = 0.0;
+            for (std::size_t i = 0; i < used.size(); ++i) {
+                const double d = average_of(i) - out.average.mean;
+                ss += d * d;
+            }
+            out.average.std_dev = std::sqrt(ss / static_cast<double>(used.size() - 1));
+        }
+        out.average.stderr_pixel =
+            out.average.std_dev / std::sqrt(static_cast<double>(used.size()));
     }
 
     out.tile_size_px =

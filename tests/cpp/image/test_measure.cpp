@@ -5,10 +5,12 @@
 // checks: the recovered values lie inside their reported 2σ interval in ≥ 90 % of seeded pairs;
 // images with the paper's printed brightness ratios (Tables 1 and 2) give back the printed σ/T;
 // the capture file's keys and its failures.
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -17,6 +19,7 @@
 
 #include "../io/shared_data.hpp"
 #include "../io/test_files.hpp"
+#include "image_files.hpp"
 #include "roughscope/core/errors.hpp"
 #include "roughscope/core/text.hpp"
 #include "roughscope/estimation/estimation.hpp"
@@ -436,6 +439,82 @@ TEST(MeasureResponseEvidence, ARawDeclaredSrgbGivesAWarning) {
     request.read.response = Response::Linear;
     const MeasureResult agreed = measure(request);
     for (const auto& w : agreed.warnings) EXPECT_EQ(w.find("srgb"), std::string::npos) << w;
+}
+
+// ---------------------------------------------------------------------------------------------
+// σ per colour channel (§4.1.1 at each channel's wavelength) and their agreement.
+
+// An RGB float TIFF of a highlight at 14°: a disc of radius 6 px at (32, 30) whose excess over
+// the surround in channel c is R_spec,c = exp(−g_c), g_c = (4π σ_c cos θ / λ_c)², with 0.2 %
+// Gaussian pixel noise (seeded).
+fs::path rgb_highlight(const fs::path& dir, const std::string& name,
+                       const std::array<double, 3>& sigma_um) {
+    const double cos_theta = std::cos(deg_to_rad(14.0));
+    std::mt19937_64 rng(42);
+    std::normal_distribution<double> noise(0.0, 0.002);
+    std::vector<float> pixels(kSize * kSize * 3);
+    for (std::size_t r = 0; r < kSize; ++r)
+        for (std::size_t x = 0; x < kSize; ++x) {
+            const double dx = static_cast<double>(x) + 0.5 - 32.0;
+            const double dy = static_cast<double>(r) + 0.5 - 30.0;
+            const bool in = dx * dx + dy * dy <= 36.0;
+            for (std::size_t c = 0; c < 3; ++c) {
+                const double k =
+                    4.0 * kPi * sigma_um[c] * cos_theta / kDefaultChannelWavelengthsUm[c];
+                const double e_tot = 0.5, e_dif = e_tot * (1.0 - std::exp(-k * k));
+                pixels[(r * kSize + x) * 3 + c] =
+                    static_cast<float>((in ? e_tot : e_dif) * (1.0 + noise(rng)));
+            }
+        }
+    const auto bytes = roughscope::testing::tiff_image(kSize, kSize, 3, 32, 3,
+                                                       roughscope::testing::raw_bytes(pixels));
+    const fs::path path = dir / name;
+    io::write_file_atomic(path, std::string(bytes.begin(), bytes.end()));
+    return path;
+}
+
+MeasureResult measure_rgb_highlight(const fs::path& image) {
+    MeasureRequest request;
+    request.read.response = Response::Linear;
+    request.roi = RectangleRegion{4.0, 4.0, 56.0, 56.0};
+    request.R0 = 1.0;
+    request.highlight.core_radius_px = 4.0;
+    request.highlight.annulus_inner_px = 9.0;
+    request.highlight.annulus_outer_px = 14.0;
+    CaptureSpec spec;
+    spec.image = image.string();
+    spec.geometry = Geometry{deg_to_rad(14.0), deg_to_rad(14.0), 0.0};
+    spec.role = CaptureRole::Specular;
+    request.captures = {spec};
+    return measure(request);
+}
+
+TEST(MeasureChannels, OneSigmaSeenThroughThreeWavelengthsAgrees) {
+    const fs::path dir = roughscope::testing::fresh_dir("measure_channels");
+    const MeasureResult result =
+        measure_rgb_highlight(rgb_highlight(dir, "same.tiff", {0.08, 0.08, 0.08}));
+    ASSERT_EQ(result.specular_sigma.size(), 4u);  // R, G, B, average
+    for (std::size_t c = 0; c < 3; ++c) {
+        const Estimate& s = *result.specular_sigma[c].estimate.sigma_um;
+        EXPECT_NEAR(s.value, 0.08, 3.0 * s.std_error) << result.specular_sigma[c].channel;
+        EXPECT_GT(s.std_error, 0.0);
+    }
+    ASSERT_TRUE(result.channel_sigma_chi2);
+    EXPECT_LE(*result.channel_sigma_chi2, 9.21);
+    for (const auto& w : result.warnings) EXPECT_EQ(w.find("channels"), std::string::npos) << w;
+}
+
+TEST(MeasureChannels, ChannelsThatDisagreeAreFlagged) {
+    const fs::path dir = roughscope::testing::fresh_dir("measure_channels_bad");
+    // σ not following λ (a response or colour error): channel σ of 0.06, 0.08, 0.10 µm.
+    const MeasureResult result =
+        measure_rgb_highlight(rgb_highlight(dir, "differ.tiff", {0.06, 0.08, 0.10}));
+    ASSERT_TRUE(result.channel_sigma_chi2);
+    EXPECT_GT(*result.channel_sigma_chi2, 9.21);
+    bool flagged = false;
+    for (const auto& w : result.warnings)
+        flagged = flagged || w.find("differs between the R, G and B") != std::string::npos;
+    EXPECT_TRUE(flagged);
 }
 
 // ---------------------------------------------------------------------------------------------
