@@ -107,10 +107,20 @@ Json to_json(const image::MeasureResult& r, const image::MeasureRequest& request
     out["capture_file"] = text_or_null(request.source);
     put(out, "E1_over_E2", r.E1_over_E2);
     // σ/T of both correlations; σ and T where the captures give them.
+    // More than two diffuse captures: σ/T from the least-squares fit of all of them (when it
+    // converged with a covariance), else from the first two (Eq. 17 / 19 or the solver).
+    const auto slope = [&](const std::optional<RoughnessEstimate>& pair,
+                           const FitResult* fit) -> std::optional<Estimate> {
+        if (fit && fit->status == SolverStatus::Converged && fit->covariance_available &&
+            !fit->parameters.empty() && fit->parameters[0].name == "sigma_over_T")
+            return Estimate{fit->parameters[0].value, fit->parameters[0].std_error};
+        return pair ? pair->sigma_over_T : std::nullopt;
+    };
     put(out, "sigma_over_T_gaussian",
-        r.slope_gaussian ? r.slope_gaussian->sigma_over_T : std::nullopt);
+        slope(r.slope_gaussian, r.fit ? &r.fit->gaussian : nullptr));
     put(out, "sigma_over_T_exponential",
-        r.slope_exponential ? r.slope_exponential->sigma_over_T : std::nullopt);
+        slope(r.slope_exponential, r.fit ? &r.fit->exponential : nullptr));
+    out["sigma_over_T_source"] = r.fit ? "fit" : "pair";
     std::optional<Estimate> sigma;
     if (request.sigma_um)
         sigma = Estimate{*request.sigma_um, request.sigma_um_stderr};

@@ -205,3 +205,28 @@ def test_report_into_a_file_fails_and_leaves_it(linear_sample, tmp_path):
     proc = run(capture_file, "--report", blocker / "report", check=False)
     assert proc.returncode != 0
     assert blocker.read_text() == "keep"
+
+
+def test_three_captures_are_fitted(linear_sample, tmp_path):
+    from roughscope import _core, report_measure as rm
+
+    spec, capture_file = linear_sample
+    folder = pathlib.Path(capture_file).parent
+    first = json.loads(pathlib.Path(capture_file).read_text())["captures"][0]
+    (folder / "capture3").mkdir(exist_ok=True)
+    _core.write_capture(str(folder / "capture3"), "tiff", scene="plane", width=rm.DEMO_SIZE,
+                        height=rm.DEMO_SIZE, theta_i_deg=60.0, exposure_s=first["exposure_s"],
+                        seed=99, **rm._surface(spec), **rm._camera(spec))
+    path = edited(capture_file, tmp_path, lambda d: d["captures"].append(
+        {"image": "capture3/capture.tiff", "theta_i_deg": 60.0,
+         "exposure_s": first["exposure_s"]}))
+    doc = json.loads(run(path, "--json").stdout)
+    assert doc["sigma_over_T_source"] == "fit"
+    assert len(doc["captures"]) == 3 and doc["fit"] is not None
+    value, err = doc["sigma_over_T_exponential"], doc["sigma_over_T_exponential_stderr"]
+    assert err > 0 and abs(value - spec["sigma_over_T"]) <= 4 * err, (value, err)
+
+
+def test_two_captures_use_the_pair(linear_sample):
+    _, capture_file = linear_sample
+    assert json.loads(run(capture_file, "--json").stdout)["sigma_over_T_source"] == "pair"

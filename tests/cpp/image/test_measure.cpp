@@ -207,6 +207,33 @@ TEST(MeasureEndToEnd, Srgb8PngPairsCoverTheTruth) { check_coverage(kSrgb8); }
 TEST(MeasureEndToEnd, Linear16TiffPairsCoverTheTruth) { check_coverage(kLinear16); }
 TEST(MeasureEndToEnd, DngPairsCoverTheTruth) { check_coverage(kDng); }
 
+// More than two diffuse captures: the least-squares fit of both correlations recovers σ/T (and
+// prefers the true correlation) from four captures at 20°, 35°, 50° and 65° with different
+// exposures.
+TEST(MeasureEndToEnd, FourCapturesAreFittedByLeastSquares) {
+    const fs::path dir = roughscope::testing::fresh_dir("measure_fit");
+    const sim::SurfaceTruth truth = very_rough(0.35, Correlation::Exponential);
+    MeasureRequest request = request_for(kLinear16);
+    int k = 0;
+    for (const double theta : {20.0, 35.0, 50.0, 65.0}) {
+        const Geometry g = normal_view(theta);
+        const double t =
+            (0.2 + 0.1 * k) * kFullWell / (kElectronsPerUnitS * sim::surface_brightness(truth, g));
+        const fs::path f = write_capture(dir, concat("c", std::to_string(k)), kLinear16, g, {truth},
+                                         {}, t, static_cast<std::uint64_t>(77 + k));
+        request.captures.push_back(diffuse_capture(f, g, t));
+        ++k;
+    }
+    const MeasureResult result = measure(request);
+    ASSERT_TRUE(result.fit);
+    const FitResult& fit = result.fit->exponential;
+    ASSERT_FALSE(fit.parameters.empty());
+    EXPECT_EQ(fit.parameters[0].name, "sigma_over_T");
+    EXPECT_NEAR(fit.parameters[0].value, 0.35, std::max(3.0 * fit.parameters[0].std_error, 0.01));
+    EXPECT_EQ(result.fit->preferred, Correlation::Exponential);
+    EXPECT_EQ(fit.num_measurements, 4);
+}
+
 // The reported error is not inflated: with a wrong exposure time for one capture (10 % off), the
 // interval must miss the truth.
 TEST(MeasureEndToEnd, AWrongExposureIsOutsideTheInterval) {
