@@ -1,21 +1,21 @@
 #include "roughscope/image/statistics.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cassert>
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <span>
+#include <vector>
 
+#include "robust_location.hpp"
 #include "roughscope/core/errors.hpp"
 #include "roughscope/core/text.hpp"
 
 namespace roughscope::image {
 namespace {
 
-constexpr double kHuberK = 1.345;              // 95 % efficiency at the normal distribution
-constexpr double kMadToSigma = 1.4826;         // 1 / Φ⁻¹(3/4): MAD → σ for normal data
-constexpr double kMeanAbsToSigma = 1.2533141;  // √(π/2): mean |v − median| → σ for normal data
-constexpr int kHuberMaxIterations = 100;
 constexpr std::size_t kMinTileSizePx = 4;
 constexpr std::size_t kTargetTiles = 32;  // t0 = ⌊√(n / 32)⌋
 constexpr std::size_t kMinAutoTiles = 16;
@@ -29,79 +29,40 @@ std::string image_name(const LinearImage& image) {
 
 std::string fraction_text(double f) { return check::format_number(f); }
 
-// Median of `v` (reorders it); v not empty.
-double median_of(std::vector<float>& v) {
-    assert(!v.empty());
-    const std::size_t mid = v.size() / 2;
-    std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(mid), v.end());
-    const double upper = v[mid];
-    if (v.size() % 2 == 1) return upper;
-    const double lower = *std::max_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(mid));
-    return 0.5 * (lower + upper);
+// Σ p[0..n) in double, four partial sums (no chain of additions through one register).
+double sum_of(const float* p, std::size_t n) {
+    std::array<double, 4> acc{};
+    std::size_t i = 0;
+    for (; i + 4 <= n; i += 4)
+        for (std::size_t j = 0; j < 4; ++j) acc[j] += p[i + j];
+    for (; i < n; ++i) acc[0] += p[i];
+    return (acc[0] + acc[1]) + (acc[2] + acc[3]);
 }
 
-// Huber M-estimate of location with a fixed scale s = 1.4826 · MAD (iteratively reweighted mean,
-// w = min(1, k s / |v − μ|), from the median). MAD = 0 (more than half the values equal): s from
-// the mean absolute deviation √(π/2) · mean |v − median|; all values equal: the median.
-double huber_mean(const std::vector<float>& values) {
-    std::vector<float> work = values;
-    const double med = median_of(work);
-    double mean_abs = 0.0;
-    for (std::size_t i = 0; i < values.size(); ++i) {
-        const double d = std::abs(static_cast<double>(values[i]) - med);
-        work[i] = static_cast<float>(d);
-        mean_abs += d;
-    }
-    mean_abs /= static_cast<double>(values.size());
-    double scale = kMadToSigma * median_of(work);
-    if (!(scale > 0.0)) scale = kMeanAbsToSigma * mean_abs;
-    if (!(scale > 0.0)) return med;
-    const double cut = kHuberK * scale;
-    double mu = med;
-    for (int iteration = 0; iteration < kHuberMaxIterations; ++iteration) {
-        double sum_w = 0.0, sum_wv = 0.0;
-        for (const float value : values) {
-            const double v = value;
-            const double d = std::abs(v - mu);
-            const double w = d <= cut ? 1.0 : cut / d;
-            sum_w += w;
-            sum_wv += w * v;
+// Σ (p[i] − m)² in double.
+double squares_about(const float* p, std::size_t n, double m) {
+    std::array<double, 4> acc{};
+    std::size_t i = 0;
+    for (; i + 4 <= n; i += 4)
+        for (std::size_t j = 0; j < 4; ++j) {
+            const double d = static_cast<double>(p[i + j]) - m;
+            acc[j] += d * d;
         }
-        const double next = sum_wv / sum_w;
-        const bool done = std::abs(next - mu) <= 1e-12 * scale;
-        mu = next;
-        if (done) break;
+    for (; i < n; ++i) {
+        const double d = static_cast<double>(p[i]) - m;
+        acc[0] += d * d;
     }
-    return mu;
-}
-
-ChannelStatistics series_statistics(const std::vector<float>& values) {
-    ChannelStatistics s;
-    s.count = values.size();
-    assert(s.count > 0);
-    double sum = 0.0;
-    for (const float v : values) sum += v;
-    s.mean = sum / static_cast<double>(s.count);
-    if (s.count > 1) {
-        double ss = 0.0;
-        for (const float v : values) ss += (v - s.mean) * (v - s.mean);
-        s.std_dev = std::sqrt(ss / static_cast<double>(s.count - 1));
-    }
-    s.stderr_pixel = s.std_dev / std::sqrt(static_cast<double>(s.count));
-    s.robust_mean = huber_mean(values);
-    return s;
+    return (acc[0] + acc[1]) + (acc[2] + acc[3]);
 }
 
 struct Box {
     std::size_t x0, y0, x1, y1;  // half-open
 };
 
-// Tiles of side t over the box (image grid): the used-pixel count of each.
+// Tiles of side t over the box (image grid).
 struct TileGrid {
     std::size_t t, tx0, ty0, ntx, nty;
-    std::size_t index(std::size_t x, std::size_t y) const {
-        return (y / t - ty0) * ntx + (x / t - tx0);
-    }
+    std::size_t cells() const { return ntx * nty; }
 };
 
 TileGrid tile_grid(const Box& box, std::size_t t) {
@@ -113,67 +74,85 @@ TileGrid tile_grid(const Box& box, std::size_t t) {
 
 bool tile_counts(std::size_t used, std::size_t t) { return 2 * used >= t * t; }
 
-std::size_t counting_tiles(const std::vector<std::uint32_t>& used, const Box& box,
-                           std::size_t width, std::size_t t) {
-    const TileGrid g = tile_grid(box, t);
-    std::vector<std::size_t> n(g.ntx * g.nty, 0);
-    for (const std::uint32_t k : used) ++n[g.index(k % width, k / width)];
+// Calls f(cell, first index, length) for the pieces of the runs (each within one image row) cut
+// at the tile borders.
+template <class F>
+void for_each_tile_piece(const std::vector<ValueRun>& runs, const TileGrid& g, std::size_t width,
+                         F&& f) {
+    for (const ValueRun& r : runs) {
+        const std::size_t y = r.start / width;
+        std::size_t x = r.start - y * width;
+        const std::size_t x_end = x + r.length;
+        const std::size_t row = (y / g.t - g.ty0) * g.ntx;
+        while (x < x_end) {
+            const std::size_t tile_x = x / g.t;
+            const std::size_t piece_end = std::min(x_end, (tile_x + 1) * g.t);
+            f(row + tile_x - g.tx0, y * width + x, piece_end - x);
+            x = piece_end;
+        }
+    }
+}
+
+// Used pixels per tile.
+std::vector<std::uint32_t> tile_pixel_counts(const std::vector<ValueRun>& runs, const TileGrid& g,
+                                             std::size_t width) {
+    std::vector<std::uint32_t> n(g.cells(), 0);
+    for_each_tile_piece(runs, g, width, [&](std::size_t cell, std::size_t, std::size_t length) {
+        n[cell] += static_cast<std::uint32_t>(length);
+    });
+    return n;
+}
+
+std::size_t counting_tiles(const std::vector<ValueRun>& runs, const Box& box, std::size_t width,
+                           std::size_t t) {
+    const std::vector<std::uint32_t> n = tile_pixel_counts(runs, tile_grid(box, t), width);
     return static_cast<std::size_t>(
         std::count_if(n.begin(), n.end(), [t](std::size_t c) { return tile_counts(c, t); }));
 }
 
-std::size_t choose_tile_size(const std::vector<std::uint32_t>& used, const Box& box,
+std::size_t choose_tile_size(const std::vector<ValueRun>& runs, std::size_t used, const Box& box,
                              std::size_t width) {
-    const auto t0 = static_cast<std::size_t>(
-        std::floor(std::sqrt(static_cast<double>(used.size()) / kTargetTiles)));
+    const auto t0 =
+        static_cast<std::size_t>(std::floor(std::sqrt(static_cast<double>(used) / kTargetTiles)));
     std::size_t t = std::max(kMinTileSizePx, t0);
     while (t > kMinTileSizePx) {
-        if (counting_tiles(used, box, width, t) >= kMinAutoTiles) return t;
+        if (counting_tiles(runs, box, width, t) >= kMinAutoTiles) return t;
         t = std::max(kMinTileSizePx,
                      static_cast<std::size_t>(std::floor(0.8 * static_cast<double>(t))));
     }
     return kMinTileSizePx;
 }
 
-// std of the tile means / √tiles for each series (the planes, then the average).
-void tile_errors(const LinearImage& image, const std::vector<std::uint32_t>& used, const Box& box,
-                 std::size_t t, RegionStatistics& out) {
-    const std::size_t planes = image.channels;
-    const std::size_t pixels = image.pixel_count();
-    const TileGrid g = tile_grid(box, t);
-    const std::size_t cells = g.ntx * g.nty;
-    std::vector<std::size_t> n(cells, 0);
-    std::vector<double> sums(cells * (planes + 1), 0.0);  // per tile: planes, then the average
-    for (const std::uint32_t k : used) {
-        const std::size_t cell = g.index(k % image.width, k / image.width);
-        ++n[cell];
-        double average = 0.0;
-        for (std::size_t c = 0; c < planes; ++c) {
-            const double v = image.values[c * pixels + k];
-            sums[cell * (planes + 1) + c] += v;
-            average += v;
-        }
-        sums[cell * (planes + 1) + planes] += average / static_cast<double>(planes);
-    }
-    std::vector<std::vector<double>> means(planes + 1);
-    for (std::size_t cell = 0; cell < cells; ++cell) {
-        if (!tile_counts(n[cell], t)) continue;
-        for (std::size_t s = 0; s <= planes; ++s)
-            means[s].push_back(sums[cell * (planes + 1) + s] / static_cast<double>(n[cell]));
-    }
-    const std::size_t tiles = means[0].size();
-    for (std::size_t s = 0; s <= planes; ++s) {
-        ChannelStatistics& target = s < planes ? out.channels[s] : out.average;
-        target.tiles = tiles;
-        if (tiles < 2) continue;
-        double mean = 0.0;
-        for (const double m : means[s]) mean += m;
-        mean /= static_cast<double>(tiles);
+// stderr_tiles and tiles from the sums of the used values per tile.
+void set_tile_error(const std::vector<double>& sums, const std::vector<std::uint32_t>& n,
+                    std::size_t t, ChannelStatistics& target) {
+    std::vector<double> means;
+    for (std::size_t cell = 0; cell < n.size(); ++cell)
+        if (tile_counts(n[cell], t)) means.push_back(sums[cell] / static_cast<double>(n[cell]));
+    target.tiles = means.size();
+    if (means.size() < 2) return;
+    double mean = 0.0;
+    for (const double m : means) mean += m;
+    mean /= static_cast<double>(means.size());
+    double ss = 0.0;
+    for (const double m : means) ss += (m - mean) * (m - mean);
+    const double sd = std::sqrt(ss / static_cast<double>(means.size() - 1));
+    target.stderr_tiles = sd / std::sqrt(static_cast<double>(means.size()));
+}
+
+// Mean, spread and robust mean of a series whose Σ is known.
+void set_spread_and_robust_mean(const ValueSeries& series, double sum, ChannelStatistics& s) {
+    s.count = series.count;
+    assert(s.count > 0);
+    s.mean = sum / static_cast<double>(s.count);
+    if (s.count > 1) {
         double ss = 0.0;
-        for (const double m : means[s]) ss += (m - mean) * (m - mean);
-        const double sd = std::sqrt(ss / static_cast<double>(tiles - 1));
-        target.stderr_tiles = sd / std::sqrt(static_cast<double>(tiles));
+        for_each_span(series,
+                      [&](const float* p, std::size_t n) { ss += squares_about(p, n, s.mean); });
+        s.std_dev = std::sqrt(ss / static_cast<double>(s.count - 1));
     }
+    s.stderr_pixel = s.std_dev / std::sqrt(static_cast<double>(s.count));
+    s.robust_mean = huber_location(series).location;
 }
 
 }  // namespace
@@ -208,32 +187,45 @@ RegionStatistics region_statistics(const LinearImage& image, const std::vector<s
         throw InvalidArgument(concat(name, ": ", std::to_string(pixels), " pixels, more than the ",
                                      std::to_string(kMaxImagePixelsForStatistics),
                                      " region statistics handle"));
-    std::vector<std::uint32_t> used;
+    // One read of mask and flags: the used pixels as runs within rows (a rectangle: one run per
+    // row), the counts and the bounding box.
+    std::vector<ValueRun> runs;
     Box box{image.width, image.height, 0, 0};
-    for (std::size_t k = 0; k < pixels; ++k) {
-        if (mask[k] == 0) continue;
-        ++out.pixels_in_region;
-        const std::uint8_t f = image.flags[k];
-        if (f & kPixelSaturated) ++out.pixels_saturated;
-        if (f & kPixelClippedLow) ++out.pixels_clipped_low;
-        if (f != 0) continue;
-        used.push_back(static_cast<std::uint32_t>(k));
-        const std::size_t x = k % image.width, y = k / image.width;
-        box.x0 = std::min(box.x0, x);
-        box.y0 = std::min(box.y0, y);
-        box.x1 = std::max(box.x1, x + 1);
-        box.y1 = std::max(box.y1, y + 1);
+    std::size_t other = 0;  // flagged for another reason (e.g. no flat field)
+    const std::uint8_t* m = mask.data();
+    const std::uint8_t* flags = image.flags.data();
+    constexpr std::uint8_t kKnownFlags = kPixelSaturated | kPixelClippedLow;
+    for (std::size_t y = 0; y < image.height; ++y) {
+        const std::size_t row = y * image.width;
+        std::size_t x = 0;
+        while (x < image.width) {
+            for (; x < image.width && (m[row + x] == 0 || flags[row + x] != 0); ++x) {
+                if (m[row + x] == 0) continue;
+                const std::uint8_t f = flags[row + x];
+                ++out.pixels_in_region;
+                if (f & kPixelSaturated) ++out.pixels_saturated;
+                if (f & kPixelClippedLow) ++out.pixels_clipped_low;
+                if (f & ~kKnownFlags) ++other;
+            }
+            const std::size_t start = x;
+            while (x < image.width && m[row + x] != 0 && flags[row + x] == 0) ++x;
+            if (x == start) continue;
+            runs.push_back(
+                {static_cast<std::uint32_t>(row + start), static_cast<std::uint32_t>(x - start)});
+            out.pixels_in_region += x - start;
+            out.pixels_used += x - start;
+            box.x0 = std::min(box.x0, start);
+            box.x1 = std::max(box.x1, x);
+            box.y0 = std::min(box.y0, y);
+            box.y1 = y + 1;
+        }
     }
-    out.pixels_used = used.size();
     if (out.pixels_in_region == 0)
         throw InvalidArgument(concat(name, ": the region holds no pixel"));
 
     const std::size_t excluded = out.pixels_in_region - out.pixels_used;
     const double excluded_fraction =
         static_cast<double>(excluded) / static_cast<double>(out.pixels_in_region);
-    std::size_t other = 0;  // flagged for another reason (e.g. no flat field)
-    for (std::size_t k = 0; k < pixels; ++k)
-        if (mask[k] != 0 && (image.flags[k] & ~(kPixelSaturated | kPixelClippedLow)) != 0) ++other;
     const std::string counts = concat(
         std::to_string(excluded), " of ", std::to_string(out.pixels_in_region),
         " pixels of the region are flagged (", std::to_string(out.pixels_saturated), " saturated, ",
@@ -246,47 +238,61 @@ RegionStatistics region_statistics(const LinearImage& image, const std::vector<s
     if (excluded_fraction > options.warn_excluded_fraction)
         out.warnings.push_back(concat(counts, " and left out"));
 
-    // Per plane and for the per-pixel channel average.
-    std::vector<float> series(used.size());
-    for (std::size_t c = 0; c < image.channels; ++c) {
+    out.tile_size_px = options.tile_size_px > 0
+                           ? options.tile_size_px
+                           : choose_tile_size(runs, out.pixels_used, box, image.width);
+    const TileGrid grid = tile_grid(box, out.tile_size_px);
+    const std::vector<std::uint32_t> tile_n = tile_pixel_counts(runs, grid, image.width);
+
+    // Per plane: one read for the tile sums (their total is Σ v), one for Σ (v − v̄)², then the
+    // reads of the robust mean (robust_location.hpp). The planes are read in place.
+    const std::size_t planes = image.channels;
+    std::vector<double> tile_sums(grid.cells());
+    std::vector<double> average_tile_sums(planes > 1 ? grid.cells() : 0, 0.0);
+    double average_sum = 0.0;
+    for (std::size_t c = 0; c < planes; ++c) {
         const float* plane = image.plane(c);
-        for (std::size_t i = 0; i < used.size(); ++i) series[i] = plane[used[i]];
-        out.channels.push_back(series_statistics(series));
+        std::fill(tile_sums.begin(), tile_sums.end(), 0.0);
+        for_each_tile_piece(runs, grid, image.width,
+                            [&](std::size_t cell, std::size_t first, std::size_t length) {
+                                tile_sums[cell] += sum_of(plane + first, length);
+                            });
+        double sum = 0.0;
+        for (const double t : tile_sums) sum += t;
+        ChannelStatistics s;
+        set_spread_and_robust_mean({plane, runs, out.pixels_used}, sum, s);
+        set_tile_error(tile_sums, tile_n, out.tile_size_px, s);
+        out.channels.push_back(s);
+        if (planes > 1) {
+            for (std::size_t cell = 0; cell < tile_sums.size(); ++cell)
+                average_tile_sums[cell] += tile_sums[cell] / static_cast<double>(planes);
+            average_sum += sum / static_cast<double>(planes);
+        }
     }
-    if (image.channels == 1) {
+    if (planes == 1) {
         out.average = out.channels[0];
     } else {
-        for (std::size_t i = 0; i < used.size(); ++i) {
-            double sum = 0.0;
-            for (std::size_t c = 0; c < image.channels; ++c) sum += image.plane(c)[used[i]];
-            series[i] = static_cast<float>(sum / static_cast<double>(image.channels));
-        }
-        out.average = series_statistics(series);
-        // Mean and spread of the average in double from the planes (the float series above,
-        // rounded per pixel, serves the robust mean only).
-        const auto average_of = [&](std::size_t i) {
-            double sum = 0.0;
-            for (std::size_t c = 0; c < image.channels; ++c) sum += image.plane(c)[used[i]];
-            return sum / static_cast<double>(image.channels);
-        };
-        double sum = 0.0;
-        for (std::size_t i = 0; i < used.size(); ++i) sum += average_of(i);
-        out.average.mean = sum / static_cast<double>(used.size());
-        if (used.size() > 1) {
-            double ss = 0.0;
-            for (std::size_t i = 0; i < used.size(); ++i) {
-                const double d = average_of(i) - out.average.mean;
-                ss += d * d;
+        // The per-pixel average in double for mean and spread; rounded to float, the series of
+        // the robust mean (one contiguous array).
+        ChannelStatistics& a = out.average;
+        a.count = out.pixels_used;
+        a.mean = average_sum / static_cast<double>(a.count);
+        std::vector<float> series(out.pixels_used);
+        std::size_t i = 0;
+        double ss = 0.0;
+        for (const ValueRun& r : runs)
+            for (std::size_t k = r.start; k < std::size_t{r.start} + r.length; ++k, ++i) {
+                double v = 0.0;
+                for (std::size_t c = 0; c < planes; ++c) v += image.plane(c)[k];
+                v /= static_cast<double>(planes);
+                series[i] = static_cast<float>(v);
+                ss += (v - a.mean) * (v - a.mean);
             }
-            out.average.std_dev = std::sqrt(ss / static_cast<double>(used.size() - 1));
-        }
-        out.average.stderr_pixel =
-            out.average.std_dev / std::sqrt(static_cast<double>(used.size()));
+        if (a.count > 1) a.std_dev = std::sqrt(ss / static_cast<double>(a.count - 1));
+        a.stderr_pixel = a.std_dev / std::sqrt(static_cast<double>(a.count));
+        a.robust_mean = huber_location(std::span<const float>(series)).location;
+        set_tile_error(average_tile_sums, tile_n, out.tile_size_px, a);
     }
-
-    out.tile_size_px =
-        options.tile_size_px > 0 ? options.tile_size_px : choose_tile_size(used, box, image.width);
-    tile_errors(image, used, box, out.tile_size_px, out);
     if (out.average.tiles < 2)
         out.warnings.push_back(concat(
             std::to_string(out.average.tiles), " tile(s) of ", std::to_string(out.tile_size_px),
