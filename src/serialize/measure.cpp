@@ -116,8 +116,7 @@ Json to_json(const image::MeasureResult& r, const image::MeasureRequest& request
             return Estimate{fit->parameters[0].value, fit->parameters[0].std_error};
         return pair ? pair->sigma_over_T : std::nullopt;
     };
-    put(out, "sigma_over_T_gaussian",
-        slope(r.slope_gaussian, r.fit ? &r.fit->gaussian : nullptr));
+    put(out, "sigma_over_T_gaussian", slope(r.slope_gaussian, r.fit ? &r.fit->gaussian : nullptr));
     put(out, "sigma_over_T_exponential",
         slope(r.slope_exponential, r.fit ? &r.fit->exponential : nullptr));
     out["sigma_over_T_source"] = r.fit ? "fit" : "pair";

@@ -17,7 +17,8 @@ namespace roughscope::image {
 // Statistics of one series of values (the used pixels of one plane, or of the channel average).
 struct ChannelStatistics {
     double mean = 0;          // Σ v / n
-    double robust_mean = 0;   // Huber M-estimate, k = 1.345, scale = 1.4826 · MAD
+    double robust_mean = 0;   // Huber M-estimate, k = 1.345, scale = 1.4826 · MAD (above 2^20
+                              // pixels: of a regular subsample of 2^20, docs/image-regions.md)
     double std_dev = 0;       // √(Σ (v − mean)² / (n − 1)); 0 for n = 1
     double stderr_pixel = 0;  // std_dev / √n
     double stderr_tiles = 0;  // std of tile means / √tiles (0 when tiles < 2)

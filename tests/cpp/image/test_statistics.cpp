@@ -302,3 +302,25 @@ TEST(RegionStatistics, InvalidInputs) {
 
 }  // namespace
 }  // namespace roughscope::image
+
+namespace roughscope::image {
+namespace {
+
+// Above 2^20 used pixels the robust mean comes from a regular subsample: on symmetric noise it
+// still estimates the centre (within 5 standard errors of the subsample, ~2^-10 of the noise),
+// and a contamination of 5 % large outliers moves the mean but hardly the robust mean.
+TEST(RegionStatistics, LargeRegionsGetARobustMeanFromASubsample) {
+    LinearImage image = noisy_image(1600, 800, 3, {0.3, 0.5, 0.7}, 0.01, 9);           // 1.28 MP
+    for (std::size_t k = 0; k < image.pixel_count(); k += 20) image.values[k] = 0.9F;  // R only
+    const std::vector<std::uint8_t> mask(image.pixel_count(), 1);
+    const RegionStatistics s = region_statistics(image, mask);
+    const double tolerance = 5.0 * 0.01 / std::sqrt(static_cast<double>(1u << 19));
+    EXPECT_NEAR(s.channels[1].robust_mean, 0.5, tolerance);
+    EXPECT_NEAR(s.channels[2].robust_mean, 0.7, tolerance);
+    EXPECT_GT(s.channels[0].mean - 0.3, 0.02);                    // the outliers pull the mean
+    EXPECT_LT(std::abs(s.channels[0].robust_mean - 0.3), 0.002);  // not the robust mean
+    EXPECT_EQ(s.channels[0].count, image.pixel_count());
+}
+
+}  // namespace
+}  // namespace roughscope::image
