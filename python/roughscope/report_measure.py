@@ -42,11 +42,12 @@ def _fmt(value, err=None, digits=4):
 # Figures: a photograph with the measured region (and the highlight's rings) drawn over it.
 
 def _display(values):
-    """Average channel, scaled to its 99.5th percentile, sRGB-encoded for the screen."""
+    """Average channel, scaled so that the 99.5th percentile (or twice the median, for a nearly
+    uniform photograph, which then shows mid-grey) is white, sRGB-encoded for the screen."""
     import numpy as np
 
     grey = values.mean(axis=0)
-    top = float(np.percentile(grey, 99.5)) or 1.0
+    top = max(float(np.percentile(grey, 99.5)), 2.0 * float(np.median(grey))) or 1.0
     u = np.clip(grey / top, 0.0, 1.0)
     return np.where(u <= 0.0031308, 12.92 * u, 1.055 * np.power(u, 1 / 2.4) - 0.055)
 
