@@ -30,6 +30,7 @@
 #include <tiffio.h>
 #include <unistd.h>
 
+#include "bench_timing.hpp"
 #include "roughscope/image/read.hpp"
 
 namespace {
@@ -42,17 +43,7 @@ std::filesystem::path bench_path(const std::string& stem, std::size_t rows, cons
             std::to_string(::getpid()) + "." + ext);
 }
 
-template <class F>
-double seconds_of(F&& f, int repeats) {
-    double best = 1e300;
-    for (int k = 0; k < repeats; ++k) {
-        const auto t0 = std::chrono::steady_clock::now();
-        f();
-        const std::chrono::duration<double> dt = std::chrono::steady_clock::now() - t0;
-        best = std::min(best, dt.count());
-    }
-    return best;
-}
+using roughscope::bench::seconds_of;
 
 std::uint16_t sample(std::size_t i) {
     return static_cast<std::uint16_t>((i * 2654435761U) >> 16);  // spread over 0..65535

@@ -20,6 +20,7 @@
 
 #include <benchmark/benchmark.h>
 
+#include "bench_timing.hpp"
 #include "roughscope/image/region.hpp"
 #include "roughscope/image/statistics.hpp"
 
@@ -75,17 +76,7 @@ double sum_of(const std::vector<float>& values) {
     return sum;
 }
 
-template <class F>
-double seconds_of(F&& f, int repeats) {
-    double best = 1e300;
-    for (int k = 0; k < repeats; ++k) {
-        const auto t0 = std::chrono::steady_clock::now();
-        f();
-        const std::chrono::duration<double> dt = std::chrono::steady_clock::now() - t0;
-        best = std::min(best, dt.count());
-    }
-    return best;
-}
+using roughscope::bench::seconds_of;
 
 void bench_region(benchmark::State& state) {
     const Scene s = make_scene(static_cast<std::size_t>(state.range(0)));

@@ -20,6 +20,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <unistd.h>
 
+#include "bench_timing.hpp"
 #include "roughscope/image/measure.hpp"
 #include "roughscope/io/output_file.hpp"
 #include "roughscope/simulation/capture.hpp"
@@ -87,17 +88,7 @@ void decode(const Pair& p, sim::CaptureFormat format) {
     }
 }
 
-template <class F>
-double seconds_of(F&& f, int repeats) {
-    double best = 1e300;
-    for (int k = 0; k < repeats; ++k) {
-        const auto t0 = std::chrono::steady_clock::now();
-        f();
-        const std::chrono::duration<double> dt = std::chrono::steady_clock::now() - t0;
-        best = std::min(best, dt.count());
-    }
-    return best;
-}
+using roughscope::bench::seconds_of;
 
 void BM_measure_pair(benchmark::State& state, sim::CaptureFormat format) {
     const Pair p = make_pair(format, static_cast<std::size_t>(state.range(0)));

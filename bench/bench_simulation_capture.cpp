@@ -20,6 +20,7 @@
 #include <benchmark/benchmark.h>
 #include <unistd.h>
 
+#include "bench_timing.hpp"
 #include "roughscope/io/output_file.hpp"
 #include "roughscope/simulation/capture.hpp"
 
@@ -50,17 +51,7 @@ std::filesystem::path bench_path(const char* ext) {
            (std::string("roughscope_bench_capture_") + std::to_string(::getpid()) + "." + ext);
 }
 
-template <class F>
-double seconds_of(F&& f, int repeats) {
-    double best = 1e300;
-    for (int k = 0; k < repeats; ++k) {
-        const auto t0 = std::chrono::steady_clock::now();
-        f();
-        const std::chrono::duration<double> dt = std::chrono::steady_clock::now() - t0;
-        best = std::min(best, dt.count());
-    }
-    return best;
-}
+using roughscope::bench::seconds_of;
 
 void write_only(const Capture& c, const CameraModel& camera, CaptureFormat format,
                 const std::filesystem::path& path) {
