@@ -126,6 +126,29 @@ PAPER = """{
   }
 }
 """
+# capture_file: the capture file of `roughscope measure` (docs/measure.md).
+CAPTURE = """{
+  "format": "roughscope-measure", "wavelength_um": 0.555, "response": "srgb",
+  "black_level_dn": [0, 0, 0], "roi": {"rect": [8, 8, 48, 48]}, "correlation": "gaussian",
+  "regime": "slightly_rough", "sigma_um": 0.1, "highlight": {"core_radius_px": 3},
+  "statistics": {"tile_size_px": 8},
+  "captures": [
+    {"image": "a.png", "theta_i_deg": 30, "exposure_s": 0.02},
+    {"image": "b.png", "light": [0.7, 0, 0.7], "view": [0, 0, 1], "exposure_s": 0.01},
+    {"image": "s.png", "theta_i_deg": 14, "theta_s_deg": 14, "role": "specular"},
+    {"bracket": [{"image": "c1.png", "exposure_s": 1}, {"image": "c2.png", "exposure_s": 4}],
+     "theta_i_deg": 45}
+  ]
+}
+"""
+write("capture_file", "valid.json", CAPTURE)
+write("capture_file", "gamma_bracket.json", CAPTURE.replace('"response": "srgb"', '"response": {"bracket": [{"image": "k1.png", "exposure_s": 1}, {"image": "k2.png", "exposure_s": 2}]}'))
+write("capture_file", "polygon.json", CAPTURE.replace('{"rect": [8, 8, 48, 48]}', '{"polygon": [[1, 1], [40, 2], [20, 30]]}'))
+write("capture_file", "circle_gamma.json", CAPTURE.replace('{"rect": [8, 8, 48, 48]}', '{"circle": [30, 30, 10]}').replace('"response": "srgb"', '"response": {"gamma": 2.2}'))
+write("capture_file", "unknown_key.json", CAPTURE.replace('"correlation"', '"colour": 1, "correlation"'))
+write("capture_file", "angle_out_of_range.json", CAPTURE.replace('"theta_i_deg": 30', '"theta_i_deg": 95'))
+write("capture_file", "truncated.json", CAPTURE[:150])
+
 write("paper_json", "valid.json", PAPER)
 write("paper_json", "sample_not_integer.json", PAPER.replace('"sample": 7', '"sample": 7.5'))
 write("paper_json", "ratio_is_string.json", PAPER.replace('"E1_over_E2": 1.1', '"E1_over_E2": "1.1"'))
