@@ -174,12 +174,30 @@ Geometry parse_capture_geometry(const Context& ctx, const Json& c, const std::st
 
 }  // namespace
 
+namespace {
+
+MeasureRequest parse_checked(std::string_view text, const std::string& path);
+
+}  // namespace
+
 MeasureRequest parse_capture_file(std::string_view text, const std::string& path) {
+    // Every value is type-checked before it is read; should the JSON library still throw, the
+    // file is named as for any other malformed input.
+    try {
+        return parse_checked(text, path);
+    } catch (const Json::exception& e) {
+        throw DataError(concat(path, ": ", e.what()));
+    }
+}
+
+namespace {
+
+MeasureRequest parse_checked(std::string_view text, const std::string& path) {
     Context ctx{path, std::filesystem::path(path).parent_path()};
     Json doc;
     try {
         doc = Json::parse(text);
-    } catch (const Json::parse_error& e) {
+    } catch (const Json::exception& e) {  // a syntax error or a number out of range
         throw DataError(concat(path, ": not valid JSON: ", e.what()));
     }
     ctx.only(doc, "",
@@ -343,6 +361,8 @@ MeasureRequest parse_capture_file(std::string_view text, const std::string& path
     }
     return request;
 }
+
+}  // namespace
 
 MeasureRequest read_capture_file(const std::string& path) {
     std::error_code ec;

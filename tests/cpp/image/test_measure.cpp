@@ -666,6 +666,7 @@ TEST(CaptureFile, BadDocumentsNameTheKey) {
     const std::string captures =
         R"("captures": [{"image": "a.png", "theta_i_deg": 30}, {"image": "b.png", "theta_i_deg": 45}])";
     expect_capture_file_error("{", "not valid JSON");
+    expect_capture_file_error(R"({"wavelength_um": 1e999999})", "not valid JSON");  // overflow
     expect_capture_file_error(
         concat(R"({"roi": {"rect": [0, 0, 4, 4]}, "colour": 1, )", captures, "}"), "colour");
     expect_capture_file_error(concat("{", captures, "}"), "roi");
