@@ -60,3 +60,14 @@ def test_measure_peak_memory_is_a_few_decoded_images(large_pair):
     print(f"peak RSS {peak_kb / 1024:.0f} MiB = {peak_kb / one_image_kb:.2f} x one decoded image")
     assert peak_kb <= 6 * one_image_kb, (
         f"peak RSS {peak_kb / 1024:.0f} MiB > 6 x {one_image_kb / 1024:.0f} MiB")
+
+
+def test_the_tool_starts_small():
+    """`roughscope --version` stays far below 40 MiB: the image topic links libpng, libtiff,
+    libjpeg, LibRaw and OpenCV's core/imgproc/photo only. OpenCV's imgcodecs would load GDAL,
+    HEIF, OpenEXR and ~100 other libraries into every command (55 MiB measured)."""
+    p = subprocess.run([sys.executable, "-c", MEASURE, cli_path(), "--version"],
+                       capture_output=True, text=True, timeout=60)
+    code, peak_kb = (int(v) for v in p.stdout.split())
+    assert code == 0, p.stderr
+    assert peak_kb <= 40 * 1024, f"roughscope --version peak RSS {peak_kb / 1024:.0f} MiB"
