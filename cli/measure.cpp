@@ -8,6 +8,7 @@
 
 #include <filesystem>
 #include <iostream>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <sstream>
@@ -19,6 +20,8 @@
 #include "common.hpp"
 #include "python_runner.hpp"
 #include "roughscope/core/text.hpp"
+#include "roughscope/image/map_files.hpp"
+#include "roughscope/io/output_file.hpp"
 #include "roughscope/serialize/json.hpp"
 #include "roughscope/serialize/measure.hpp"
 
@@ -32,7 +35,8 @@ struct MeasureCommand {
     bool json_output = false;
     std::string output_path;
     std::string report_dir;
-    CLI::Option *o_output{}, *o_report{};
+    std::string maps_dir;
+    CLI::Option *o_output{}, *o_report{}, *o_maps{};
 };
 
 std::string value_with_error(const serialize::Json& doc, const std::string& key,
@@ -51,9 +55,12 @@ std::string value_with_error(const serialize::Json& doc, const std::string& key,
 std::string text_report(const serialize::Json& doc) {
     std::vector<std::pair<std::string, std::string>> items;
     items.emplace_back("captures", std::to_string(doc["captures"].size()));
-    items.emplace_back(
-        "region", concat(doc["region"]["description"].get<std::string>(), " (",
-                         std::to_string(doc["region"]["pixels"].get<std::size_t>()), " pixels)"));
+    items.emplace_back("object", doc["object"]["shape"].get<std::string>());
+    if (doc["region"].contains("description"))
+        items.emplace_back(
+            "region",
+            concat(doc["region"]["description"].get<std::string>(), " (",
+                   std::to_string(doc["region"]["pixels"].get<std::size_t>()), " pixels)"));
     items.emplace_back("E1/E2", value_with_error(doc, "E1_over_E2"));
     items.emplace_back("sigma/T (Gaussian)", value_with_error(doc, "sigma_over_T_gaussian"));
     items.emplace_back("sigma/T (exponential)", value_with_error(doc, "sigma_over_T_exponential"));
@@ -68,16 +75,96 @@ std::string text_report(const serialize::Json& doc) {
                       : concat(cls.get<std::string>(), doc["roughness_class_assumed"].get<bool>()
                                                            ? " (assumed by the estimator)"
                                                            : ""));
+    if (const auto& cyl = doc["cylinder"]; !cyl.is_null()) {
+        items.emplace_back("profile bins", std::to_string(cyl["profile"].size()));
+        for (const auto& m : cyl["models"]) {
+            const auto& d = m["departure_angle_deg"];
+            items.emplace_back(concat("departure ", m["model"].get<std::string>()),
+                               d.is_null() ? std::string("none (follows the data)")
+                                           : concat(format_result(d.get<double>(), "departure"),
+                                                    " deg"));
+        }
+    }
+    if (const auto& sph = doc["sphere"]; !sph.is_null()) {
+        items.emplace_back("sphere table rows", std::to_string(sph["rows"].get<std::size_t>()));
+        const auto& winner = sph["comparison"]["winner"];
+        items.emplace_back("best model", winner.is_null() ? std::string("-")
+                                                          : winner.get<std::string>());
+    }
+    if (const auto& map = doc["map"]; !map.is_null()) {
+        items.emplace_back("map", concat(std::to_string(map["width"].get<std::size_t>()), " x ",
+                                         std::to_string(map["height"].get<std::size_t>()),
+                                         " (window ", std::to_string(map["window_px"].get<std::size_t>()),
+                                         " px), ", std::to_string(map["valid"].get<std::size_t>()),
+                                         " valid"));
+        for (const auto& c : map["classes"])
+            items.emplace_back(concat("map ", c["roughness_class"].get<std::string>()),
+                               concat(format_fixed(100.0 * c["fraction"].get<double>(), 1), " %"));
+        for (const auto& r : map["regions"])
+            items.emplace_back(concat("region ", r["name"].get<std::string>()),
+                               concat("sigma/T (G) ", value_with_error(r, "sigma_over_T_gaussian")));
+    }
     std::ostringstream out;
     print_key_values(out, items);
     for (const auto& w : doc["warnings"]) out << "warning: " << w.get<std::string>() << '\n';
     return out.str();
 }
 
+// The map's layers as files in `dir` (docs/measure.md "Map files"): <layer>.tiff (float32) and
+// <layer>.npy for every float layer, <layer>.png (false colour with a colour bar) for σ/T and T,
+// <class layer>.png and .npy (codes as float, NaN for none). Everything is encoded first, then
+// every file is opened (temporary files) and only then committed, so a failure leaves no file
+// half-written. Returns the names written.
+std::vector<std::string> write_map_files(const image::RoughnessMap& map, const fs::path& dir) {
+    std::vector<std::pair<std::string, std::string>> files;
+    for (const auto& layer : serialize::map_float_layers(map)) {
+        files.emplace_back(layer.name + ".tiff",
+                           image::encode_map_tiff_float(*layer.values, map.width, map.height));
+        files.emplace_back(layer.name + ".npy",
+                           image::encode_npy(*layer.values, map.width, map.height));
+        if (layer.name.find("stderr") == std::string::npos && layer.name != "E1_over_E2")
+            files.emplace_back(layer.name + ".png",
+                               image::encode_map_png(*layer.values, map.width, map.height,
+                                                     image::finite_range(*layer.values),
+                                                     layer.name));
+    }
+    for (const auto& layer : serialize::map_class_layers(map)) {
+        files.emplace_back(layer.name + ".png",
+                           image::encode_class_png(*layer.values, map.width, map.height));
+        std::vector<float> codes(layer.values->size());
+        for (std::size_t k = 0; k < codes.size(); ++k)
+            codes[k] = (*layer.values)[k] == image::kClassNone
+                           ? std::numeric_limits<float>::quiet_NaN()
+                           : static_cast<float>((*layer.values)[k]);
+        files.emplace_back(layer.name + ".npy", image::encode_npy(codes, map.width, map.height));
+    }
+    std::error_code ec;
+    fs::create_directories(dir, ec);
+    if (ec) throw DataError(concat("cannot write ", dir.string(), ": ", ec.message()));
+    std::vector<io::OutputFile> outputs;
+    for (const auto& [name, bytes] : files) {
+        outputs.emplace_back(dir / name);
+        outputs.back().write(bytes);
+    }
+    std::vector<std::string> names;
+    for (std::size_t k = 0; k < outputs.size(); ++k) {
+        outputs[k].commit();
+        names.push_back(files[k].first);
+    }
+    return names;
+}
+
 void run_measure(const MeasureCommand& c) {
     const image::MeasureRequest request = image::read_capture_file(c.capture_file);
     const image::MeasureResult result = image::measure(request);
-    const serialize::Json doc = serialize::to_json(result, request);
+    serialize::Json doc = serialize::to_json(result, request);
+    if (given(c.o_maps)) {
+        if (!result.map)
+            throw InvalidArgument(concat("--maps: ", c.capture_file,
+                                         " asks for no map (add \"maps\" to the capture file)"));
+        doc["map"]["directory"] = c.maps_dir;
+        doc["map"]["files"] = write_map_files(*result.map, c.maps_dir);
+    }
     if (given(c.o_report)) {
         run_python_module("roughscope.report_measure",
                           {"--out", fs::absolute(c.report_dir).string()}, serialize::dump(doc),
@@ -102,6 +189,9 @@ void register_measure(CLI::App& app) {
     c.o_report = cmd->add_option("--report", c.report_dir,
                                  "Write an HTML report (photographs with the regions, values, "
                                  "checks) to DIR/index.html");
+    c.o_maps = cmd->add_option("--maps", c.maps_dir,
+                               "Write the roughness map's layers (float32 TIFF, .npy, false-colour "
+                               "PNG, class map) to DIR (the capture file's \"maps\")");
     cmd->callback([args]() { run_measure(*args); });
 }
 

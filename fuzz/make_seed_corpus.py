@@ -148,6 +148,29 @@ write("capture_file", "circle_gamma.json", CAPTURE.replace('{"rect": [8, 8, 48, 
 write("capture_file", "unknown_key.json", CAPTURE.replace('"correlation"', '"colour": 1, "correlation"'))
 write("capture_file", "angle_out_of_range.json", CAPTURE.replace('"theta_i_deg": 30', '"theta_i_deg": 95'))
 write("capture_file", "truncated.json", CAPTURE[:150])
+# Curved objects and maps (docs/measure.md "Curved objects and maps").
+write("capture_file", "cylinder.json", """{
+  "object": {"shape": "cylinder", "axis": {"point_px": [40, 30], "direction": [0, 1], "radius_px": 20},
+             "half": "both", "bin_width_deg": 3, "sigma_over_T": 0.7, "departure_bins": 2},
+  "captures": [{"image": "c.tiff", "light": [0, 0, 1]}]
+}
+""")
+write("capture_file", "cylinder_edges.json", """{
+  "object": {"shape": "cylinder", "edges": [[[10, 0], [10, 50]], [[50, 0], [50, 50]]]},
+  "roi": {"rect": [0, 0, 60, 60]}, "captures": [{"image": "c.tiff", "theta_i_deg": 0}]
+}
+""")
+write("capture_file", "sphere.json", """{
+  "object": {"shape": "sphere"}, "captures": [{"image": "s.tiff", "light": [-0.5, 0, 0.866]}]
+}
+""")
+write("capture_file", "maps.json", """{
+  "object": {"shape": "normal_map", "file": "n.png"},
+  "maps": {"window_px": 4, "max_shift_px": 0.5, "allow_misregistration": false,
+           "regions": [{"name": "a", "rect": [0, 0, 8, 8]}, {"name": "b", "circle": [9, 9, 3]}]},
+  "captures": [{"image": "a.png", "light": [0.5, 0, 0.866]}, {"image": "b.png", "light": [0.7, 0, 0.7]}]
+}
+""")
 
 write("paper_json", "valid.json", PAPER)
 write("paper_json", "sample_not_integer.json", PAPER.replace('"sample": 7', '"sample": 7.5'))

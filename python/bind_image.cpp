@@ -160,7 +160,7 @@ void bind_image(py::module_& m) {
                 concat(R"({"roi": )", serialize::dump(from_python(roi, "roi"), -1),
                        R"(, "captures": [{"image": "unused", "theta_i_deg": 0}]})");
             const image::MeasureRequest request = image::parse_capture_file(text, "roi");
-            const std::vector<std::uint8_t> mask = image::rasterize(request.roi, width, height);
+            const std::vector<std::uint8_t> mask = image::rasterize(*request.roi, width, height);
             py::array_t<bool> out({height, width});
             auto* dst = out.mutable_data();
             for (std::size_t k = 0; k < mask.size(); ++k) dst[k] = mask[k] != 0;
@@ -187,17 +187,36 @@ void bind_image(py::module_& m) {
         "per channel and for the channel average (docs/image-regions.md).");
     m.def(
         "measure",
-        [](const std::string& capture_file) {
+        [](const std::string& capture_file, bool layers) {
             serialize::Json doc;
+            std::optional<image::RoughnessMap> map;
             {
                 py::gil_scoped_release release;
                 const image::MeasureRequest request = image::read_capture_file(capture_file);
-                doc = serialize::to_json(image::measure(request), request);
+                image::MeasureResult result = image::measure(request);
+                doc = serialize::to_json(result, request);
+                if (layers) map = std::move(result.map);
             }
-            return to_python(doc);
+            py::dict out = to_python(doc).cast<py::dict>();
+            if (map) {
+                // The map's layers as (height, width) arrays, named as the CLI's files.
+                py::dict arrays;
+                const std::vector<py::ssize_t> shape{static_cast<py::ssize_t>(map->height),
+                                                     static_cast<py::ssize_t>(map->width)};
+                for (const auto& layer : serialize::map_float_layers(*map))
+                    arrays[py::str(layer.name)] =
+                        py::array_t<float>(shape, layer.values->data());
+                for (const auto& layer : serialize::map_class_layers(*map))
+                    arrays[py::str(layer.name)] =
+                        py::array_t<std::uint8_t>(shape, layer.values->data());
+                out["map"].cast<py::dict>()["layers"] = arrays;
+            }
+            return out;
         },
-        py::arg("capture_file"),
+        py::arg("capture_file"), py::arg("layers") = false,
         "Roughness from the photographs named in a capture file (JSON): the dict of "
+        "`roughscope measure --json` (docs/measure.md); layers=True adds the roughness map's "
+        "layers as (height, width) arrays under result['map']['layers'] "
         "`roughscope measure --json` (docs/measure.md).");
 }
 

@@ -150,6 +150,7 @@ def build_report(outdir):
     outdir = pathlib.Path(outdir)
     now = datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
     sections = [_import_section_module("report_measure").section(outdir),
+                _import_section_module("report_objects").section(outdir),
                 models_section(outdir)]
     for name in ("report_estimation", "report_curet", "report_surface", "report_simulation"):
         fragment = _import_section_module(name).section(outdir)

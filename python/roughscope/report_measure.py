@@ -193,6 +193,8 @@ def measurement_html(doc, capture_file=None, truth=None, title=None):
         if isinstance(response, dict):
             gamma, response = response["gamma"], "gamma"
         for c in doc["captures"]:
+            if "roi" not in spec:  # a curved object or a map: the figures below show it
+                break
             try:
                 png = overlay_png(c["image"], spec["roi"], response, gamma, c.get("highlight"),
                                   title=f"{pathlib.Path(c['image']).name}: θi = "
@@ -206,7 +208,13 @@ def measurement_html(doc, capture_file=None, truth=None, title=None):
                      "channel average, sRGB for display) with the measured region (orange), "
                      "saturated pixels (red) and, for a specular capture, the highlight's core "
                      "and annulus.</figcaption></figure>")
-    parts.append(captures_table(doc))
+    from .report_objects import objects_html
+
+    objects = objects_html(doc)
+    if objects:
+        parts.append(objects)
+    if doc.get("region", {}).get("description"):
+        parts.append(captures_table(doc))
     parts.append("<h4>Checks</h4>" + checks_html(doc))
     return "\n".join(parts)
 

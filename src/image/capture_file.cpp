@@ -109,38 +109,243 @@ std::vector<BracketShot> parse_bracket(const Context& ctx, const Json& j, const 
     return shots;
 }
 
-Region parse_roi(const Context& ctx, const Json& j) {
-    ctx.only(j, "roi", {"rect", "circle", "polygon", "mask"});
-    if (j.size() != 1) ctx.fail("roi", "must have exactly one of rect, circle, polygon, mask");
+// {"rect": ...} | {"circle": ...} | {"polygon": ...} | {"mask": FILE}, under `key`; `allowed`
+// lists the keys the object may hold (a map region also has its "name").
+Region parse_region(const Context& ctx, const Json& j, const std::string& key,
+                    std::initializer_list<std::string_view> allowed = {"rect", "circle", "polygon",
+                                                                       "mask"}) {
+    ctx.only(j, key, allowed);
+    const int shapes = static_cast<int>(j.contains("rect")) + static_cast<int>(j.contains("circle")) +
+                       static_cast<int>(j.contains("polygon")) + static_cast<int>(j.contains("mask"));
+    if (shapes != 1) ctx.fail(key, "must have exactly one of rect, circle, polygon, mask");
     if (j.contains("rect")) {
-        const auto r = ctx.numbers(j["rect"], "roi.rect", 4);
+        const auto r = ctx.numbers(j["rect"], concat(key, ".rect"), 4);
         return RectangleRegion{r[0], r[1], r[2], r[3]};
     }
     if (j.contains("circle")) {
-        const auto c = ctx.numbers(j["circle"], "roi.circle", 3);
+        const auto c = ctx.numbers(j["circle"], concat(key, ".circle"), 3);
         return CircleRegion{c[0], c[1], c[2]};
     }
     if (j.contains("polygon")) {
         const Json& p = j["polygon"];
-        if (!p.is_array()) ctx.fail("roi.polygon", "must be an array of [x, y] points");
+        if (!p.is_array()) ctx.fail(concat(key, ".polygon"), "must be an array of [x, y] points");
         std::vector<std::array<double, 2>> points;
         for (std::size_t k = 0; k < p.size(); ++k) {
-            const auto xy = ctx.numbers(p[k], concat("roi.polygon[", std::to_string(k), "]"), 2);
+            const auto xy =
+                ctx.numbers(p[k], concat(key, ".polygon[", std::to_string(k), "]"), 2);
             points.push_back({xy[0], xy[1]});
         }
         return PolygonRegion{points};
     }
-    const std::string file = ctx.path(j["mask"], "roi.mask");
+    const std::string file = ctx.path(j["mask"], concat(key, ".mask"));
     return mask_region_from_image(read_image(file));
 }
 
-Geometry parse_capture_geometry(const Context& ctx, const Json& c, const std::string& key) {
+// A whole number in [lo, hi].
+std::size_t whole(const Context& ctx, const Json& j, const std::string& key, double lo, double hi) {
+    const double v = ctx.number(j, key);
+    if (v != std::floor(v) || v < lo || v > hi)
+        ctx.fail(key, concat(check::format_number(v), " must be a whole number in [",
+                             check::format_number(lo), ", ", check::format_number(hi), "]"));
+    return static_cast<std::size_t>(v);
+}
+
+bool boolean(const Context& ctx, const Json& j, const std::string& key) {
+    if (!j.is_boolean()) ctx.fail(key, concat("must be true or false, not ", j.dump()));
+    return j.get<bool>();
+}
+
+// The library's own check of an options struct, its InvalidArgument reported under `key`.
+template <class F>
+void checked(const Context& ctx, const std::string& key, F check) {
+    try {
+        check();
+    } catch (const InvalidArgument& e) {
+        ctx.fail(key, e.what());
+    }
+}
+
+EdgePoint point_px(const Context& ctx, const Json& j, const std::string& key) {
+    const auto xy = ctx.numbers(j, key, 2);
+    EdgePoint p;
+    p.x_px = xy[0];
+    p.y_px = xy[1];
+    return p;
+}
+
+void parse_sphere_object(const Context& ctx, const Json& j, SphereOptions& o) {
+    ctx.only(j, "object",
+             {"shape", "circle", "threshold", "limb_fraction", "max_angle_deg", "cell_px",
+              "max_cells", "min_cell_fraction"});
+    if (j.contains("circle")) {
+        const auto c = ctx.numbers(j["circle"], "object.circle", 3);
+        CircleFit circle;
+        circle.centre_x_px = c[0];
+        circle.centre_y_px = c[1];
+        circle.radius_px = c[2];
+        if (!(circle.radius_px > 0.0)) ctx.fail("object.circle", "the radius must be > 0");
+        o.circle = circle;
+    }
+    if (j.contains("threshold"))
+        o.silhouette.threshold = ctx.positive(j["threshold"], "object.threshold");
+    if (j.contains("limb_fraction"))
+        o.limb_fraction = ctx.number(j["limb_fraction"], "object.limb_fraction");
+    if (j.contains("max_angle_deg"))
+        o.max_angle_deg = ctx.number(j["max_angle_deg"], "object.max_angle_deg");
+    if (j.contains("cell_px")) o.cell_px = whole(ctx, j["cell_px"], "object.cell_px", 0, 65535);
+    if (j.contains("max_cells"))
+        o.max_cells = whole(ctx, j["max_cells"], "object.max_cells", 1, 1e7);
+    if (j.contains("min_cell_fraction"))
+        o.min_cell_fraction = ctx.number(j["min_cell_fraction"], "object.min_cell_fraction");
+    checked(ctx, "object", [&] { check_sphere_options(o); });
+}
+
+// "object": {"shape": ..., shape options} (docs/measure.md "Curved objects and maps").
+ObjectSpec parse_object(const Context& ctx, const Json& j) {
+    if (!j.is_object() || !j.contains("shape"))
+        ctx.fail("object", concat("must be an object with a \"shape\" (plane, cylinder, sphere, "
+                                  "normal_map), not ",
+                                  j.dump()));
+    ObjectSpec spec;
+    spec.shape = ctx.named(j["shape"], "object.shape", parse_object_shape);
+    switch (spec.shape) {
+        case ObjectShape::Plane:
+            ctx.only(j, "object", {"shape"});
+            break;
+        case ObjectShape::NormalMap:
+            ctx.only(j, "object", {"shape", "file"});
+            if (!j.contains("file")) ctx.fail("object.file", "missing: the normal-map image");
+            spec.normal_map = ctx.path(j["file"], "object.file");
+            break;
+        case ObjectShape::Cylinder: {
+            ctx.only(j, "object",
+                     {"shape", "axis", "edges", "half", "bin_width_deg", "min_pixels_per_bin",
+                      "limb_fraction", "sigma_over_T", "fit_max_theta_i_deg", "departure_k",
+                      "departure_bins", "threshold"});
+            CylinderOptions& o = spec.cylinder;
+            if (j.contains("axis") && j.contains("edges"))
+                ctx.fail("object", "give the cylinder's axis or its edges, not both");
+            if (j.contains("axis")) {
+                const Json& a = j["axis"];
+                ctx.only(a, "object.axis", {"point_px", "direction", "radius_px"});
+                if (!a.contains("point_px") || !a.contains("direction") ||
+                    !a.contains("radius_px"))
+                    ctx.fail("object.axis", "needs point_px [x, y], direction [dx, dy] and "
+                                            "radius_px");
+                const auto p = ctx.numbers(a["point_px"], "object.axis.point_px", 2);
+                const auto d = ctx.numbers(a["direction"], "object.axis.direction", 2);
+                const double r = ctx.positive(a["radius_px"], "object.axis.radius_px");
+                checked(ctx, "object.axis", [&] {
+                    o.axis = cylinder_axis_from_line(p[0], p[1], d[0], d[1], r);
+                });
+            }
+            if (j.contains("edges")) {
+                const Json& e = j["edges"];
+                if (!e.is_array() || e.size() != 2 || !e[0].is_array() || e[0].size() != 2 ||
+                    !e[1].is_array() || e[1].size() != 2)
+                    ctx.fail("object.edges",
+                             "must be two edges of two points each: [[[x, y], [x, y]], "
+                             "[[x, y], [x, y]]]");
+                const EdgePoint a0 = point_px(ctx, e[0][0], "object.edges[0][0]");
+                const EdgePoint a1 = point_px(ctx, e[0][1], "object.edges[0][1]");
+                const EdgePoint b0 = point_px(ctx, e[1][0], "object.edges[1][0]");
+                const EdgePoint b1 = point_px(ctx, e[1][1], "object.edges[1][1]");
+                checked(ctx, "object.edges",
+                        [&] { o.axis = cylinder_axis_from_edges(a0, a1, b0, b1); });
+            }
+            if (j.contains("half")) o.half = ctx.named(j["half"], "object.half", parse_cylinder_half);
+            if (j.contains("bin_width_deg"))
+                o.bin_width_deg = ctx.number(j["bin_width_deg"], "object.bin_width_deg");
+            if (j.contains("min_pixels_per_bin"))
+                o.min_pixels_per_bin =
+                    whole(ctx, j["min_pixels_per_bin"], "object.min_pixels_per_bin", 1, 1e9);
+            if (j.contains("limb_fraction"))
+                o.limb_fraction = ctx.number(j["limb_fraction"], "object.limb_fraction");
+            if (j.contains("sigma_over_T") && !j["sigma_over_T"].is_null())
+                o.sigma_over_T = ctx.positive(j["sigma_over_T"], "object.sigma_over_T");
+            if (j.contains("fit_max_theta_i_deg"))
+                o.fit_max_theta_i_deg =
+                    ctx.number(j["fit_max_theta_i_deg"], "object.fit_max_theta_i_deg");
+            if (j.contains("departure_k"))
+                o.departure_k = ctx.number(j["departure_k"], "object.departure_k");
+            if (j.contains("departure_bins"))
+                o.departure_bins = whole(ctx, j["departure_bins"], "object.departure_bins", 1, 1e6);
+            if (j.contains("threshold"))
+                o.silhouette.threshold = ctx.positive(j["threshold"], "object.threshold");
+            checked(ctx, "object", [&] { check_cylinder_options(o); });
+            break;
+        }
+        case ObjectShape::Sphere:
+            parse_sphere_object(ctx, j, spec.sphere);
+            break;
+    }
+    return spec;
+}
+
+// "maps": {...} (docs/measure.md "Curved objects and maps", docs/maps.md).
+MapRequest parse_maps(const Context& ctx, const Json& j) {
+    ctx.only(j, "maps",
+             {"window_px", "min_used_fraction", "max_shift_px", "allow_misregistration",
+              "slightly_rough_max_sigma_over_T", "very_rough_min_sigma_over_T", "regions"});
+    MapRequest maps;
+    MapOptions& o = maps.options;
+    if (j.contains("window_px")) o.window_px = whole(ctx, j["window_px"], "maps.window_px", 1, 4096);
+    if (j.contains("min_used_fraction"))
+        o.min_used_fraction = ctx.positive(j["min_used_fraction"], "maps.min_used_fraction");
+    if (j.contains("max_shift_px")) {
+        o.max_shift_px = ctx.number(j["max_shift_px"], "maps.max_shift_px");
+        if (o.max_shift_px < 0.0) ctx.fail("maps.max_shift_px", "must be ≥ 0");
+    }
+    if (j.contains("allow_misregistration"))
+        o.allow_misregistration =
+            boolean(ctx, j["allow_misregistration"], "maps.allow_misregistration");
+    if (j.contains("slightly_rough_max_sigma_over_T"))
+        o.slightly_rough_max_sigma_over_T = ctx.positive(j["slightly_rough_max_sigma_over_T"],
+                                                         "maps.slightly_rough_max_sigma_over_T");
+    if (j.contains("very_rough_min_sigma_over_T"))
+        o.very_rough_min_sigma_over_T =
+            ctx.positive(j["very_rough_min_sigma_over_T"], "maps.very_rough_min_sigma_over_T");
+    if (j.contains("regions")) {
+        const Json& r = j["regions"];
+        if (!r.is_array())
+            ctx.fail("maps.regions", "must be an array of {\"name\": ..., \"rect\": ...} regions");
+        for (std::size_t k = 0; k < r.size(); ++k) {
+            const std::string key = concat("maps.regions[", std::to_string(k), "]");
+            if (!r[k].is_object() || !r[k].contains("name"))
+                ctx.fail(key, "needs a \"name\" and one of rect, circle, polygon, mask");
+            const std::string name = ctx.string(r[k]["name"], concat(key, ".name"));
+            maps.regions.emplace_back(
+                name, parse_region(ctx, r[k], key, {"name", "rect", "circle", "polygon", "mask"}));
+        }
+    }
+    return maps;
+}
+
+// The capture's geometry: theta_i_deg, theta_s_deg, phi_s_deg (paper frame) or light and view
+// vectors (the sample's normal +z; for a curved object the camera frame, view +z by default, and
+// neither given: L = V = +z, the retro-reflection of §5.2).
+void parse_capture_geometry(const Context& ctx, const Json& c, const std::string& key,
+                            bool curved, CaptureSpec& spec) {
     const bool angles =
         c.contains("theta_i_deg") || c.contains("theta_s_deg") || c.contains("phi_s_deg");
     const bool vectors = c.contains("light") || c.contains("view");
     if (angles && vectors)
         ctx.fail(key,
                  "give either theta_i_deg, theta_s_deg, phi_s_deg or light and view, not both");
+    if (curved && !angles) {
+        spec.light = c.contains("light") ? unit_vector(ctx, c["light"], concat(key, ".light"))
+                                         : Eigen::Vector3d::UnitZ();
+        spec.view = c.contains("view") ? unit_vector(ctx, c["view"], concat(key, ".view"))
+                                       : Eigen::Vector3d::UnitZ();
+        for (const auto& [name, v] : {std::pair{"light", *spec.light}, std::pair{"view", *spec.view}})
+            if (!(v.z() > 0.0))
+                ctx.fail(concat(key, ".", name),
+                         "must point toward the camera side (z > 0; camera frame: x image right, "
+                         "y image up, z toward the camera)");
+        if (const auto g = geometry_from_vectors(Eigen::Vector3d::UnitZ(), *spec.light, *spec.view))
+            spec.geometry = *g;
+        return;
+    }
     if (vectors) {
         if (!c.contains("light") || !c.contains("view"))
             ctx.fail(key, "light and view must both be given");
@@ -151,7 +356,10 @@ Geometry parse_capture_geometry(const Context& ctx, const Json& c, const std::st
             ctx.fail(key,
                      "the light or the view is at or below the sample's plane (z ≤ 0); the "
                      "normal of the sample is +z");
-        return *g;
+        spec.geometry = *g;
+        spec.light = L;
+        spec.view = V;
+        return;
     }
     if (!c.contains("theta_i_deg"))
         ctx.fail(key, "needs theta_i_deg (and theta_s_deg, phi_s_deg) or light and view");
@@ -169,7 +377,11 @@ Geometry parse_capture_geometry(const Context& ctx, const Json& c, const std::st
             ctx.fail(concat(key, ".", name),
                      concat(check::format_number(rad_to_deg(value)), " must be in [0, 90)"));
     }
-    return g;
+    spec.geometry = g;
+    if (curved) {
+        spec.light = light_direction(g);
+        spec.view = view_direction(g);
+    }
 }
 
 }  // namespace
@@ -221,6 +433,8 @@ MeasureRequest parse_checked(std::string_view text, const std::string& path) {
               "highlight",
               "statistics",
               "white_balance",
+              "object",
+              "maps",
               "description"});
     MeasureRequest request;
     request.source = path;
@@ -327,8 +541,14 @@ MeasureRequest parse_checked(std::string_view text, const std::string& path) {
             request.statistics.max_excluded_fraction = f;
         }
     }
-    if (!doc.contains("roi")) ctx.fail("roi", "missing: the region to measure is required");
-    request.roi = parse_roi(ctx, doc["roi"]);
+    if (doc.contains("object")) request.object = parse_object(ctx, doc["object"]);
+    if (doc.contains("maps")) request.maps = parse_maps(ctx, doc["maps"]);
+    const bool curved = request.object.shape != ObjectShape::Plane;
+    if (doc.contains("roi"))
+        request.roi = parse_region(ctx, doc["roi"], "roi");
+    else if (!curved && !request.maps)
+        ctx.fail("roi", "missing: the region to measure is required (for a flat sample without "
+                        "\"maps\")");
     if (!doc.contains("captures") || !doc["captures"].is_array() || doc["captures"].empty())
         ctx.fail("captures", "must be a non-empty array of captures");
     const Json& captures = doc["captures"];
@@ -352,7 +572,7 @@ MeasureRequest parse_checked(std::string_view text, const std::string& path) {
         } else {
             spec.image = ctx.path(c["image"], concat(key, ".image"));
         }
-        spec.geometry = parse_capture_geometry(ctx, c, key);
+        parse_capture_geometry(ctx, c, key, curved, spec);
         if (c.contains("exposure_s") && !c["exposure_s"].is_null())
             spec.exposure_s = ctx.positive(c["exposure_s"], concat(key, ".exposure_s"));
         if (c.contains("role"))

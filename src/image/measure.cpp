@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
+#include <limits>
 #include <utility>
 
 #include "roughscope/core/errors.hpp"
@@ -18,6 +20,17 @@ constexpr std::array<NameEntry<CaptureRole>, 2> kRoleNames{{
     {"diffuse", CaptureRole::Diffuse},
     {"specular", CaptureRole::Specular},
 }};
+
+constexpr std::array<NameEntry<ObjectShape>, 4> kShapeNames{{
+    {"plane", ObjectShape::Plane},
+    {"cylinder", ObjectShape::Cylinder},
+    {"sphere", ObjectShape::Sphere},
+    {"normal_map", ObjectShape::NormalMap},
+}};
+
+bool is_profile(ObjectShape shape) {
+    return shape == ObjectShape::Cylinder || shape == ObjectShape::Sphere;
+}
 
 std::string where(const MeasureRequest& request) {
     return request.source.empty() ? std::string("measure") : request.source;
@@ -65,6 +78,29 @@ void check_request(const MeasureRequest& request) {
         std::count_if(request.captures.begin(), request.captures.end(),
                       [](const CaptureSpec& s) { return s.role == CaptureRole::Diffuse; });
     const auto specular = static_cast<std::ptrdiff_t>(request.captures.size()) - diffuse;
+    const ObjectShape shape = request.object.shape;
+    if (is_profile(shape)) {
+        if (request.captures.size() != 1 || specular != 0)
+            throw InvalidArgument(concat(src, ": a ", to_string(shape),
+                                         " is measured from one diffuse photograph (§5.2); got ",
+                                         std::to_string(request.captures.size()), " captures (",
+                                         std::to_string(specular), " specular)"));
+        if (request.maps)
+            throw InvalidArgument(concat(src, ": maps are made of a flat sample or an object with "
+                                              "a normal map (object.shape plane or normal_map), "
+                                              "not of a ",
+                                         to_string(shape)));
+        return;
+    }
+    if (request.maps && diffuse < 2)
+        throw InvalidArgument(concat(src, ": a roughness map needs two diffuse captures (lit from "
+                                          "two directions); got ",
+                                     std::to_string(diffuse)));
+    if (shape == ObjectShape::NormalMap && !request.maps)
+        throw InvalidArgument(concat(src, ": object.shape normal_map is measured as a map: give "
+                                          "\"maps\""));
+    if (!request.roi && !request.maps)
+        throw InvalidArgument(concat(src, ": no roi: give the region to measure"));
     if (diffuse == 1 && specular == 0)
         throw InvalidArgument(concat(src,
                                      ": one diffuse capture gives no estimate; give a second "
@@ -179,6 +215,17 @@ class Loader {
     const MeasureRequest& request_;
     std::optional<ResponseCurve> curve_;
 };
+
+// Width and height only (a normal map has 3 channels whatever the captures have).
+void check_same_size_pixels(const LinearImage& image, const LinearImage& first,
+                            const std::string& src) {
+    if (image.width != first.width || image.height != first.height)
+        throw DataError(concat(src, ": ", image.info.source, " is ", std::to_string(image.width),
+                               " x ", std::to_string(image.height), " but ", first.info.source,
+                               " is ", std::to_string(first.width), " x ",
+                               std::to_string(first.height), ": the normal map must have the "
+                               "captures' size"));
+}
 
 void check_same_size(const LinearImage& image, const LinearImage& first, const std::string& src) {
     if (image.width != first.width || image.height != first.height ||
@@ -357,10 +404,58 @@ CaptureRole parse_capture_role(std::string_view name) {
     return parse_name(kRoleNames, "capture role", name);
 }
 
+std::string_view to_string(ObjectShape shape) { return name_of(kShapeNames, shape); }
+
+ObjectShape parse_object_shape(std::string_view name) {
+    return parse_name(kShapeNames, "object shape", name);
+}
+
+namespace {
+
+// The normals of a normal-map image (ObjectSpec::normal_map): 3 floats per pixel, NaN off the
+// object.
+std::vector<float> decode_normal_map(const LinearImage& image, const std::string& src) {
+    if (image.channels != 3)
+        throw DataError(concat(src, ": normal map ", image.info.source, " has ",
+                               std::to_string(image.channels),
+                               " channel(s); a normal map holds 3 (n_x, n_y, n_z as R, G, B)"));
+    const bool encoded = !image.info.is_float;  // integer files: n = 2v − 1
+    const std::size_t n = image.pixel_count();
+    std::vector<float> normals(3 * n);
+    for (std::size_t k = 0; k < n; ++k) {
+        double v[3];
+        for (std::size_t c = 0; c < 3; ++c) {
+            const double x = image.values[c * n + k];
+            v[c] = encoded ? 2.0 * x - 1.0 : x;
+        }
+        const double norm = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+        const bool on = norm >= 0.5 && (image.flags.empty() || image.flags[k] == 0);
+        for (std::size_t c = 0; c < 3; ++c)
+            normals[3 * k + c] = on ? static_cast<float>(v[c] / norm)
+                                    : std::numeric_limits<float>::quiet_NaN();
+    }
+    return normals;
+}
+
+// One int32 per pixel: the index of the first named region that holds the pixel, else −1.
+std::vector<std::int32_t> region_labels(const MapRequest& maps, std::size_t width,
+                                        std::size_t height) {
+    std::vector<std::int32_t> labels(width * height, -1);
+    for (std::size_t r = 0; r < maps.regions.size(); ++r) {
+        const std::vector<std::uint8_t> mask = rasterize(maps.regions[r].second, width, height);
+        for (std::size_t k = 0; k < mask.size(); ++k)
+            if (mask[k] != 0 && labels[k] < 0) labels[k] = static_cast<std::int32_t>(r);
+    }
+    return labels;
+}
+
+}  // namespace
+
 MeasureResult measure(const MeasureRequest& request) {
     check_request(request);
     const std::string src = where(request);
     MeasureResult result;
+    const ObjectShape shape = request.object.shape;
 
     const Loader loader(request);
     std::optional<LinearImage> dark, flat;
@@ -369,6 +464,9 @@ MeasureResult measure(const MeasureRequest& request) {
 
     std::vector<std::uint8_t> mask;
     std::optional<LinearImage> first;
+    // A map keeps the first two diffuse images (the pair it divides) and their captures' index.
+    std::vector<LinearImage> map_images;
+    std::vector<std::size_t> map_captures;
     for (const CaptureSpec& spec : request.captures) {
         CaptureMeasurement capture;
         capture.spec = spec;
@@ -381,9 +479,11 @@ MeasureResult measure(const MeasureRequest& request) {
             first->height = image.height;
             first->channels = image.channels;
             first->info.source = image.info.source;
-            mask = rasterize(request.roi, image.width, image.height);
-            result.region_pixels = static_cast<std::size_t>(
-                std::count_if(mask.begin(), mask.end(), [](std::uint8_t m) { return m != 0; }));
+            if (request.roi) {
+                mask = rasterize(*request.roi, image.width, image.height);
+                result.region_pixels = static_cast<std::size_t>(
+                    std::count_if(mask.begin(), mask.end(), [](std::uint8_t m) { return m != 0; }));
+            }
         }
         check_same_size(image, *first, src);
         if (dark) {
@@ -396,32 +496,62 @@ MeasureResult measure(const MeasureRequest& request) {
         }
         for (const auto& w : image.info.warnings)
             result.warnings.push_back(concat(spec.image, ": ", w));
-        if (spec.role == CaptureRole::Specular) {
+        const std::vector<std::uint8_t>* roi_mask = request.roi ? &mask : nullptr;
+        if (shape == ObjectShape::Cylinder) {
+            CylinderOptions options = request.object.cylinder;
+            options.light = spec.light.value_or(Eigen::Vector3d::UnitZ());
+            options.view = spec.view.value_or(Eigen::Vector3d::UnitZ());
+            result.cylinder = measure_cylinder_profile(image, roi_mask, options);
+            for (const auto& w : result.cylinder->warnings)
+                result.warnings.push_back(concat(spec.image, ": ", w));
+        } else if (shape == ObjectShape::Sphere) {
+            SphereOptions options = request.object.sphere;
+            options.light = spec.light.value_or(Eigen::Vector3d::UnitZ());
+            options.view = spec.view.value_or(Eigen::Vector3d::UnitZ());
+            result.sphere = measure_sphere(image, roi_mask, options);
+            for (const auto& w : result.sphere->warnings)
+                result.warnings.push_back(concat(spec.image, ": ", w));
+        } else if (spec.role == CaptureRole::Specular) {
+            if (!request.roi)
+                throw InvalidArgument(concat(src, ": ", spec.image,
+                                             ": a specular capture needs the roi that holds its "
+                                             "highlight"));
             capture.highlight = measure_highlight(image, mask, request.highlight);
             capture.region = capture.highlight->core;
             for (const auto& w : capture.highlight->warnings)
                 result.warnings.push_back(concat(spec.image, ": ", w));
-        } else {
+        } else if (request.roi) {
             capture.region = region_statistics(image, mask, request.statistics);
             for (const auto& w : capture.region.warnings)
                 result.warnings.push_back(concat(spec.image, ": ", w));
         }
-        capture.info = std::move(image.info);
+        capture.info = image.info;
+        if (request.maps && spec.role == CaptureRole::Diffuse && map_images.size() < 2) {
+            map_images.push_back(std::move(image));
+            map_captures.push_back(result.captures.size());
+        }
         result.captures.push_back(std::move(capture));
     }
     assign_exposures(result.captures, result.warnings, src);
+    if (is_profile(shape)) {
+        for (CaptureMeasurement& c : result.captures) c.brightness_relative_stderr = 0.0;
+        return result;
+    }
     std::vector<const CaptureMeasurement*> diffuse;
-    for (CaptureMeasurement& c : result.captures) {
-        if (c.spec.role != CaptureRole::Diffuse) continue;
-        const ChannelStatistics& avg = c.region.average;
-        if (!(avg.mean > 0.0))
-            throw InvalidArgument(concat(src, ": ", c.spec.image, ": the region's mean brightness ",
-                                         check::format_number(avg.mean),
-                                         " is not above the black level (after the dark frame): "
-                                         "nothing to measure; check the exposure and the region"));
-        c.brightness = avg.mean / c.exposure_scale;
-        c.brightness_relative_stderr = relative_stderr(avg);
-        diffuse.push_back(&c);
+    if (request.roi) {
+        for (CaptureMeasurement& c : result.captures) {
+            if (c.spec.role != CaptureRole::Diffuse) continue;
+            const ChannelStatistics& avg = c.region.average;
+            if (!(avg.mean > 0.0))
+                throw InvalidArgument(
+                    concat(src, ": ", c.spec.image, ": the region's mean brightness ",
+                           check::format_number(avg.mean),
+                           " is not above the black level (after the dark frame): nothing to "
+                           "measure; check the exposure and the region"));
+            c.brightness = avg.mean / c.exposure_scale;
+            c.brightness_relative_stderr = relative_stderr(avg);
+            diffuse.push_back(&c);
+        }
     }
 
     std::optional<double> sigma_um = request.sigma_um;
@@ -446,6 +576,57 @@ MeasureResult measure(const MeasureRequest& request) {
         sigma_um_stderr = result.sigma->sigma_um->std_error;
     }
     if (diffuse.size() >= 2) estimate_diffuse(diffuse, request, sigma_um, sigma_um_stderr, result);
+
+    if (request.maps) {
+        MapOptions options = request.maps->options;
+        options.factor = request.factor;
+        options.radiometry = request.radiometry;
+        options.wavelength_um = request.wavelength_um;
+        options.correlation = request.correlation;
+        if (sigma_um) {
+            options.sigma_um = sigma_um;
+            options.sigma_um_stderr = sigma_um_stderr;
+        }
+        std::vector<float> normals;
+        if (shape == ObjectShape::NormalMap) {
+            // Read as stored (linear, no black level): the values encode directions, not light.
+            const LinearImage normal_image = read_image(request.object.normal_map, code_scale());
+            check_same_size_pixels(normal_image, *first, src);
+            normals = decode_normal_map(normal_image, src);
+            options.normal_map = normals;
+        }
+        std::vector<std::int32_t> labels;
+        if (!request.maps->regions.empty()) {
+            labels = region_labels(*request.maps, first->width, first->height);
+            options.region_labels = labels;
+            for (const auto& r : request.maps->regions) options.region_names.push_back(r.first);
+        }
+        std::vector<MapCapture> captures;
+        for (std::size_t k = 0; k < map_images.size(); ++k) {
+            const CaptureMeasurement& c = result.captures[map_captures[k]];
+            MapCapture m;
+            m.image = &map_images[k];
+            m.name = c.spec.image;
+            m.geometry = c.spec.geometry;
+            m.exposure_scale = c.exposure_scale;
+            m.light = c.spec.light;
+            m.view = c.spec.view;
+            if (shape == ObjectShape::NormalMap) {
+                if (!m.light) m.light = light_direction(c.spec.geometry);
+                if (!m.view) m.view = view_direction(c.spec.geometry);
+            }
+            captures.push_back(std::move(m));
+        }
+        const auto diffuse_count =
+            std::count_if(request.captures.begin(), request.captures.end(),
+                          [](const CaptureSpec& s) { return s.role == CaptureRole::Diffuse; });
+        if (diffuse_count > 2)
+            result.warnings.push_back(concat(src,
+                                             ": the map divides the first two diffuse captures; "
+                                             "the others enter the region measurement only"));
+        result.map = roughness_map(captures, options);
+        for (const auto& w : result.map->warnings) result.warnings.push_back(concat("map: ", w));
+    }
     // Each warning once, in the order first given.
     std::vector<std::string> unique;
     for (auto& w : result.warnings)

@@ -5,6 +5,7 @@
 
 #include "roughscope/scattering/beckmann.hpp"
 #include "roughscope/scattering/validity.hpp"
+#include "roughscope/serialize/comparison.hpp"
 #include "roughscope/serialize/estimation.hpp"
 
 namespace roughscope::serialize {
@@ -84,7 +85,183 @@ Json capture_json(const image::CaptureMeasurement& c) {
     return out;
 }
 
+Json vector_json(const Eigen::Vector3d& v) {
+    return Json::array({number(v.x()), number(v.y()), number(v.z())});
+}
+
+Json degrees_or_null(const std::optional<double>& radians) {
+    return radians ? degrees(*radians) : Json();
+}
+
+Json profile_fit_json(const image::ProfileFit& f) {
+    Json out;
+    out["correlation"] = std::string(to_string(f.correlation));
+    out["status"] = std::string(to_string(f.status));
+    out["message"] = f.message;
+    out["sigma_over_T"] = number(f.sigma_over_T);
+    out["sigma_over_T_stderr"] =
+        f.sigma_over_T && f.sigma_over_T_stderr > 0.0 ? number(f.sigma_over_T_stderr) : Json();
+    out["gain"] = number(f.gain);
+    out["aic"] = number(f.aic);
+    out["bins"] = f.bins;
+    return out;
+}
+
 }  // namespace
+
+Json to_json(const image::CylinderProfile& p) {
+    Json out;
+    Json axis;
+    axis["point_px"] = Json::array({number(p.axis.point_x_px), number(p.axis.point_y_px)});
+    axis["direction"] = Json::array({number(p.axis.direction_x), number(p.axis.direction_y)});
+    axis["radius_px"] = number(p.axis.radius_px);
+    axis["source"] = p.axis.detected ? "detected" : "given";
+    axis["rms_residual_px"] = p.axis.detected ? number(p.axis.rms_residual_px) : Json();
+    out["axis"] = axis;
+    out["light"] = vector_json(p.light);
+    out["view"] = vector_json(p.view);
+    out["half"] = std::string(image::to_string(p.half));
+    out["bin_width_deg"] = degrees(p.bin_width_rad);
+    out["maximum"] = number(p.maximum);
+    Json rows = Json::array();
+    for (const image::ProfileBin& b : p.bins) {
+        Json row;
+        row["theta_deg"] = degrees(b.theta_i_rad);
+        row["theta_s_deg"] = degrees(b.geometry.theta_s_rad);
+        row["phi_s_deg"] = degrees(b.geometry.phi_s_rad);
+        row["alpha_deg"] = degrees(b.alpha_rad);
+        row["brightness"] = number(b.brightness);
+        row["stderr"] = number(b.standard_error);
+        row["count"] = b.count;
+        row["in_fit"] = b.in_fit;
+        rows.push_back(row);
+    }
+    out["profile"] = rows;
+    put(out, "sigma_over_T_gaussian",
+        p.gaussian_fit.sigma_over_T
+            ? std::optional<Estimate>(
+                  Estimate{*p.gaussian_fit.sigma_over_T, p.gaussian_fit.sigma_over_T_stderr})
+            : std::nullopt);
+    put(out, "sigma_over_T_exponential",
+        p.exponential_fit.sigma_over_T
+            ? std::optional<Estimate>(Estimate{*p.exponential_fit.sigma_over_T,
+                                               p.exponential_fit.sigma_over_T_stderr})
+            : std::nullopt);
+    out["preferred_correlation"] = std::string(to_string(p.preferred));
+    out["fit"] = Json{{"gaussian", profile_fit_json(p.gaussian_fit)},
+                      {"exponential", profile_fit_json(p.exponential_fit)}};
+    Json models = Json::array();
+    Json departure;
+    for (const image::ProfileModelCurve& m : p.models) {
+        Json mj;
+        mj["model"] = m.name;
+        mj["display_name"] = std::string(image::display_name(m.model));
+        mj["sigma_over_T"] = number(m.sigma_over_T);
+        mj["prediction"] = numbers(m.prediction);
+        mj["rms_difference"] = number(m.rms_difference);
+        mj["departure_angle_deg"] = degrees_or_null(m.departure_theta_i_rad);
+        departure[m.name] = mj["departure_angle_deg"];
+        models.push_back(mj);
+    }
+    out["models"] = models;
+    out["departure_angle_deg"] = departure;
+    out["theta_K_deg"] = degrees_or_null(p.theta_K_rad);
+    out["pixels_used"] = p.pixels_used;
+    out["pixels_flagged"] = p.pixels_flagged;
+    out["warnings"] = p.warnings;
+    return out;
+}
+
+Json to_json(const image::SphereResult& s) {
+    Json out;
+    Json circle;
+    circle["centre_x_px"] = number(s.circle.centre_x_px);
+    circle["centre_y_px"] = number(s.circle.centre_y_px);
+    circle["radius_px"] = number(s.circle.radius_px);
+    circle["rms_residual_px"] = s.circle_detected ? number(s.circle.rms_residual_px) : Json();
+    circle["source"] = s.circle_detected ? "detected" : "given";
+    out["circle"] = circle;
+    out["cell_px"] = s.cell_px;
+    out["rows"] = s.table.size();
+    out["pixels_used"] = s.pixels_used;
+    out["pixels_flagged"] = s.pixels_flagged;
+    out["comparison"] = to_json(s.comparison);
+    out["warnings"] = s.warnings;
+    return out;
+}
+
+Json to_json(const image::RoughnessMap& m) {
+    Json out;
+    out["width"] = m.width;
+    out["height"] = m.height;
+    out["window_px"] = m.window_px;
+    out["image_width"] = m.image_width;
+    out["image_height"] = m.image_height;
+    out["method"] = m.method;
+    out["valid"] = m.valid;
+    out["missing"] = m.missing;
+    out["no_solution"] = m.no_solution;
+    out["no_solution_exponential"] = m.no_solution_exponential;
+    if (m.registration) {
+        Json r;
+        r["shift_x_px"] = number(m.registration->shift_x_px);
+        r["shift_y_px"] = number(m.registration->shift_y_px);
+        r["magnitude_px"] = number(m.registration->magnitude_px);
+        r["response"] = number(m.registration->response);
+        out["registration"] = r;
+    } else {
+        out["registration"] = Json();
+    }
+    Json classes = Json::array();
+    for (const image::ClassStatistics& c : m.classes) {
+        Json cj;
+        cj["roughness_class"] = std::string(to_string(c.roughness_class));
+        cj["count"] = c.count;
+        cj["fraction"] = number(c.fraction);
+        put(cj, "mean_sigma_over_T", c.mean_sigma_over_T);
+        classes.push_back(cj);
+    }
+    out["classes"] = classes;
+    Json regions = Json::array();
+    for (const image::RegionMapStatistics& r : m.regions) {
+        Json rj;
+        rj["name"] = r.name;
+        rj["count"] = r.count;
+        rj["missing"] = r.missing;
+        put(rj, "sigma_over_T_gaussian", r.mean_sigma_over_T_gaussian);
+        put(rj, "sigma_over_T_exponential", r.mean_sigma_over_T_exponential);
+        put(rj, "T_um", r.mean_T_um);
+        Json counts;
+        for (std::size_t c = 0; c < 3; ++c)
+            counts[std::string(to_string(static_cast<RoughnessClass>(c)))] = r.class_counts[c];
+        rj["class_counts"] = counts;
+        regions.push_back(rj);
+    }
+    out["regions"] = regions;
+    out["warnings"] = m.warnings;
+    return out;
+}
+
+std::vector<MapLayer> map_float_layers(const image::RoughnessMap& m) {
+    std::vector<MapLayer> layers{
+        {"sigma_over_T_gaussian", &m.sigma_over_T_gaussian},
+        {"sigma_over_T_gaussian_stderr", &m.sigma_over_T_gaussian_stderr},
+        {"sigma_over_T_exponential", &m.sigma_over_T_exponential},
+        {"sigma_over_T_exponential_stderr", &m.sigma_over_T_exponential_stderr},
+        {"E1_over_E2", &m.E1_over_E2},
+    };
+    if (!m.T_um.empty()) {
+        layers.push_back({"T_um", &m.T_um});
+        layers.push_back({"T_um_stderr", &m.T_um_stderr});
+    }
+    return layers;
+}
+
+std::vector<MapClassLayer> map_class_layers(const image::RoughnessMap& m) {
+    std::vector<MapClassLayer> layers{{"roughness_class", &m.roughness_class}};
+    if (!m.roughness_class_g.empty()) layers.push_back({"roughness_class_g", &m.roughness_class_g});
+    return layers;
+}
 
 Json to_json(const image::RegionStatistics& s) {
     Json out;
@@ -116,10 +293,23 @@ Json to_json(const image::MeasureResult& r, const image::MeasureRequest& request
             return Estimate{fit->parameters[0].value, fit->parameters[0].std_error};
         return pair ? pair->sigma_over_T : std::nullopt;
     };
-    put(out, "sigma_over_T_gaussian", slope(r.slope_gaussian, r.fit ? &r.fit->gaussian : nullptr));
-    put(out, "sigma_over_T_exponential",
-        slope(r.slope_exponential, r.fit ? &r.fit->exponential : nullptr));
-    out["sigma_over_T_source"] = r.fit ? "fit" : "pair";
+    if (r.cylinder) {
+        // A cylinder: σ/T fitted on its profile (§5.2).
+        const Json profile = to_json(*r.cylinder);
+        for (const char* key : {"sigma_over_T_gaussian", "sigma_over_T_exponential"}) {
+            out[key] = profile[key];
+            out[std::string(key) + "_stderr"] = profile[std::string(key) + "_stderr"];
+        }
+        out["sigma_over_T_source"] = "cylinder_profile";
+    } else {
+        put(out, "sigma_over_T_gaussian",
+            slope(r.slope_gaussian, r.fit ? &r.fit->gaussian : nullptr));
+        put(out, "sigma_over_T_exponential",
+            slope(r.slope_exponential, r.fit ? &r.fit->exponential : nullptr));
+        out["sigma_over_T_source"] = r.fit                                        ? "fit"
+                                     : r.slope_gaussian || r.slope_exponential ? "pair"
+                                                                                 : Json();
+    }
     std::optional<Estimate> sigma;
     if (request.sigma_um)
         sigma = Estimate{*request.sigma_um, request.sigma_um_stderr};
@@ -139,7 +329,12 @@ Json to_json(const image::MeasureResult& r, const image::MeasureRequest& request
                                        : r.sigma              ? &*r.sigma
                                                               : nullptr;
     put(out, "rms_slope", derived ? derived->rms_slope : std::nullopt);
-    put(out, "theta_K_deg", derived ? degrees_of(derived->theta_K_rad) : std::nullopt);
+    if (!derived && r.cylinder) {
+        out["theta_K_deg"] = degrees_or_null(r.cylinder->theta_K_rad);
+        out["theta_K_deg_stderr"] = Json();
+    } else {
+        put(out, "theta_K_deg", derived ? degrees_of(derived->theta_K_rad) : std::nullopt);
+    }
     put(out, "xi_K", derived ? derived->xi_K : std::nullopt);
     // The class: from g when σ is known (the specular estimate or T given σ), else assumed.
     const RoughnessEstimate* classed = r.correlation_length ? &*r.correlation_length
@@ -169,9 +364,19 @@ Json to_json(const image::MeasureResult& r, const image::MeasureRequest& request
     out["correlation_length"] = optional_estimate(r.correlation_length);
     out["fit"] = r.fit ? to_json(*r.fit, false) : Json();
     Json region;
-    region["description"] = image::describe(request.roi);
-    region["pixels"] = r.region_pixels;
+    if (request.roi) {
+        region["description"] = image::describe(*request.roi);
+        region["pixels"] = r.region_pixels;
+    }
     out["region"] = region;
+    Json object;
+    object["shape"] = std::string(image::to_string(request.object.shape));
+    if (request.object.shape == image::ObjectShape::NormalMap)
+        object["normal_map"] = request.object.normal_map;
+    out["object"] = object;
+    out["cylinder"] = r.cylinder ? to_json(*r.cylinder) : Json();
+    out["sphere"] = r.sphere ? to_json(*r.sphere) : Json();
+    out["map"] = r.map ? to_json(*r.map) : Json();
     Json captures = Json::array();
     for (const auto& c : r.captures) captures.push_back(capture_json(c));
     out["captures"] = captures;

@@ -21,11 +21,14 @@
 #include "roughscope/core/response.hpp"
 #include "roughscope/estimation/estimation.hpp"
 #include "roughscope/fit/fit.hpp"
+#include "roughscope/image/cylinder.hpp"
 #include "roughscope/image/hdr.hpp"
 #include "roughscope/image/image.hpp"
+#include "roughscope/image/maps.hpp"
 #include "roughscope/image/read.hpp"
 #include "roughscope/image/region.hpp"
 #include "roughscope/image/specular.hpp"
+#include "roughscope/image/sphere.hpp"
 #include "roughscope/image/statistics.hpp"
 #include "roughscope/scattering/geometry.hpp"
 
@@ -52,10 +55,39 @@ struct CaptureSpec {
     // request (recovered from response_bracket, or the declared response's).
     std::vector<BracketShot> bracket;
     Geometry geometry;  // (θi, θs, φs) in the paper's frame, radians
+    // The light and view directions as given (unit vectors; the capture file's light and view).
+    // A curved object (ObjectShape::Cylinder, Sphere, NormalMap) takes them in the camera frame
+    // (x image right, y image up, z toward the camera); absent, both are +z (L = V, §5.2).
+    std::optional<Eigen::Vector3d> light;
+    std::optional<Eigen::Vector3d> view;
     // Exposure time (s); when absent, the file's metadata (EXIF, RAW); when no capture has one,
     // all are taken as equal (a warning says so).
     std::optional<double> exposure_s;
     CaptureRole role = CaptureRole::Diffuse;
+};
+
+// What was photographed (docs/measure.md "Curved objects and maps"): a flat sample (the §4
+// estimators on a region, and maps), a cylinder (the §5.2 profile, cylinder.hpp), a sphere (a BRDF
+// table from one photograph, sphere.hpp) or any object whose normals are given as a normal-map
+// image (maps only).
+enum class ObjectShape { Plane, Cylinder, Sphere, NormalMap };
+std::string_view to_string(ObjectShape shape);  // "plane", "cylinder", "sphere", "normal_map"
+ObjectShape parse_object_shape(std::string_view name);
+
+struct ObjectSpec {
+    ObjectShape shape = ObjectShape::Plane;
+    CylinderOptions cylinder;  // light and view come from the capture
+    SphereOptions sphere;      // light and view come from the capture
+    // NormalMap: the image of the normals (camera frame). An integer file holds n = 2v − 1 per
+    // channel (v on [0, 1], the usual 8/16-bit normal-map encoding); a float TIFF holds n itself.
+    // Pixels whose decoded |n| is below 0.5 are off the object.
+    std::string normal_map;
+};
+
+// A roughness map (maps.hpp) of the diffuse captures, with named regions for its statistics.
+struct MapRequest {
+    MapOptions options;  // normal_map and region_labels are filled in by measure()
+    std::vector<std::pair<std::string, Region>> regions;
 };
 
 struct MeasureRequest {
@@ -68,7 +100,11 @@ struct MeasureRequest {
     std::vector<BracketShot> response_bracket;
     std::optional<std::string> dark_frame;  // image subtracted from every capture
     std::optional<std::string> flat_field;  // image every capture is divided by (mean 1)
-    Region roi;                             // the measured region (every capture)
+    // The measured region (every capture). Required for a flat sample without maps; for a
+    // curved object it restricts the pixels used (absent: the whole object).
+    std::optional<Region> roi;
+    ObjectSpec object;
+    std::optional<MapRequest> maps;
     std::vector<CaptureSpec> captures;
     Correlation correlation = Correlation::Gaussian;  // for T given σ
     // The diffuse term's regime for T given σ: SlightlyRough is the paper's Eq. 15 (§4.1.2,
@@ -119,6 +155,10 @@ struct MeasureResult {
     std::optional<RoughnessEstimate> correlation_length;
     // More than two diffuse captures: the least-squares fits (both correlations).
     std::optional<CorrelationComparison> fit;
+    // Curved objects and maps (one photograph for a cylinder or a sphere).
+    std::optional<CylinderProfile> cylinder;
+    std::optional<SphereResult> sphere;
+    std::optional<RoughnessMap> map;
     std::vector<std::string> warnings;
 };
 

@@ -2,6 +2,10 @@
 // `roughscope measure --json` and the dict of roughscope.measure. Keys in docs/measure.md.
 #pragma once
 
+#include <cstdint>
+#include <string>
+#include <vector>
+
 #include "roughscope/image/measure.hpp"
 #include "roughscope/serialize/json.hpp"
 
@@ -15,6 +19,32 @@ namespace roughscope::serialize {
 // region, captures (per capture: file, geometry, exposure, response, region statistics, highlight)
 // and warnings.
 Json to_json(const image::MeasureResult& result, const image::MeasureRequest& request);
+
+// A cylinder's profile (§5.2, image/cylinder.hpp): axis, profile rows (theta_deg, brightness,
+// stderr, ...), the fitted sigma_over_T_gaussian / _exponential with _stderr, the models with
+// their predictions and departure_angle_deg, theta_K_deg.
+Json to_json(const image::CylinderProfile& profile);
+// A sphere (image/sphere.hpp): the circle, the table's size and the comparison of every model.
+Json to_json(const image::SphereResult& sphere);
+// A roughness map's summary (image/maps.hpp): size, registration, classes, regions (the layers
+// are written as files by the CLI and returned as arrays by the Python module).
+Json to_json(const image::RoughnessMap& map);
+
+// The float layers of a map by name ("sigma_over_T_gaussian", "sigma_over_T_gaussian_stderr",
+// "sigma_over_T_exponential", "sigma_over_T_exponential_stderr", "E1_over_E2", and with σ known
+// "T_um", "T_um_stderr"), NaN where missing; the class layers ("roughness_class", and with σ
+// "roughness_class_g") as kClass* codes. The CLI writes these as files, the Python module returns
+// them as arrays, under the same names.
+struct MapLayer {
+    std::string name;
+    const std::vector<float>* values;
+};
+std::vector<MapLayer> map_float_layers(const image::RoughnessMap& map);
+struct MapClassLayer {
+    std::string name;
+    const std::vector<std::uint8_t>* values;
+};
+std::vector<MapClassLayer> map_class_layers(const image::RoughnessMap& map);
 
 // The region statistics of one capture (also used for the highlight's core and annulus).
 Json to_json(const image::RegionStatistics& statistics);

@@ -638,8 +638,8 @@ TEST(CaptureFile, EveryDocumentedKeyIsRead) {
     EXPECT_DOUBLE_EQ(r.read.black_level_dn->at(0), 16.0);
     ASSERT_TRUE(r.dark_frame);
     EXPECT_EQ(fs::path(*r.dark_frame), fs::path("dir/dark.png"));
-    ASSERT_TRUE(std::holds_alternative<CircleRegion>(r.roi));
-    EXPECT_DOUBLE_EQ(std::get<CircleRegion>(r.roi).radius_px, 12.0);
+    ASSERT_TRUE(r.roi && std::holds_alternative<CircleRegion>(*r.roi));
+    EXPECT_DOUBLE_EQ(std::get<CircleRegion>(*r.roi).radius_px, 12.0);
     EXPECT_EQ(r.correlation, Correlation::Exponential);
     ASSERT_EQ(r.captures.size(), 3u);
     EXPECT_EQ(fs::path(r.captures[1].image), fs::path("dir/sub/b.png"));

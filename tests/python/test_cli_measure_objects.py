@@ -1,0 +1,275 @@
+"""Tests of `roughscope measure` on curved objects and maps (docs/measure.md "Curved objects and
+maps"): a cylinder (§5.2), a sphere, a flat sample with three regions made into a roughness map.
+
+The photographs are the report's synthetic demo captures (roughscope.report_objects: 14-bit
+linear TIFF with shot and read noise, V–H truth of known σ/T). Each success test has a failure
+companion asserting the exit code and the one-line message.
+"""
+
+import json
+import pathlib
+import subprocess
+
+import numpy as np
+import pytest
+
+from conftest import cli_path
+
+EXIT_USAGE, EXIT_NO_SOLUTION, EXIT_DATA = 2, 3, 4
+
+
+def run(*args, check=True):
+    proc = subprocess.run([cli_path(), "measure", *map(str, args)], capture_output=True,
+                          text=True, timeout=300)
+    if check:
+        assert proc.returncode == 0, f"exit {proc.returncode}: {proc.stderr}"
+    return proc
+
+
+def fails(code, *args):
+    proc = run(*args, check=False)
+    assert proc.returncode == code, proc.stderr
+    lines = proc.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("roughscope: error: "), proc.stderr
+    assert proc.stdout == ""
+    return lines[0]
+
+
+def edited(capture_file, name, change):
+    doc = json.loads(pathlib.Path(capture_file).read_text())
+    change(doc)
+    path = pathlib.Path(capture_file).parent / f"edited-{name}.json"
+    path.write_text(json.dumps(doc))
+    return path
+
+
+@pytest.fixture(scope="module")
+def cylinder(tmp_path_factory):
+    from roughscope import report_objects
+
+    return report_objects.write_cylinder_demo(tmp_path_factory.mktemp("cylinder"))
+
+
+@pytest.fixture(scope="module")
+def sphere(tmp_path_factory):
+    from roughscope import report_objects
+
+    return report_objects.write_sphere_demo(tmp_path_factory.mktemp("sphere"))
+
+
+@pytest.fixture(scope="module")
+def flat_map(tmp_path_factory):
+    from roughscope import report_objects
+
+    return report_objects.write_map_demo(tmp_path_factory.mktemp("map"))
+
+
+# --------------------------------------------------------------------------------------------
+# Cylinder
+
+def test_cylinder_profile_keys_and_the_fitted_sigma_over_T(cylinder):
+    from roughscope import report_objects
+
+    doc = json.loads(run(cylinder, "--json").stdout)
+    cyl = doc["cylinder"]
+    assert doc["object"]["shape"] == "cylinder"
+    assert doc["sigma_over_T_source"] == "cylinder_profile"
+    rows = cyl["profile"]
+    assert len(rows) >= 20
+    assert all(set(r) >= {"theta_deg", "brightness", "stderr"} for r in rows)
+    theta = [r["theta_deg"] for r in rows]
+    assert theta == sorted(theta) and 0 <= theta[0] < 5 and theta[-1] > 70
+    # Normalised as the paper (§2): the brightest bin is 1.
+    assert max(r["brightness"] for r in rows) == pytest.approx(1.0)
+    truth = report_objects.CYLINDER_SIGMA_OVER_T
+    value, err = cyl["sigma_over_T_gaussian"], cyl["sigma_over_T_gaussian_stderr"]
+    assert err > 0 and abs(value - truth) <= 4 * err, (value, err)
+    assert doc["sigma_over_T_gaussian"] == value
+    assert cyl["sigma_over_T_exponential"] is not None and cyl["sigma_over_T_exponential_stderr"] > 0
+    # θK of the V–H Gaussian σ/T (validity.hpp): atan(1/(√2 σ/T))... compare with the library.
+    import roughscope
+
+    assert cyl["theta_K_deg"] == pytest.approx(
+        float(roughscope.caron_theta_K_deg(cyl["models"][2]["sigma_over_T"])), rel=1e-9)
+    models = {m["model"]: m for m in cyl["models"]}
+    assert set(cyl["departure_angle_deg"]) == {"lambert", "bk_gaussian", "vh_gaussian",
+                                               "vh_exponential"}
+    # The data follow V–H Gaussian (the truth): it never leaves them, Eq. 7 (1/cos⁶θ) does.
+    assert models["vh_gaussian"]["departure_angle_deg"] is None
+    assert models["bk_gaussian"]["departure_angle_deg"] is not None
+    assert len(models["vh_gaussian"]["prediction"]) == len(rows)
+
+
+def test_cylinder_text_report_lists_the_departures(cylinder):
+    out = run(cylinder).stdout
+    assert "object" in out and "cylinder" in out
+    assert "departure bk_gaussian" in out and "departure vh_gaussian" in out
+    assert "nan" not in out.lower()
+
+
+def test_cylinder_given_axis_agrees_with_the_detected_one(cylinder):
+    doc = json.loads(run(cylinder, "--json").stdout)
+    axis = doc["cylinder"]["axis"]
+    assert axis["source"] == "detected"
+
+    def given(d):
+        d["object"]["axis"] = {"point_px": axis["point_px"], "direction": axis["direction"],
+                               "radius_px": axis["radius_px"]}
+
+    doc2 = json.loads(run(edited(cylinder, "axis", given), "--json").stdout)
+    assert doc2["cylinder"]["axis"]["source"] == "given"
+    assert doc2["cylinder"]["sigma_over_T_gaussian"] == pytest.approx(
+        doc["cylinder"]["sigma_over_T_gaussian"], rel=1e-6)
+
+
+@pytest.mark.parametrize("change,words", [
+    (lambda d: d["object"].update(shape="cone"), ["object.shape", "cone"]),
+    (lambda d: d["object"].update(bin_width_deg=0), ["bin_width_deg"]),
+    (lambda d: d["object"].update(colour=1), ["object.colour", "unknown key"]),
+    (lambda d: d["object"].update(axis={"point_px": [1, 2]}), ["object.axis"]),
+    (lambda d: d["captures"][0].update(light=[0, 0, -1]), ["light", "z > 0"]),
+    (lambda d: d["captures"].append(dict(d["captures"][0])), ["one diffuse photograph"]),
+])
+def test_cylinder_bad_capture_files_fail_naming_the_key(cylinder, change, words):
+    name = "bad-" + str(abs(hash(tuple(words))))
+    message = fails(EXIT_DATA if "photograph" not in words[0] else EXIT_USAGE,
+                    edited(cylinder, name, change))
+    for w in words:
+        assert w in message, message
+
+
+def test_an_image_without_an_object_is_a_data_error(cylinder, tmp_path):
+    import roughscope
+
+    # A uniform photograph: no silhouette.
+    folder = pathlib.Path(cylinder).parent
+    roughscope.write_capture(str(tmp_path), "tiff", scene="plane", width=64, height=64,
+                             theta_i_deg=0.0, sigma_over_T=0.5, seed=3)
+    doc = json.loads(pathlib.Path(cylinder).read_text())
+    doc["captures"][0]["image"] = str(tmp_path / "capture.tiff")
+    path = folder / "uniform.json"
+    path.write_text(json.dumps(doc))
+    message = fails(EXIT_DATA, path)
+    assert "capture.tiff" in message or "object" in message, message
+
+
+# --------------------------------------------------------------------------------------------
+# Sphere
+
+def test_sphere_comparison_prefers_the_true_model(sphere):
+    from roughscope import report_objects
+
+    doc = json.loads(run(sphere, "--json").stdout)
+    sph = doc["sphere"]
+    assert sph["rows"] >= 50
+    comp = sph["comparison"]
+    assert comp["winner"] in ("vh_gaussian_fit",), comp["winner"]
+    fit = comp["models"]["vh_gaussian_fit"]
+    value, err = fit["parameters"]["sigma_over_T"], fit["standard_errors"]["sigma_over_T"]
+    assert err > 0 and abs(value - report_objects.SPHERE_SIGMA_OVER_T) <= 4 * err, (value, err)
+    circle = sph["circle"]
+    # The renderer's default radius: 0.4 · min(width, height) pixels, centred.
+    assert circle["radius_px"] == pytest.approx(0.4 * 160, abs=0.5)
+    assert circle["centre_x_px"] == pytest.approx(80, abs=0.5)
+
+
+def test_sphere_with_a_map_request_is_refused(sphere):
+    message = fails(EXIT_USAGE, edited(sphere, "maps", lambda d: d.update(maps={})))
+    assert "maps" in message and "sphere" in message
+
+
+# --------------------------------------------------------------------------------------------
+# Maps
+
+def test_map_regions_recover_the_truth_and_files_are_written(flat_map, tmp_path):
+    from roughscope import report_objects
+
+    out = tmp_path / "maps"
+    doc = json.loads(run(flat_map, "--json", "--maps", out).stdout)
+    m = doc["map"]
+    assert m["window_px"] == report_objects.MAP_WINDOW_PX
+    assert m["width"] == report_objects.MAP_SIZE // report_objects.MAP_WINDOW_PX
+    truth = dict(report_objects.MAP_REGIONS)
+    classes = {"slightly rough": "slightly_rough", "moderately rough": "moderately_rough",
+               "very rough": "very_rough"}
+    for r in m["regions"]:
+        value, err = r["sigma_over_T_gaussian"], r["sigma_over_T_gaussian_stderr"]
+        assert err > 0 and abs(value - truth[r["name"]]) <= 4 * err, (r["name"], value, err)
+        counts = r["class_counts"]
+        assert counts[classes[r["name"]]] >= 0.95 * sum(counts.values()), (r["name"], counts)
+    # Files: every float layer as .tiff and .npy, PNGs, the class map.
+    for name in ("sigma_over_T_gaussian", "sigma_over_T_exponential", "E1_over_E2"):
+        assert (out / f"{name}.tiff").is_file() and (out / f"{name}.npy").is_file()
+    assert (out / "sigma_over_T_gaussian.png").is_file()
+    assert (out / "roughness_class.png").is_file()
+    assert sorted(m["files"]) == sorted(p.name for p in out.iterdir())
+    layer = np.load(out / "sigma_over_T_gaussian.npy")
+    assert layer.shape == (m["height"], m["width"]) and layer.dtype == np.float32
+    # The .npy agrees with the region statistics: the mean over the middle band's tiles.
+    band = report_objects.MAP_SIZE // 3 // report_objects.MAP_WINDOW_PX
+    middle = layer[:, band + 1:2 * band - 1]
+    assert np.nanmean(middle) == pytest.approx(truth["moderately rough"], rel=0.1)
+    # The Python module returns the same layers.
+    import roughscope
+
+    py = roughscope.measure(str(flat_map), layers=True)
+    np.testing.assert_array_equal(py["map"]["layers"]["sigma_over_T_gaussian"], layer)
+    classes_npy = np.load(out / "roughness_class.npy")
+    np.testing.assert_array_equal(np.nan_to_num(classes_npy, nan=255).astype(np.uint8),
+                                  py["map"]["layers"]["roughness_class"])
+
+
+def test_a_shifted_pair_is_refused_with_the_shift(flat_map, tmp_path):
+    import roughscope
+
+    folder = pathlib.Path(flat_map).parent
+    spec = json.loads(pathlib.Path(flat_map).read_text())
+    # The second photograph moved 5 px to the right.
+    second = roughscope.read_image(str(folder / spec["captures"][1]["image"]))
+    assert second["values"].shape[0] == 1
+    from roughscope import report_objects
+    import numpy as np
+
+    shifted_dir = folder / "shifted"
+    shifted_dir.mkdir(exist_ok=True)
+    # Re-render the second capture with labels and truth moved by 5 columns.
+    size = report_objects.MAP_SIZE
+    band = size // 3
+    cols = np.arange(size) - 5
+    labels = np.repeat(np.clip(cols // band, 0, 2)[None, :], size, axis=0).astype(np.int32)
+    roughscope.write_capture(str(shifted_dir), "tiff", scene="plane", width=size, height=size,
+                             theta_i_deg=45.0, sigma_over_T=[r for _, r in report_objects.MAP_REGIONS],
+                             labels=labels, correlation="gaussian",
+                             exposure_s=spec["captures"][1]["exposure_s"], seed=32,
+                             **report_objects._camera())
+    spec["captures"][1]["image"] = "shifted/capture.tiff"
+    path = folder / "shifted.json"
+    path.write_text(json.dumps(spec))
+    message = fails(EXIT_DATA, path)
+    assert "shift" in message and "5" in message, message
+    # Allowed when asked: then it measures (with a warning).
+    spec["maps"]["allow_misregistration"] = True
+    path.write_text(json.dumps(spec))
+    doc = json.loads(run(path, "--json").stdout)
+    assert doc["map"]["registration"]["magnitude_px"] == pytest.approx(5.0, abs=0.5)
+
+
+def test_maps_flag_without_a_map_request_fails(cylinder, tmp_path):
+    message = fails(EXIT_USAGE, cylinder, "--maps", tmp_path / "m")
+    assert "--maps" in message
+    assert not (tmp_path / "m").exists()
+
+
+@pytest.mark.parametrize("change,words", [
+    (lambda d: d["maps"].update(window_px=0), ["maps.window_px"]),
+    (lambda d: d["maps"].update(window_px=2.5), ["maps.window_px", "whole number"]),
+    (lambda d: d["maps"].update(regions=[{"rect": [0, 0, 4, 4]}]), ["maps.regions[0]", "name"]),
+    (lambda d: d["maps"].update(allow_misregistration="yes"), ["allow_misregistration"]),
+    (lambda d: d.update(captures=d["captures"][:1]), ["two diffuse captures"]),
+])
+def test_bad_map_requests_fail_naming_the_key(flat_map, change, words):
+    name = "badmap-" + str(abs(hash(tuple(words))))
+    code = EXIT_USAGE if words[0] == "two diffuse captures" else EXIT_DATA
+    message = fails(code, edited(flat_map, name, change))
+    for w in words:
+        assert w in message, message
