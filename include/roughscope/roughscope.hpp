@@ -50,10 +50,13 @@
 // image: photographs on a linear scale, regions, the highlight, response curves, measurements
 #include "roughscope/image/hdr.hpp"
 #include "roughscope/image/image.hpp"
+#include "roughscope/image/map_files.hpp"
+#include "roughscope/image/maps.hpp"
 #include "roughscope/image/measure.hpp"
 #include "roughscope/image/radiometry.hpp"
 #include "roughscope/image/read.hpp"
 #include "roughscope/image/region.hpp"
+#include "roughscope/image/registration.hpp"
 #include "roughscope/image/specular.hpp"
 #include "roughscope/image/statistics.hpp"
 
