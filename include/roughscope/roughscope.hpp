@@ -48,13 +48,19 @@
 #include "roughscope/simulation/kirchhoff.hpp"
 
 // image: photographs on a linear scale, regions, the highlight, response curves, measurements
+#include "roughscope/image/cylinder.hpp"
 #include "roughscope/image/hdr.hpp"
 #include "roughscope/image/image.hpp"
+#include "roughscope/image/map_files.hpp"
+#include "roughscope/image/maps.hpp"
 #include "roughscope/image/measure.hpp"
 #include "roughscope/image/radiometry.hpp"
 #include "roughscope/image/read.hpp"
 #include "roughscope/image/region.hpp"
+#include "roughscope/image/registration.hpp"
+#include "roughscope/image/silhouette.hpp"
 #include "roughscope/image/specular.hpp"
+#include "roughscope/image/sphere.hpp"
 #include "roughscope/image/statistics.hpp"
 
 // serialize: every result type to JSON, CSV and Markdown

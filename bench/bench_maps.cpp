@@ -1,0 +1,150 @@
+// Roughness maps (image/maps.hpp) of a 24-MP pair against decoding the same two files (the
+// baseline, timed in the same run).
+//
+//   build*/bin/roughscope_bench --benchmark_filter='maps'
+//
+// Names: maps/decode/<rows>          baseline: read_image of the two 16-bit TIFFs
+//        maps/map_tiles8/<rows>      read_image of both + roughness_map, window 8
+//        maps/map_pixels/<rows>      read_image of both + roughness_map, per pixel
+// <rows> = 4096 is the 24-MP pair (5859 x 4096 = 24.0 MP, the size of the other image benchmarks;
+// 6000 x 4000 has the same pixel count); 256 a small one (the smoke run skips /4096).
+// Counters: time_vs_decode = (decode + map) / decode of the two files; peak_vs_image = the peak
+// resident memory of decode + map above the resident memory before it, divided by that of
+// decoding one image. The peak is Linux's VmHWM of /proc/self/status, reset before each
+// measurement by writing 5 to /proc/self/clear_refs (0 when the kernel does not allow it).
+#include <cstddef>
+#include <cstdint>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include <benchmark/benchmark.h>
+#include <unistd.h>
+
+#include "bench_timing.hpp"
+#include "roughscope/image/maps.hpp"
+#include "roughscope/image/read.hpp"
+#include "roughscope/io/output_file.hpp"
+#include "roughscope/simulation/capture.hpp"
+
+namespace {
+
+namespace sim = roughscope::simulation;
+namespace img = roughscope::image;
+namespace fs = std::filesystem;
+using roughscope::bench::seconds_of;
+
+struct PairFiles {
+    std::vector<fs::path> files;
+    ~PairFiles() {
+        for (const auto& f : files) fs::remove(f);
+    }
+};
+
+void make_pair(PairFiles& p, std::size_t rows) {
+    const std::size_t width = (24'000'000 / 4096) * rows / 4096;
+    for (const double theta : {30.0, 45.0}) {
+        sim::Scene scene;
+        scene.width = width;
+        scene.height = rows;
+        scene.light = sim::direction_from_angles(roughscope::deg_to_rad(theta), roughscope::kPi);
+        sim::SurfaceTruth truth;  // very rough, σ/T = 0.2
+        sim::CameraModel camera;
+        camera.bit_depth = 16;
+        camera.gain_dn_per_e = 0.9;
+        camera.seed = static_cast<std::uint64_t>(theta);
+        const sim::Capture c =
+            sim::render_capture(scene, {truth}, {}, camera, {.keep_geometry = false});
+        const fs::path path =
+            fs::temp_directory_path() / ("roughscope_bench_maps_" + std::to_string(::getpid()) +
+                                         "_" + std::to_string(static_cast<int>(theta)) + ".tiff");
+        roughscope::io::write_file_atomic(path,
+                                          sim::encode_capture(c, camera, sim::CaptureFormat::Tiff));
+        p.files.push_back(path);
+    }
+}
+
+img::ReadOptions read_options() {
+    img::ReadOptions o;
+    o.response = roughscope::Response::Linear;
+    o.black_level_dn = std::vector<double>{64.0};
+    return o;
+}
+
+void decode_pair(const PairFiles& p) {
+    for (const auto& f : p.files) {
+        const img::LinearImage im = img::read_image(f.string(), read_options());
+        benchmark::DoNotOptimize(im.values.data());
+    }
+}
+
+img::RoughnessMap decode_and_map(const PairFiles& p, std::size_t window) {
+    const img::LinearImage a = img::read_image(p.files[0].string(), read_options());
+    const img::LinearImage b = img::read_image(p.files[1].string(), read_options());
+    std::vector<img::MapCapture> c(2);
+    c[0].image = &a;
+    c[0].geometry = roughscope::normal_view_geometry(roughscope::deg_to_rad(30.0));
+    c[1].image = &b;
+    c[1].geometry = roughscope::normal_view_geometry(roughscope::deg_to_rad(45.0));
+    img::MapOptions o;
+    o.window_px = window;
+    return img::roughness_map(c, o);
+}
+
+// Resident memory (kB) of this process: "VmRSS" now or "VmHWM" (peak since the last reset).
+long status_kb(const std::string& key) {
+    std::ifstream in("/proc/self/status");
+    std::string line;
+    while (std::getline(in, line))
+        if (line.rfind(key + ":", 0) == 0) return std::stol(line.substr(key.size() + 1));
+    return 0;
+}
+bool reset_peak() {
+    std::ofstream out("/proc/self/clear_refs");
+    out << "5";
+    return static_cast<bool>(out);
+}
+template <class F>
+long peak_above_now_kb(F&& body) {
+    if (!reset_peak()) return 0;
+    const long before = status_kb("VmRSS");
+    body();
+    return status_kb("VmHWM") - before;
+}
+
+void BM_maps_decode(benchmark::State& state) {
+    PairFiles p;
+    make_pair(p, static_cast<std::size_t>(state.range(0)));
+    for (auto _ : state) decode_pair(p);
+}
+
+void BM_maps_map(benchmark::State& state, std::size_t window) {
+    PairFiles p;
+    make_pair(p, static_cast<std::size_t>(state.range(0)));
+    for (auto _ : state) benchmark::DoNotOptimize(decode_and_map(p, window).valid);
+    const double t_decode = seconds_of([&] { decode_pair(p); }, 3);
+    const double t_map = seconds_of([&] { (void)decode_and_map(p, window); }, 2);
+    state.counters["time_vs_decode"] = t_map / t_decode;
+    const long one = peak_above_now_kb([&] {
+        const img::LinearImage im = img::read_image(p.files[0].string(), read_options());
+        benchmark::DoNotOptimize(im.values.data());
+    });
+    const long map = peak_above_now_kb([&] { (void)decode_and_map(p, window); });
+    state.counters["peak_vs_image"] = one > 0 ? static_cast<double>(map) / one : 0.0;
+    state.counters["peak_MB"] = static_cast<double>(map) / 1024.0;
+}
+
+BENCHMARK(BM_maps_decode)->Name("maps/decode")->Arg(256)->Arg(4096)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_maps_map, tiles8, 8)
+    ->Name("maps/map_tiles8")
+    ->Arg(256)
+    ->Arg(4096)
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_maps_map, pixels, 1)
+    ->Name("maps/map_pixels")
+    ->Arg(256)
+    ->Arg(4096)
+    ->Unit(benchmark::kMillisecond);
+
+}  // namespace

@@ -1,0 +1,213 @@
+// Roughness maps (paper §5.1, §4.2, §3.5): σ/T per pixel or per tile of an object photographed
+// under two light directions, and the class of each part (slightly, moderately, very rough).
+// Every formula is in docs/maps.md; the symbols below follow it.
+//
+// Brightness of capture k at pixel p: x_k(p) = (channel average of the LinearImage at p) / s_k
+// (s_k: the exposure scale, as in image/measure.hpp). A pixel is used when neither image flags
+// it (image.hpp kPixel*). For a tile W (window_px × window_px; the last row/column of tiles may be
+// smaller) of n used pixels:
+//   m_k = Σ x_k / n,  v_k = Σ (x_k − m_k)² / (n − 1),  c_12 = Σ (x_1 − m_1)(x_2 − m_2) / (n − 1)
+//   E1/E2 = m_1 / m_2,   var(ln E1/E2) = (v_1/m_1² + v_2/m_2² − 2 c_12/(m_1 m_2)) / n
+// (first order; the covariance removes what the two images share, e.g. a texture or shading).
+// Per pixel (window_px = 1) the ratio is the pixel's own x_1/x_2 and its variance that of one
+// pixel, n·var above over the used pixels of the (2·kPixelNoiseRadius + 1)² neighbourhood.
+// σ/T from E1/E2: Eq. 17 (Gaussian) and Eq. 19 (exponential) for a flat sample seen along its
+// normal, through a table of the inverse (RatioInverseTable) built once per map; the two-geometry
+// solver of estimation.hpp for any other flat geometry (also tabulated) and, per tile, for a
+// normal map. sd(σ/T) = |dσ/T / d ln(E1/E2)| · sd(ln E1/E2).
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "roughscope/estimation/estimation.hpp"
+#include "roughscope/image/image.hpp"
+#include "roughscope/image/registration.hpp"
+#include "roughscope/scattering/geometry.hpp"
+#include "roughscope/scattering/validity.hpp"
+
+namespace roughscope::image {
+
+// ---------------------------------------------------------------------------------------------
+// Classes by σ/T (§3.1, §5.1: slightly rough σ ≪ T, moderately σ ≈ T, very rough σ ≫ T).
+// (σ/T)² is what enters the very-rough forms (T²/σ² in Eq. 16–19), as σ² enters g; the library
+// draws the g lines one decade either side of g = 1 (validity.hpp), so the σ/T lines are one
+// decade of (σ/T)² either side of σ/T = 1: 10^(−1/2) and 10^(1/2). In slopes: RMS slope
+// m = √2 σ/T = 0.45 (24°) and 4.5 (77°); Caron's θK = 66° and 13° (validity.hpp).
+inline constexpr double kSlightlyRoughMaxSigmaOverT = 0.31622776601683794;  // 10^(−1/2)
+inline constexpr double kVeryRoughMinSigmaOverT = 3.1622776601683795;       // 10^(1/2)
+
+// Class layer codes (RoughnessClass order; kClassNone where there is no estimate).
+inline constexpr std::uint8_t kClassSlightlyRough = 0;
+inline constexpr std::uint8_t kClassModeratelyRough = 1;
+inline constexpr std::uint8_t kClassVeryRough = 2;
+inline constexpr std::uint8_t kClassNone = 255;
+
+// The class of σ/T against the two thresholds (σ/T < slightly_max: slightly; > very_min: very).
+RoughnessClass roughness_class_of_sigma_over_T(
+    double sigma_over_T, double slightly_rough_max = kSlightlyRoughMaxSigmaOverT,
+    double very_rough_min = kVeryRoughMinSigmaOverT);
+
+// Per-pixel mode: the noise of a pixel is estimated from the (2R + 1)² neighbourhood, R = 2.
+inline constexpr std::size_t kPixelNoiseRadius = 2;
+
+// ---------------------------------------------------------------------------------------------
+// The inverse of a brightness-ratio model, tabulated.
+//
+// For two fixed geometries the model ratio M(x) (x = σ/T, or T with σ known) is monotone in x.
+// The table holds nodes x_j = exp(ln lower + j h) (h = ln(upper/lower)/(nodes − 1)) with
+// y_j = ln M(x_j) and dy/dx_j (analytic for Eq. 16/18, a central difference of ln M otherwise);
+// x(y) between two nodes is the cubic Hermite interpolant in y with the slopes dx/dy = 1/(dy/dx).
+// With the defaults (x in [1e-4, 1e4], 4097 nodes) its error against Eq. 17/19 is below 1e-9
+// relative (tests/cpp/image/test_maps.cpp measures it); ratios outside [y_0, y_last] (outside the
+// model's range, or σ/T outside [lower, upper]) have no solution.
+struct RatioInverseTableOptions {
+    double lower = 1e-4;  // the unknown's range
+    double upper = 1e4;
+    std::size_t nodes = 4097;
+};
+
+class RatioInverseTable {
+  public:
+    // σ/T at two geometries (Eq. 16/18 in closed form when both are normal view, θs = 0; the
+    // very-rough model ratio of estimation.hpp otherwise). InvalidArgument for bad geometries,
+    // options, or two geometries the ratio cannot tell apart.
+    static RatioInverseTable sigma_over_T(const Geometry& geom1, const Geometry& geom2,
+                                          Correlation correlation,
+                                          const TwoGeometryOptions& model = {},
+                                          const RatioInverseTableOptions& table = {});
+    // T (µm) with σ known: ln of model_ratio_diffuse (the regime of `model`).
+    static RatioInverseTable correlation_length(const Geometry& geom1, const Geometry& geom2,
+                                                double sigma_um, Correlation correlation,
+                                                const TwoGeometryOptions& model = {},
+                                                const RatioInverseTableOptions& table = {});
+
+    struct Value {
+        double x = 0.0;              // the unknown
+        double dx_dlog_ratio = 0.0;  // d x / d ln(E1/E2)
+    };
+    // x at ln(E1/E2); nullopt when outside the table. `hint` (any start value) speeds up
+    // look-ups of nearby ratios (a galloping search from the last interval).
+    std::optional<Value> lookup(double log_ratio, std::size_t& hint) const;
+    std::optional<Value> lookup(double log_ratio) const {
+        std::size_t hint = 0;
+        return lookup(log_ratio, hint);
+    }
+    // The ratios E1/E2 the table inverts (open interval).
+    RatioRange ratio_range() const;
+    std::size_t size() const { return y_.size(); }
+
+  private:
+    std::vector<double> y_, x_, dxdy_;  // y increasing
+};
+
+// ---------------------------------------------------------------------------------------------
+// Input
+
+// One photograph. The image is not copied: it must outlive roughness_map.
+struct MapCapture {
+    const LinearImage* image = nullptr;
+    std::string name;  // for messages (default: image->info.source)
+    // Flat sample: the one geometry of every pixel (paper frame, radians).
+    Geometry geometry;
+    double exposure_scale = 1.0;  // s_k: brightness = value / s_k (> 0)
+    // Non-flat object (MapOptions::normal_map given): the light and view directions, unit vectors
+    // in the camera frame (x right, y up, z toward the camera); each pixel's geometry is
+    // geometry_from_vectors(n, L, V). Required then; ignored for a flat sample.
+    std::optional<Eigen::Vector3d> light;
+    std::optional<Eigen::Vector3d> view;
+};
+
+struct MapOptions {
+    // 1: per pixel; N ≥ 2: tiles of N × N pixels. In [1, 4096].
+    std::size_t window_px = 8;
+    // A tile needs at least this fraction of its pixels used (and ≥ 2 pixels); per pixel, the
+    // pixel itself used and ≥ 3 used in its neighbourhood. In (0, 1].
+    double min_used_fraction = 0.5;
+    GeometricFactor factor = GeometricFactor::VernoldHarvey;
+    Radiometry radiometry = Radiometry::Radiance;
+    double wavelength_um = 0.555;
+    // Known σ (µm): T per pixel/tile and the class by g (validity.hpp roughness_class) too.
+    std::optional<double> sigma_um;
+    double sigma_um_stderr = 0.0;
+    // The correlation of T given σ and of the class by σ/T.
+    Correlation correlation = Correlation::Gaussian;
+    // Registration of capture 2 against capture 1 (registration.hpp): a shift above max_shift_px
+    // (with a peak-to-sidelobe ratio ≥ min_peak_to_sidelobe: the images share structure) is
+    // refused (DataError) unless allow_misregistration; a lower PSR only warns.
+    double max_shift_px = 1.0;
+    bool allow_misregistration = false;
+    double min_peak_to_sidelobe = 8.0;
+    bool check_registration = true;
+    RegistrationOptions registration;
+    double slightly_rough_max_sigma_over_T = kSlightlyRoughMaxSigmaOverT;
+    double very_rough_min_sigma_over_T = kVeryRoughMinSigmaOverT;
+    // Non-flat object: 3 floats per pixel (n_x, n_y, n_z, camera frame), row-major; a non-finite
+    // normal marks a pixel off the object (not used). Empty: a flat sample.
+    std::span<const float> normal_map;
+    // Regions: one int32 per pixel (−1 = none, else an index into region_names); empty = none.
+    std::span<const std::int32_t> region_labels;
+    std::vector<std::string> region_names;
+    RatioInverseTableOptions table;
+};
+
+// ---------------------------------------------------------------------------------------------
+// Result
+
+struct ClassStatistics {
+    RoughnessClass roughness_class = RoughnessClass::SlightlyRough;
+    std::size_t count = 0;                      // pixels/tiles of the class
+    double fraction = 0.0;                      // of the valid pixels/tiles
+    std::optional<Estimate> mean_sigma_over_T;  // of MapOptions::correlation; stderr of the mean
+};
+
+struct RegionMapStatistics {
+    std::string name;
+    std::size_t count = 0;  // valid pixels/tiles wholly in the region
+    std::size_t missing = 0;
+    std::optional<Estimate> mean_sigma_over_T_gaussian;     // mean, its standard error
+    std::optional<Estimate> mean_sigma_over_T_exponential;  // (sd / √count)
+    std::optional<Estimate> mean_T_um;                      // σ known
+    std::array<std::size_t, 3> class_counts{};              // by σ/T (RoughnessClass order)
+};
+
+struct RoughnessMap {
+    std::size_t width = 0;  // of the map (pixels or tiles): ceil(image width / window_px)
+    std::size_t height = 0;
+    std::size_t window_px = 1;
+    std::size_t image_width = 0, image_height = 0;
+    // Layers, width · height, row-major, NaN where missing.
+    std::vector<float> E1_over_E2;
+    std::vector<float> sigma_over_T_gaussian, sigma_over_T_gaussian_stderr;
+    std::vector<float> sigma_over_T_exponential, sigma_over_T_exponential_stderr;
+    std::vector<float> T_um, T_um_stderr;  // σ known only (else empty)
+    // Class by σ/T of MapOptions::correlation (kClass* codes), and by g when σ is known.
+    std::vector<std::uint8_t> roughness_class;
+    std::vector<std::uint8_t> roughness_class_g;  // σ known only
+    std::size_t valid = 0;        // pixels/tiles with a σ/T (of MapOptions::correlation)
+    std::size_t missing = 0;      // too few used pixels (flagged, off the object)
+    std::size_t no_solution = 0;  // a ratio the model does not produce
+    std::size_t no_solution_exponential = 0;  // the same for the other layer
+    std::optional<Registration> registration;
+    std::array<ClassStatistics, 3> classes;
+    std::vector<RegionMapStatistics> regions;
+    std::vector<std::string> warnings;
+    std::string method;  // "table (Eq. 17/19)", "table (two-geometry model)", "solver per tile"
+};
+
+// Throws InvalidArgument (fewer than 2 captures, a null image, images of different sizes,
+// window_px or other options out of range, a normal map or region labels of the wrong size,
+// missing light/view for a normal map) or DataError (capture 2 moved against capture 1 by more
+// than max_shift_px: the message gives the shift and the threshold). With more than two captures
+// the first two are used and a warning says so (a per-tile least-squares fit is left to
+// image/measure.hpp's region measurement).
+RoughnessMap roughness_map(const std::vector<MapCapture>& captures, const MapOptions& options);
+
+}  // namespace roughscope::image

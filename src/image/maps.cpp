@@ -1,0 +1,866 @@
+// Roughness maps: two photographs → σ/T per pixel or tile (image/maps.hpp, docs/maps.md).
+#include "roughscope/image/maps.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+#include <utility>
+
+#include "roughscope/core/errors.hpp"
+#include "roughscope/core/text.hpp"
+
+namespace roughscope::image {
+namespace {
+
+constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
+constexpr std::size_t kMaxWindowPx = 4096;
+constexpr double kLogStep = 1e-5;  // central difference of ln M in ln x
+
+// g = σ² v_z² = (2πσ/λ)² (cos θi + cos θs)² (§3.1).
+double roughness_g(double sigma_um, const Geometry& geom, double wavelength_um) {
+    const double vz =
+        2.0 * kPi / wavelength_um * (std::cos(geom.theta_i_rad) + std::cos(geom.theta_s_rad));
+    return sigma_um * sigma_um * vz * vz;
+}
+
+bool normal_view(const Geometry& g) { return g.theta_s_rad == 0.0; }
+
+std::uint8_t class_code(RoughnessClass c) { return static_cast<std::uint8_t>(c); }
+
+// Running mean and variance of a set of values (for the summaries).
+struct Accumulator {
+    std::size_t n = 0;
+    double sum = 0.0, sum2 = 0.0;
+    void add(double v) {
+        ++n;
+        sum += v;
+        sum2 += v * v;
+    }
+    std::optional<Estimate> mean() const {
+        if (n == 0) return std::nullopt;
+        const double m = sum / static_cast<double>(n);
+        double se = 0.0;
+        if (n >= 2) {
+            const double var =
+                std::max(0.0, (sum2 - static_cast<double>(n) * m * m) / static_cast<double>(n - 1));
+            se = std::sqrt(var / static_cast<double>(n));
+        }
+        if (!std::isfinite(m) || !std::isfinite(se)) return std::nullopt;
+        return Estimate{m, se};
+    }
+};
+
+struct RegionAccumulator {
+    Accumulator gaussian, exponential, T;
+    std::size_t missing = 0;
+    std::array<std::size_t, 3> classes{};
+};
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------------
+// Classes
+
+RoughnessClass roughness_class_of_sigma_over_T(double sigma_over_T, double slightly_rough_max,
+                                               double very_rough_min) {
+    if (sigma_over_T < slightly_rough_max) return RoughnessClass::SlightlyRough;
+    if (sigma_over_T > very_rough_min) return RoughnessClass::VeryRough;
+    return RoughnessClass::ModeratelyRough;
+}
+
+// ---------------------------------------------------------------------------------------------
+// RatioInverseTable
+
+namespace {
+
+void check_table_options(const RatioInverseTableOptions& t) {
+    check::positive("table lower", t.lower);
+    check::positive("table upper", t.upper);
+    if (!(t.upper > t.lower))
+        throw InvalidArgument(concat("table: upper = ", check::format_number(t.upper),
+                                     " must exceed lower = ", check::format_number(t.lower)));
+    if (t.nodes < 3 || t.nodes > 10'000'000)
+        throw InvalidArgument(
+            concat("table: nodes = ", std::to_string(t.nodes), " must be in [3, 10000000]"));
+}
+
+// Fills (y, x, dx/dy) from forward(ln x) → (y, dy/d ln x), keeping the longest run of nodes with
+// a finite y and a non-zero slope of one sign, stored with y increasing.
+template <class F>
+void fill_table(F&& forward, const RatioInverseTableOptions& t, std::vector<double>& ys,
+                std::vector<double>& xs, std::vector<double>& dxdy) {
+    check_table_options(t);
+    const double l0 = std::log(t.lower), l1 = std::log(t.upper);
+    const double h = (l1 - l0) / static_cast<double>(t.nodes - 1);
+    std::vector<double> y(t.nodes), x(t.nodes), d(t.nodes);
+    std::vector<int> sign(t.nodes);
+    for (std::size_t j = 0; j < t.nodes; ++j) {
+        const double lx = j + 1 == t.nodes ? l1 : l0 + h * static_cast<double>(j);
+        const auto [yj, dyj] = forward(lx);
+        x[j] = std::exp(lx);
+        y[j] = yj;
+        d[j] = dyj;
+        sign[j] =
+            (std::isfinite(yj) && std::isfinite(dyj) && dyj != 0.0) ? (dyj > 0.0 ? 1 : -1) : 0;
+    }
+    // The longest run of one sign whose y is strictly monotone.
+    std::size_t best_begin = 0, best_len = 0;
+    for (std::size_t j = 0; j < t.nodes;) {
+        if (sign[j] == 0) {
+            ++j;
+            continue;
+        }
+        std::size_t k = j + 1;
+        while (k < t.nodes && sign[k] == sign[j] &&
+               (sign[j] > 0 ? y[k] > y[k - 1] : y[k] < y[k - 1]))
+            ++k;
+        if (k - j > best_len) {
+            best_begin = j;
+            best_len = k - j;
+        }
+        j = k;
+    }
+    if (best_len < 3)
+        throw NoSolution(
+            "table: the model ratio is not monotone in the unknown over the table's "
+            "range");
+    ys.assign(y.begin() + static_cast<std::ptrdiff_t>(best_begin),
+              y.begin() + static_cast<std::ptrdiff_t>(best_begin + best_len));
+    xs.assign(x.begin() + static_cast<std::ptrdiff_t>(best_begin),
+              x.begin() + static_cast<std::ptrdiff_t>(best_begin + best_len));
+    dxdy.resize(best_len);
+    // dx/dy = x / (dy/d ln x).
+    for (std::size_t j = 0; j < best_len; ++j) dxdy[j] = xs[j] / d[best_begin + j];
+    if (ys.front() > ys.back()) {
+        std::reverse(ys.begin(), ys.end());
+        std::reverse(xs.begin(), xs.end());
+        std::reverse(dxdy.begin(), dxdy.end());
+    }
+}
+
+// d ln M / d ln x by a central difference.
+template <class M>
+std::pair<double, double> log_model(M&& model, double lx) {
+    const double y = std::log(model(std::exp(lx)));
+    const double yp = std::log(model(std::exp(lx + kLogStep)));
+    const double ym = std::log(model(std::exp(lx - kLogStep)));
+    return {y, (yp - ym) / (2.0 * kLogStep)};
+}
+
+}  // namespace
+
+RatioInverseTable RatioInverseTable::sigma_over_T(const Geometry& geom1, const Geometry& geom2,
+                                                  Correlation correlation,
+                                                  const TwoGeometryOptions& model,
+                                                  const RatioInverseTableOptions& table) {
+    check::geometry(geom1, "geom1");
+    check::geometry(geom2, "geom2");
+    RatioInverseTable out;
+    if (normal_view(geom1) && normal_view(geom2)) {
+        // Eq. 16 / 18 with a = v_xy²/v_z² = tan²(θi/2) at normal view and C the ratio's finite
+        // bound (ratio_range_gaussian validates the two angles).
+        const double t1 = geom1.theta_i_rad, t2 = geom2.theta_i_rad;
+        const RatioRange range = ratio_range_gaussian(t1, t2, model.factor);
+        const double C = t1 < t2 ? range.lower : range.upper;
+        const double lnC = std::log(C);
+        const double a1 = std::pow(std::tan(t1 / 2.0), 2), a2 = std::pow(std::tan(t2 / 2.0), 2);
+        if (correlation == Correlation::Gaussian) {
+            // Eq. 16: ln(E1/E2) = ln C + (a2 − a1)/(4 (σ/T)²).
+            fill_table(
+                [&](double lx) {
+                    const double s2 = std::exp(2.0 * lx);
+                    return std::pair{lnC + (a2 - a1) / (4.0 * s2), -(a2 - a1) / (2.0 * s2)};
+                },
+                table, out.y_, out.x_, out.dxdy_);
+        } else {
+            // Eq. 18: ln(E1/E2) = ln C + (3/2) ln[(1 + a2/(σ/T)²)/(1 + a1/(σ/T)²)].
+            fill_table(
+                [&](double lx) {
+                    const double s2 = std::exp(2.0 * lx);
+                    return std::pair{lnC + 1.5 * (std::log1p(a2 / s2) - std::log1p(a1 / s2)),
+                                     -3.0 * (a2 / (s2 + a2) - a1 / (s2 + a1))};
+                },
+                table, out.y_, out.x_, out.dxdy_);
+        }
+        return out;
+    }
+    // Any other pair of geometries: the very-rough model ratio of the two-geometry solver.
+    (void)model_ratio_very_rough(geom1, geom2, 1.0, correlation, model);  // validates
+    fill_table(
+        [&](double lx) {
+            return log_model(
+                [&](double s) {
+                    return model_ratio_very_rough(geom1, geom2, s, correlation, model);
+                },
+                lx);
+        },
+        table, out.y_, out.x_, out.dxdy_);
+    return out;
+}
+
+RatioInverseTable RatioInverseTable::correlation_length(const Geometry& geom1,
+                                                        const Geometry& geom2, double sigma_um,
+                                                        Correlation correlation,
+                                                        const TwoGeometryOptions& model,
+                                                        const RatioInverseTableOptions& table) {
+    check::geometry(geom1, "geom1");
+    check::geometry(geom2, "geom2");
+    check::positive("sigma_um", sigma_um, " µm");
+    RatioInverseTable out;
+    fill_table(
+        [&](double lx) {
+            return log_model(
+                [&](double T) {
+                    try {
+                        return model_ratio_diffuse(geom1, geom2, sigma_um, T, correlation, model);
+                    } catch (const Error&) {
+                        return std::numeric_limits<double>::quiet_NaN();
+                    }
+                },
+                lx);
+        },
+        table, out.y_, out.x_, out.dxdy_);
+    return out;
+}
+
+std::optional<RatioInverseTable::Value> RatioInverseTable::lookup(double log_ratio,
+                                                                  std::size_t& hint) const {
+    const std::size_t n = y_.size();
+    if (!(log_ratio >= y_.front() && log_ratio <= y_.back())) return std::nullopt;
+    std::size_t j = std::min(hint, n - 2);
+    if (!(y_[j] <= log_ratio && log_ratio <= y_[j + 1])) {
+        if (j + 2 < n && y_[j + 1] <= log_ratio && log_ratio <= y_[j + 2]) {
+            ++j;
+        } else if (j > 0 && y_[j - 1] <= log_ratio && log_ratio <= y_[j]) {
+            --j;
+        } else {
+            const auto it = std::upper_bound(y_.begin(), y_.end(), log_ratio);
+            j = static_cast<std::size_t>(std::clamp<std::ptrdiff_t>(
+                it - y_.begin() - 1, 0, static_cast<std::ptrdiff_t>(n - 2)));
+        }
+    }
+    hint = j;
+    // Cubic Hermite in y between nodes j and j + 1.
+    const double dy = y_[j + 1] - y_[j];
+    const double t = (log_ratio - y_[j]) / dy;
+    const double t2 = t * t, t3 = t2 * t;
+    const double h00 = 2.0 * t3 - 3.0 * t2 + 1.0, h10 = t3 - 2.0 * t2 + t;
+    const double h01 = -2.0 * t3 + 3.0 * t2, h11 = t3 - t2;
+    const double x0 = x_[j], x1 = x_[j + 1], d0 = dxdy_[j] * dy, d1 = dxdy_[j + 1] * dy;
+    Value v;
+    v.x = h00 * x0 + h10 * d0 + h01 * x1 + h11 * d1;
+    v.dx_dlog_ratio = ((6.0 * t2 - 6.0 * t) * x0 + (3.0 * t2 - 4.0 * t + 1.0) * d0 +
+                       (6.0 * t - 6.0 * t2) * x1 + (3.0 * t2 - 2.0 * t) * d1) /
+                      dy;
+    if (!(v.x > 0.0) || !std::isfinite(v.x)) return std::nullopt;
+    return v;
+}
+
+RatioRange RatioInverseTable::ratio_range() const {
+    return RatioRange{std::exp(y_.front()), std::exp(y_.back())};
+}
+
+// ---------------------------------------------------------------------------------------------
+// roughness_map
+
+namespace {
+
+std::string capture_name(const MapCapture& c, std::size_t k) {
+    if (!c.name.empty()) return c.name;
+    if (c.image != nullptr && !c.image->info.source.empty()) return c.image->info.source;
+    return concat("captures[", std::to_string(k), "]");
+}
+
+void check_map_input(const std::vector<MapCapture>& captures, const MapOptions& o) {
+    if (captures.size() < 2)
+        throw InvalidArgument(concat("roughness map: ", std::to_string(captures.size()),
+                                     " capture(s) given; a map needs at least 2 (two light "
+                                     "directions)"));
+    for (std::size_t k = 0; k < captures.size(); ++k) {
+        const MapCapture& c = captures[k];
+        const std::string name = concat("roughness map: captures[", std::to_string(k), "]");
+        if (c.image == nullptr) throw InvalidArgument(concat(name, ": no image"));
+        check_linear_image(*c.image);
+        check::positive(concat(name, ": exposure_scale"), c.exposure_scale);
+        const LinearImage& first = *captures[0].image;
+        if (c.image->width != first.width || c.image->height != first.height)
+            throw InvalidArgument(concat(
+                "roughness map: ", capture_name(c, k), " is ", std::to_string(c.image->width),
+                " x ", std::to_string(c.image->height), " but ", capture_name(captures[0], 0),
+                " is ", std::to_string(first.width), " x ", std::to_string(first.height),
+                ": every capture must have the same size"));
+        if (o.normal_map.empty()) {
+            check::geometry(c.geometry, name);
+        } else {
+            if (!c.light || !c.view)
+                throw InvalidArgument(concat(name,
+                                             ": a normal map needs the light and view "
+                                             "directions of every capture"));
+            for (const auto* v : {&*c.light, &*c.view})
+                if (!v->allFinite() || std::abs(v->norm() - 1.0) > 1e-6)
+                    throw InvalidArgument(
+                        concat(name, ": light and view must be finite unit vectors"));
+        }
+    }
+    if (o.window_px < 1 || o.window_px > kMaxWindowPx)
+        throw InvalidArgument(concat("roughness map: window_px = ", std::to_string(o.window_px),
+                                     " must be in [1, ", std::to_string(kMaxWindowPx), "]"));
+    if (!(o.min_used_fraction > 0.0 && o.min_used_fraction <= 1.0))
+        throw InvalidArgument(
+            concat("roughness map: min_used_fraction = ", check::format_number(o.min_used_fraction),
+                   " must be in (0, 1]"));
+    check::positive("roughness map: wavelength_um", o.wavelength_um, " µm");
+    if (o.sigma_um) check::positive("roughness map: sigma_um", *o.sigma_um, " µm");
+    check::non_negative("roughness map: sigma_um_stderr", o.sigma_um_stderr, " µm");
+    check::non_negative("roughness map: max_shift_px", o.max_shift_px, " px");
+    check::non_negative("roughness map: min_peak_to_sidelobe", o.min_peak_to_sidelobe);
+    check::positive("roughness map: slightly_rough_max_sigma_over_T",
+                    o.slightly_rough_max_sigma_over_T);
+    if (!(o.very_rough_min_sigma_over_T >= o.slightly_rough_max_sigma_over_T) ||
+        !std::isfinite(o.very_rough_min_sigma_over_T))
+        throw InvalidArgument(concat("roughness map: very_rough_min_sigma_over_T = ",
+                                     check::format_number(o.very_rough_min_sigma_over_T),
+                                     " must be finite and at least slightly_rough_max_sigma_over_T"
+                                     " = ",
+                                     check::format_number(o.slightly_rough_max_sigma_over_T)));
+    const std::size_t pixels = captures[0].image->pixel_count();
+    if (!o.normal_map.empty() && o.normal_map.size() != 3 * pixels)
+        throw InvalidArgument(concat("roughness map: the normal map has ",
+                                     std::to_string(o.normal_map.size()),
+                                     " values; it needs 3 per "
+                                     "pixel (",
+                                     std::to_string(3 * pixels), ")"));
+    if (!o.region_labels.empty()) {
+        if (o.region_labels.size() != pixels)
+            throw InvalidArgument(concat(
+                "roughness map: the region labels have ", std::to_string(o.region_labels.size()),
+                " values; they need one per pixel (", std::to_string(pixels), ")"));
+        const auto n = static_cast<std::int32_t>(o.region_names.size());
+        for (std::size_t i = 0; i < pixels; ++i)
+            if (o.region_labels[i] < -1 || o.region_labels[i] >= n)
+                throw InvalidArgument(concat("roughness map: region label ",
+                                             std::to_string(o.region_labels[i]), " at pixel ",
+                                             std::to_string(i), " must be −1 (none) or in [0, ",
+                                             std::to_string(n), ") (one name per region)"));
+    }
+}
+
+// What one map cell (pixel or tile) needs: ln(E1/E2), its variance and, for a normal map, the
+// (mean) normal.
+struct Cell {
+    double log_ratio = 0.0;
+    double var_log_ratio = 0.0;
+    Eigen::Vector3d normal = Eigen::Vector3d::Zero();
+};
+
+// Sums over a tile or neighbourhood.
+struct Sums {
+    double n = 0, s1 = 0, s2 = 0, s11 = 0, s22 = 0, s12 = 0;
+    void add(double x1, double x2) {
+        n += 1.0;
+        s1 += x1;
+        s2 += x2;
+        s11 += x1 * x1;
+        s22 += x2 * x2;
+        s12 += x1 * x2;
+    }
+    // var(ln m1/m2) · n (the variance of one pixel's ln ratio), with the means.
+    bool pixel_log_variance(double& m1, double& m2, double& var) const {
+        if (n < 2.0) return false;
+        m1 = s1 / n;
+        m2 = s2 / n;
+        if (!(m1 > 0.0) || !(m2 > 0.0)) return false;
+        const double v1 = std::max(0.0, (s11 - n * m1 * m1) / (n - 1.0));
+        const double v2 = std::max(0.0, (s22 - n * m2 * m2) / (n - 1.0));
+        const double c12 = (s12 - n * m1 * m2) / (n - 1.0);
+        var = std::max(0.0, v1 / (m1 * m1) + v2 / (m2 * m2) - 2.0 * c12 / (m1 * m2));
+        return true;
+    }
+};
+
+// The brightness of one row of a capture: channel average / s_k.
+void load_row(const MapCapture& c, std::size_t r, std::vector<double>& out) {
+    const LinearImage& im = *c.image;
+    const double scale = 1.0 / (static_cast<double>(im.channels) * c.exposure_scale);
+    const float* p0 = im.plane(0) + r * im.width;
+    if (im.channels == 1) {
+        for (std::size_t x = 0; x < im.width; ++x) out[x] = static_cast<double>(p0[x]) * scale;
+        return;
+    }
+    const float* p1 = im.plane(1) + r * im.width;
+    const float* p2 = im.plane(2) + r * im.width;
+    for (std::size_t x = 0; x < im.width; ++x)
+        out[x] = (static_cast<double>(p0[x]) + p1[x] + p2[x]) * scale;
+}
+
+// Evaluates cells into the layers of the map.
+class Evaluator {
+  public:
+    Evaluator(const std::vector<MapCapture>& captures, const MapOptions& o, RoughnessMap& map)
+        : c1_(captures[0]), c2_(captures[1]), o_(o), map_(map) {
+        model_.factor = o.factor;
+        model_.radiometry = o.radiometry;
+        model_.wavelength_um = o.wavelength_um;
+        flat_ = o.normal_map.empty();
+        if (flat_) {
+            table_g_ = RatioInverseTable::sigma_over_T(c1_.geometry, c2_.geometry,
+                                                       Correlation::Gaussian, model_, o.table);
+            table_e_ = RatioInverseTable::sigma_over_T(c1_.geometry, c2_.geometry,
+                                                       Correlation::Exponential, model_, o.table);
+            map_.method = normal_view(c1_.geometry) && normal_view(c2_.geometry)
+                              ? "table (Eq. 17/19)"
+                              : "table (two-geometry model)";
+            if (o.sigma_um) {
+                const double g = std::max(roughness_g(*o.sigma_um, c1_.geometry, o.wavelength_um),
+                                          roughness_g(*o.sigma_um, c2_.geometry, o.wavelength_um));
+                flat_g_class_ = roughness_class(g);
+                if (*flat_g_class_ != RoughnessClass::VeryRough) {
+                    // T from the diffuse term of the class's regime (Eq. 15 for slightly rough).
+                    TwoGeometryOptions m = model_;
+                    m.regime = *flat_g_class_ == RoughnessClass::SlightlyRough
+                                   ? Regime::SlightlyRough
+                                   : Regime::Series;
+                    try {
+                        table_t_ = RatioInverseTable::correlation_length(
+                            c1_.geometry, c2_.geometry, *o.sigma_um, o.correlation, m, o.table);
+                        if (o.sigma_um_stderr > 0.0) {
+                            sigma_step_ = *o.sigma_um * 1e-4;
+                            table_t2_ = RatioInverseTable::correlation_length(
+                                c1_.geometry, c2_.geometry, *o.sigma_um + sigma_step_,
+                                o.correlation, m, o.table);
+                        }
+                    } catch (const NoSolution& e) {
+                        map_.warnings.push_back(concat("T given σ: ", e.what()));
+                    }
+                }
+            }
+        } else {
+            map_.method = "solver per tile (two-geometry model)";
+        }
+    }
+
+    void evaluate(std::size_t index, const Cell& cell) {
+        const double lr = cell.log_ratio;
+        map_.E1_over_E2[index] = static_cast<float>(std::exp(lr));
+        const double sd_lr = std::sqrt(cell.var_log_ratio);
+        std::optional<Estimate> g, e;
+        std::optional<Geometry> geom1, geom2;
+        if (flat_) {
+            if (auto v = table_g_.lookup(lr, hint_g_))
+                g = Estimate{v->x, std::abs(v->dx_dlog_ratio) * sd_lr};
+            if (auto v = table_e_.lookup(lr, hint_e_))
+                e = Estimate{v->x, std::abs(v->dx_dlog_ratio) * sd_lr};
+        } else {
+            const double nn = cell.normal.norm();
+            if (nn > 0.0) {
+                const Eigen::Vector3d n = cell.normal / nn;
+                geom1 = geometry_from_vectors(n, *c1_.light, *c1_.view);
+                geom2 = geometry_from_vectors(n, *c2_.light, *c2_.view);
+            }
+            if (!geom1 || !geom2) {
+                ++map_.missing;
+                map_.roughness_class[index] = kClassNone;
+                if (!map_.roughness_class_g.empty()) map_.roughness_class_g[index] = kClassNone;
+                return;
+            }
+            g = solve(lr, sd_lr, *geom1, *geom2, Correlation::Gaussian);
+            e = solve(lr, sd_lr, *geom1, *geom2, Correlation::Exponential);
+        }
+        if (g) {
+            map_.sigma_over_T_gaussian[index] = static_cast<float>(g->value);
+            map_.sigma_over_T_gaussian_stderr[index] = static_cast<float>(g->std_error);
+        }
+        if (e) {
+            map_.sigma_over_T_exponential[index] = static_cast<float>(e->value);
+            map_.sigma_over_T_exponential_stderr[index] = static_cast<float>(e->std_error);
+        }
+        const std::optional<Estimate>& primary = o_.correlation == Correlation::Gaussian ? g : e;
+        const std::optional<Estimate>& other = o_.correlation == Correlation::Gaussian ? e : g;
+        if (!other) ++map_.no_solution_exponential;
+        if (o_.sigma_um) estimate_T(index, lr, sd_lr, primary, geom1, geom2);
+        if (!primary) {
+            ++map_.no_solution;
+            map_.roughness_class[index] = kClassNone;
+            return;
+        }
+        ++map_.valid;
+        map_.roughness_class[index] = class_code(roughness_class_of_sigma_over_T(
+            primary->value, o_.slightly_rough_max_sigma_over_T, o_.very_rough_min_sigma_over_T));
+    }
+
+    // σ known: the class by g and T (Eq. 15 / the diffuse term of the class's regime; σ/(σ/T)
+    // for a very rough surface).
+    void estimate_T(std::size_t index, double lr, double sd_lr,
+                    const std::optional<Estimate>& primary, const std::optional<Geometry>& geom1,
+                    const std::optional<Geometry>& geom2) {
+        const double sigma = *o_.sigma_um;
+        RoughnessClass gc = RoughnessClass::VeryRough;
+        if (flat_) {
+            gc = *flat_g_class_;
+        } else {
+            gc = roughness_class(std::max(roughness_g(sigma, *geom1, o_.wavelength_um),
+                                          roughness_g(sigma, *geom2, o_.wavelength_um)));
+        }
+        map_.roughness_class_g[index] = class_code(gc);
+        std::optional<Estimate> T;
+        if (gc == RoughnessClass::VeryRough) {
+            if (primary) {
+                const double s = primary->value;
+                T = Estimate{sigma / s, std::hypot(sigma / (s * s) * primary->std_error,
+                                                   o_.sigma_um_stderr / s)};
+            }
+        } else if (flat_) {
+            if (table_t_) {
+                if (auto v = table_t_->lookup(lr, hint_t_)) {
+                    double dT_dsigma = 0.0;
+                    if (table_t2_) {
+                        if (auto v2 = table_t2_->lookup(lr, hint_t2_))
+                            dT_dsigma = (v2->x - v->x) / sigma_step_;
+                    }
+                    T = Estimate{
+                        v->x, std::hypot(v->dx_dlog_ratio * sd_lr, dT_dsigma * o_.sigma_um_stderr)};
+                }
+            }
+        } else {
+            TwoGeometryOptions m = model_;
+            m.regime = gc == RoughnessClass::SlightlyRough ? Regime::SlightlyRough : Regime::Series;
+            try {
+                const double t0 = correlation_length_two_geometries(std::exp(lr), *geom1, *geom2,
+                                                                    sigma, o_.correlation, m);
+                const double tp = correlation_length_two_geometries(
+                    std::exp(lr + kLogStep), *geom1, *geom2, sigma, o_.correlation, m);
+                const double ts = correlation_length_two_geometries(
+                    std::exp(lr), *geom1, *geom2, sigma * (1.0 + 1e-4), o_.correlation, m);
+                T = Estimate{t0, std::hypot((tp - t0) / kLogStep * sd_lr,
+                                            (ts - t0) / (sigma * 1e-4) * o_.sigma_um_stderr)};
+            } catch (const Error&) {
+            }
+        }
+        if (T && std::isfinite(T->value) && std::isfinite(T->std_error)) {
+            map_.T_um[index] = static_cast<float>(T->value);
+            map_.T_um_stderr[index] = static_cast<float>(T->std_error);
+        } else {
+            ++no_solution_T_;
+        }
+    }
+
+    std::size_t no_solution_T() const { return no_solution_T_; }
+    std::optional<RoughnessClass> flat_g_class() const { return flat_g_class_; }
+
+  private:
+    // The two-geometry solver (normal map), with d(σ/T)/d ln r = σ/T / (d ln M/d ln(σ/T)).
+    std::optional<Estimate> solve(double lr, double sd_lr, const Geometry& g1, const Geometry& g2,
+                                  Correlation c) const {
+        try {
+            const double s = sigma_over_T_two_geometries(std::exp(lr), g1, g2, c, model_);
+            const auto [y, dy] =
+                log_model([&](double x) { return model_ratio_very_rough(g1, g2, x, c, model_); },
+                          std::log(s));
+            (void)y;
+            const double se = std::abs(s / dy) * sd_lr;
+            if (!std::isfinite(s) || !std::isfinite(se)) return std::nullopt;
+            return Estimate{s, se};
+        } catch (const Error&) {
+            return std::nullopt;
+        }
+    }
+
+    const MapCapture& c1_;
+    const MapCapture& c2_;
+    const MapOptions& o_;
+    RoughnessMap& map_;
+    TwoGeometryOptions model_;
+    bool flat_ = true;
+    RatioInverseTable table_g_, table_e_;
+    std::optional<RatioInverseTable> table_t_, table_t2_;
+    double sigma_step_ = 0.0;
+    std::optional<RoughnessClass> flat_g_class_;
+    std::size_t hint_g_ = 0, hint_e_ = 0, hint_t_ = 0, hint_t2_ = 0;
+    std::size_t no_solution_T_ = 0;
+};
+
+bool pixel_used(const MapCapture& c1, const MapCapture& c2, const MapOptions& o, std::size_t p) {
+    if ((c1.image->flags[p] | c2.image->flags[p]) != 0) return false;
+    if (!o.normal_map.empty()) {
+        const float* n = o.normal_map.data() + 3 * p;
+        if (!std::isfinite(n[0]) || !std::isfinite(n[1]) || !std::isfinite(n[2])) return false;
+    }
+    return true;
+}
+
+// Tiles: one pass over the rows, the sums of each tile of a row of tiles.
+void tile_map(const std::vector<MapCapture>& captures, const MapOptions& o, Evaluator& ev,
+              RoughnessMap& map, std::vector<std::int32_t>& cell_region) {
+    const MapCapture& c1 = captures[0];
+    const MapCapture& c2 = captures[1];
+    const std::size_t W = c1.image->width, H = c1.image->height, w = o.window_px;
+    std::vector<double> x1(W), x2(W);
+    std::vector<Sums> sums(map.width);
+    std::vector<Eigen::Vector3d> normals(map.width);
+    std::vector<std::int32_t> region(map.width);
+    const bool labels = !o.region_labels.empty();
+    for (std::size_t ty = 0; ty < map.height; ++ty) {
+        std::fill(sums.begin(), sums.end(), Sums{});
+        std::fill(normals.begin(), normals.end(), Eigen::Vector3d::Zero());
+        std::fill(region.begin(), region.end(), -2);
+        const std::size_t r0 = ty * w, r1 = std::min(H, r0 + w);
+        for (std::size_t r = r0; r < r1; ++r) {
+            load_row(c1, r, x1);
+            load_row(c2, r, x2);
+            for (std::size_t tx = 0; tx < map.width; ++tx) {
+                const std::size_t q0 = tx * w, q1 = std::min(W, q0 + w);
+                Sums& s = sums[tx];
+                for (std::size_t x = q0; x < q1; ++x) {
+                    const std::size_t p = r * W + x;
+                    if (labels) {
+                        const std::int32_t l = o.region_labels[p];
+                        std::int32_t& t = region[tx];
+                        t = t == -2 ? l : (t == l ? t : -1);
+                    }
+                    if (!pixel_used(c1, c2, o, p)) continue;
+                    s.add(x1[x], x2[x]);
+                    if (!o.normal_map.empty()) {
+                        const float* n = o.normal_map.data() + 3 * p;
+                        normals[tx] += Eigen::Vector3d(n[0], n[1], n[2]);
+                    }
+                }
+            }
+        }
+        for (std::size_t tx = 0; tx < map.width; ++tx) {
+            const std::size_t index = ty * map.width + tx;
+            const std::size_t q0 = tx * w, q1 = std::min(W, q0 + w);
+            const double area = static_cast<double>((q1 - q0) * (r1 - r0));
+            if (labels) cell_region[index] = std::max(region[tx], -1);
+            const Sums& s = sums[tx];
+            double m1 = 0, m2 = 0, var = 0;
+            if (s.n < std::max(2.0, o.min_used_fraction * area)) {
+                ++map.missing;
+                map.roughness_class[index] = kClassNone;
+                if (!map.roughness_class_g.empty()) map.roughness_class_g[index] = kClassNone;
+                continue;
+            }
+            if (!s.pixel_log_variance(m1, m2, var)) {
+                ++map.no_solution;
+                ++map.no_solution_exponential;
+                map.roughness_class[index] = kClassNone;
+                if (!map.roughness_class_g.empty()) map.roughness_class_g[index] = kClassNone;
+                continue;
+            }
+            Cell cell;
+            cell.log_ratio = std::log(m1 / m2);
+            cell.var_log_ratio = var / s.n;
+            cell.normal = normals[tx];
+            ev.evaluate(index, cell);
+        }
+    }
+}
+
+// Per pixel: the pixel's ratio, the noise from the (2R + 1)² neighbourhood (running sums).
+void pixel_map(const std::vector<MapCapture>& captures, const MapOptions& o, Evaluator& ev,
+               RoughnessMap& map, std::vector<std::int32_t>& cell_region) {
+    const MapCapture& c1 = captures[0];
+    const MapCapture& c2 = captures[1];
+    const std::size_t W = c1.image->width, H = c1.image->height, R = kPixelNoiseRadius;
+    const std::size_t ring = 2 * R + 2;
+    std::vector<std::vector<double>> x1(ring, std::vector<double>(W)),
+        x2(ring, std::vector<double>(W));
+    std::vector<std::vector<std::uint8_t>> used(ring, std::vector<std::uint8_t>(W));
+    std::vector<Sums> col(W);
+    std::vector<double> tmp1(W), tmp2(W);
+    auto load = [&](std::size_t r) {
+        const std::size_t k = r % ring;
+        load_row(c1, r, x1[k]);
+        load_row(c2, r, x2[k]);
+        for (std::size_t x = 0; x < W; ++x) used[k][x] = pixel_used(c1, c2, o, r * W + x) ? 1 : 0;
+    };
+    auto add_row = [&](std::size_t r, double sign) {
+        const std::size_t k = r % ring;
+        for (std::size_t x = 0; x < W; ++x) {
+            if (!used[k][x]) continue;
+            const double a = x1[k][x], b = x2[k][x];
+            Sums& s = col[x];
+            s.n += sign;
+            s.s1 += sign * a;
+            s.s2 += sign * b;
+            s.s11 += sign * a * a;
+            s.s22 += sign * b * b;
+            s.s12 += sign * a * b;
+        }
+    };
+    for (std::size_t r = 0; r < std::min(H, R + 1); ++r) {
+        load(r);
+        add_row(r, 1.0);
+    }
+    const bool labels = !o.region_labels.empty();
+    for (std::size_t r = 0; r < H; ++r) {
+        if (r >= 1 && r + R < H) {
+            load(r + R);
+            add_row(r + R, 1.0);
+        }
+        if (r >= R + 1) add_row(r - R - 1, -1.0);
+        const std::size_t k = r % ring;
+        Sums window;
+        auto add_col = [&](const Sums& s, double sign) {
+            window.n += sign * s.n;
+            window.s1 += sign * s.s1;
+            window.s2 += sign * s.s2;
+            window.s11 += sign * s.s11;
+            window.s22 += sign * s.s22;
+            window.s12 += sign * s.s12;
+        };
+        for (std::size_t x = 0; x < std::min(W, R + 1); ++x) add_col(col[x], 1.0);
+        for (std::size_t x = 0; x < W; ++x) {
+            if (x >= 1 && x + R < W) add_col(col[x + R], 1.0);
+            if (x >= R + 1) add_col(col[x - R - 1], -1.0);
+            const std::size_t index = r * W + x;
+            if (labels) cell_region[index] = o.region_labels[index];
+            double m1 = 0, m2 = 0, var = 0;
+            // Running sums of ±1 stay exact integers in n.
+            if (!used[k][x] || window.n < 3.0) {
+                ++map.missing;
+                map.roughness_class[index] = kClassNone;
+                if (!map.roughness_class_g.empty()) map.roughness_class_g[index] = kClassNone;
+                continue;
+            }
+            const double a = x1[k][x], b = x2[k][x];
+            if (!(a > 0.0) || !(b > 0.0) || !window.pixel_log_variance(m1, m2, var)) {
+                ++map.no_solution;
+                ++map.no_solution_exponential;
+                map.roughness_class[index] = kClassNone;
+                if (!map.roughness_class_g.empty()) map.roughness_class_g[index] = kClassNone;
+                continue;
+            }
+            Cell cell;
+            cell.log_ratio = std::log(a / b);
+            cell.var_log_ratio = var;
+            if (!o.normal_map.empty()) {
+                const float* n = o.normal_map.data() + 3 * index;
+                cell.normal = Eigen::Vector3d(n[0], n[1], n[2]);
+            }
+            ev.evaluate(index, cell);
+        }
+    }
+}
+
+void summarise(const MapOptions& o, RoughnessMap& map,
+               const std::vector<std::int32_t>& cell_region) {
+    std::array<Accumulator, 3> classes;
+    std::vector<RegionAccumulator> regions(o.region_names.size());
+    const std::vector<float>& primary = o.correlation == Correlation::Gaussian
+                                            ? map.sigma_over_T_gaussian
+                                            : map.sigma_over_T_exponential;
+    const std::size_t cells = map.width * map.height;
+    for (std::size_t i = 0; i < cells; ++i) {
+        const std::uint8_t c = map.roughness_class[i];
+        const std::int32_t region = cell_region.empty() ? -1 : cell_region[i];
+        if (region >= 0 && !map.T_um.empty() && std::isfinite(map.T_um[i]))
+            regions[static_cast<std::size_t>(region)].T.add(map.T_um[i]);
+        if (c == kClassNone) {
+            if (region >= 0) ++regions[static_cast<std::size_t>(region)].missing;
+            continue;
+        }
+        classes[c].add(primary[i]);
+        if (region < 0) continue;
+        RegionAccumulator& ra = regions[static_cast<std::size_t>(region)];
+        ++ra.classes[c];
+        if (std::isfinite(map.sigma_over_T_gaussian[i]))
+            ra.gaussian.add(map.sigma_over_T_gaussian[i]);
+        if (std::isfinite(map.sigma_over_T_exponential[i]))
+            ra.exponential.add(map.sigma_over_T_exponential[i]);
+    }
+    for (std::size_t c = 0; c < 3; ++c) {
+        ClassStatistics& s = map.classes[c];
+        s.roughness_class = static_cast<RoughnessClass>(c);
+        s.count = classes[c].n;
+        s.fraction =
+            map.valid > 0 ? static_cast<double>(s.count) / static_cast<double>(map.valid) : 0.0;
+        s.mean_sigma_over_T = classes[c].mean();
+    }
+    for (std::size_t k = 0; k < regions.size(); ++k) {
+        RegionMapStatistics s;
+        s.name = o.region_names[k];
+        const RegionAccumulator& ra = regions[k];
+        s.count = ra.classes[0] + ra.classes[1] + ra.classes[2];
+        s.missing = ra.missing;
+        s.mean_sigma_over_T_gaussian = ra.gaussian.mean();
+        s.mean_sigma_over_T_exponential = ra.exponential.mean();
+        s.mean_T_um = ra.T.mean();
+        s.class_counts = ra.classes;
+        map.regions.push_back(std::move(s));
+    }
+}
+
+}  // namespace
+
+RoughnessMap roughness_map(const std::vector<MapCapture>& captures, const MapOptions& o) {
+    check_map_input(captures, o);
+    RoughnessMap map;
+    const LinearImage& a = *captures[0].image;
+    const LinearImage& b = *captures[1].image;
+    map.window_px = o.window_px;
+    map.image_width = a.width;
+    map.image_height = a.height;
+    map.width = (a.width + o.window_px - 1) / o.window_px;
+    map.height = (a.height + o.window_px - 1) / o.window_px;
+    if (captures.size() > 2)
+        map.warnings.push_back(concat("roughness map: ", std::to_string(captures.size()),
+                                      " captures given; the map uses the first two (",
+                                      capture_name(captures[0], 0), ", ",
+                                      capture_name(captures[1], 1), ") and ignores the others"));
+    if (o.check_registration && a.width >= 16 && a.height >= 16) {
+        const Registration reg = estimate_misregistration(a, b, o.registration);
+        map.registration = reg;
+        if (reg.magnitude_px > o.max_shift_px) {
+            const std::string shift = concat(
+                capture_name(captures[1], 1), " is shifted by (",
+                check::format_number(reg.shift_x_px), ", ", check::format_number(reg.shift_y_px),
+                ") px = ", check::format_number(reg.magnitude_px), " px against ",
+                capture_name(captures[0], 0), " (phase correlation, peak-to-sidelobe ",
+                check::format_number(reg.peak_to_sidelobe), "); the threshold max_shift_px is ",
+                check::format_number(o.max_shift_px), " px");
+            if (reg.peak_to_sidelobe < o.min_peak_to_sidelobe)
+                map.warnings.push_back(concat("roughness map: ", shift,
+                                              ", but the peak-to-sidelobe ratio is below ",
+                                              check::format_number(o.min_peak_to_sidelobe),
+                                              ": the images share too little structure to tell"));
+            else if (!o.allow_misregistration)
+                throw DataError(concat("roughness map: ", shift,
+                                       ": register the images (or allow the misregistration)"));
+            else
+                map.warnings.push_back(concat("roughness map: ", shift,
+                                              " (allowed: ratios near edges are unreliable)"));
+        }
+    }
+    const std::size_t cells = map.width * map.height;
+    for (auto* layer :
+         {&map.E1_over_E2, &map.sigma_over_T_gaussian, &map.sigma_over_T_gaussian_stderr,
+          &map.sigma_over_T_exponential, &map.sigma_over_T_exponential_stderr})
+        layer->assign(cells, kNaN);
+    map.roughness_class.assign(cells, kClassNone);
+    if (o.sigma_um) {
+        map.T_um.assign(cells, kNaN);
+        map.T_um_stderr.assign(cells, kNaN);
+        map.roughness_class_g.assign(cells, kClassNone);
+    }
+    std::vector<std::int32_t> cell_region;
+    if (!o.region_labels.empty()) cell_region.assign(cells, -1);
+    Evaluator ev(captures, o, map);
+    if (o.window_px == 1)
+        pixel_map(captures, o, ev, map, cell_region);
+    else
+        tile_map(captures, o, ev, map, cell_region);
+    summarise(o, map, cell_region);
+    if (map.no_solution > 0)
+        map.warnings.push_back(concat("roughness map: ", std::to_string(map.no_solution), " of ",
+                                      std::to_string(cells),
+                                      " pixels/tiles have a ratio E1/E2 the model does not produce "
+                                      "(no σ/T)"));
+    if (o.sigma_um && ev.no_solution_T() > 0)
+        map.warnings.push_back(concat("roughness map: ", std::to_string(ev.no_solution_T()),
+                                      " pixels/tiles with σ/T have no T given σ"));
+    if (map.valid == 0) map.warnings.push_back("roughness map: no pixel or tile has an estimate");
+    return map;
+}
+
+}  // namespace roughscope::image

@@ -1,0 +1,575 @@
+#include "roughscope/image/silhouette.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include <Eigen/Dense>
+#include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "roughscope/core/errors.hpp"
+#include "roughscope/core/text.hpp"
+#include "roughscope/scattering/geometry.hpp"
+
+namespace roughscope::image {
+namespace {
+
+using check::format_number;
+
+std::string image_name(const LinearImage& image) {
+    return image.info.source.empty() ? std::string("image") : image.info.source;
+}
+
+// The per-pixel channel average (R + G + B)/3, row-major.
+std::vector<float> channel_average(const LinearImage& image) {
+    const std::size_t n = image.pixel_count();
+    std::vector<float> avg(image.plane(0), image.plane(0) + n);
+    if (image.channels == 3) {
+        const float* g = image.plane(1);
+        const float* b = image.plane(2);
+        for (std::size_t i = 0; i < n; ++i) avg[i] = (avg[i] + g[i] + b[i]) * (1.0F / 3.0F);
+    }
+    return avg;
+}
+
+void check_fraction(std::string_view name, double value) {
+    if (!(value > 0.0 && value < 1.0))
+        throw InvalidArgument(
+            concat(name, " = ", format_number(value), " is outside the valid range (0, 1)"));
+}
+
+// Sobel gradient of the 0/1 mask at (c, r), clamped at the image edge.
+std::array<int, 2> mask_gradient(const std::vector<std::uint8_t>& m, std::size_t w, std::size_t h,
+                                 std::size_t c, std::size_t r) {
+    auto at = [&](std::ptrdiff_t cc, std::ptrdiff_t rr) -> int {
+        cc = std::clamp<std::ptrdiff_t>(cc, 0, static_cast<std::ptrdiff_t>(w) - 1);
+        rr = std::clamp<std::ptrdiff_t>(rr, 0, static_cast<std::ptrdiff_t>(h) - 1);
+        return m[static_cast<std::size_t>(rr) * w + static_cast<std::size_t>(cc)];
+    };
+    const auto x = static_cast<std::ptrdiff_t>(c), y = static_cast<std::ptrdiff_t>(r);
+    const int gx = (at(x + 1, y - 1) + 2 * at(x + 1, y) + at(x + 1, y + 1)) -
+                   (at(x - 1, y - 1) + 2 * at(x - 1, y) + at(x - 1, y + 1));
+    const int gy = (at(x - 1, y + 1) + 2 * at(x, y + 1) + at(x + 1, y + 1)) -
+                   (at(x - 1, y - 1) + 2 * at(x, y - 1) + at(x + 1, y - 1));
+    return {gx, gy};
+}
+
+// The sub-pixel crossing between inside pixel i and outside pixel o (neighbours along a row or
+// a column), with i2, o2 the next pixels further in and out. The midpoint of i and o — unbiased
+// for a sharp edge sampled at pixel centres, whatever the brightness does towards a darkening
+// limb — unless the object is flat up to the edge (A_i ≥ 0.9 A_i2) and the level halfway
+// between the object's and the background's values, (A_i2 + A_o2)/2, lies between A_o and A_i:
+// then where that level is crossed, interpolated linearly between i and o (a blurred step).
+// Returns the fraction of the way from i to o.
+double crossing_fraction(float ai, float ao, float ai2, float ao2) {
+    const double level = 0.5 * (static_cast<double>(ai2) + static_cast<double>(ao2));
+    const double step = static_cast<double>(ai) - static_cast<double>(ao);
+    if (!(step > 0.0) || ai < 0.9 * ai2 || level > ai || level < ao) return 0.5;
+    return (static_cast<double>(ai) - level) / step;
+}
+
+}  // namespace
+
+Silhouette find_silhouette(const LinearImage& image, const SilhouetteOptions& options) {
+    check_linear_image(image);
+    check_fraction("silhouette edge_fraction", options.edge_fraction);
+    check_fraction("silhouette min_object_fraction", options.min_object_fraction);
+    if (options.threshold && !std::isfinite(*options.threshold))
+        throw InvalidArgument("silhouette threshold must be finite");
+    const std::size_t w = image.width, h = image.height, n = image.pixel_count();
+    if (n > static_cast<std::size_t>(std::numeric_limits<int>::max()) || w < 3 || h < 3)
+        throw InvalidArgument(concat(image_name(image),
+                                     ": a silhouette needs an image of at least "
+                                     "3 x 3 and below 2^31 pixels"));
+    const std::vector<float> avg = channel_average(image);
+    const int rows = static_cast<int>(h), cols = static_cast<int>(w);
+
+    Silhouette s;
+    s.width = w;
+    s.height = h;
+    if (options.threshold) {
+        s.threshold = *options.threshold;
+    } else {
+        const auto [lo_it, hi_it] = std::minmax_element(avg.begin(), avg.end());
+        const double lo = *lo_it, hi = *hi_it;
+        if (!(hi > lo))
+            throw DataError(concat(image_name(image), ": no object found (the image is uniform, ",
+                                   format_number(lo), ")"));
+        cv::Mat u8(rows, cols, CV_8UC1);
+        const double scale = 255.0 / (hi - lo);
+        for (std::size_t i = 0; i < n; ++i)
+            u8.data[i] =
+                static_cast<std::uint8_t>(std::lround((static_cast<double>(avg[i]) - lo) * scale));
+        cv::Mat unused;
+        const double t8 = cv::threshold(u8, unused, 0, 255, cv::THRESH_BINARY | cv::THRESH_OTSU);
+        const double t_otsu = lo + (t8 + 0.5) / scale;
+        s.otsu_threshold = t_otsu;
+        // Background level and noise: median and 1.4826 · MAD of the pixels below t_O (robust
+        // to the dark limb of the object, which falls below t_O too), on a regular subsample of
+        // at most 2^20 pixels; object level: mean of the pixels above t_O.
+        const std::size_t stride = std::max<std::size_t>(1, n >> 20);
+        std::vector<float> below;
+        double so = 0;
+        std::size_t no = 0;
+        for (std::size_t i = 0; i < n; ++i) {
+            const float v = avg[i];
+            if (v <= t_otsu) {
+                if (i % stride == 0) below.push_back(v);
+            } else {
+                so += v;
+                ++no;
+            }
+        }
+        if (below.empty() || no == 0)
+            throw DataError(concat(image_name(image), ": no object found (no background)"));
+        auto median = [](std::vector<float>& x) {
+            const auto mid = x.begin() + static_cast<std::ptrdiff_t>(x.size() / 2);
+            std::nth_element(x.begin(), mid, x.end());
+            return static_cast<double>(*mid);
+        };
+        const double mb = median(below);
+        for (float& v : below) v = static_cast<float>(std::abs(v - mb));
+        const double sdb = 1.4826 * median(below);
+        const double mo = so / static_cast<double>(no);
+        s.threshold = std::min(t_otsu, mb + std::max(6.0 * sdb, options.edge_fraction * (mo - mb)));
+    }
+
+    // Largest 8-connected component above the level.
+    cv::Mat bin(rows, cols, CV_8UC1);
+    const auto t = static_cast<float>(s.threshold);
+    for (std::size_t i = 0; i < n; ++i) bin.data[i] = avg[i] > t ? 1 : 0;
+    cv::Mat labels, stats, centroids;
+    const int count = cv::connectedComponentsWithStats(bin, labels, stats, centroids, 8, CV_32S);
+    int best = 0, best_area = 0;
+    for (int k = 1; k < count; ++k) {
+        const int area = stats.at<int>(k, cv::CC_STAT_AREA);
+        if (area > best_area) {
+            best_area = area;
+            best = k;
+        }
+    }
+    if (best == 0 ||
+        static_cast<double>(best_area) < options.min_object_fraction * static_cast<double>(n))
+        throw DataError(
+            concat(image_name(image), ": no object found: the largest region brighter than ",
+                   format_number(s.threshold), " covers ", std::to_string(best_area), " of ",
+                   std::to_string(n), " pixels, below the minimum object fraction ",
+                   format_number(options.min_object_fraction)));
+    s.mask.assign(n, 0);
+    const auto* lab = labels.ptr<std::int32_t>(0);
+    for (std::size_t i = 0; i < n; ++i) s.mask[i] = lab[i] == best ? 1 : 0;
+
+    // Fill holes: background components (4-connected) that do not reach the image border.
+    {
+        cv::Mat inv(rows, cols, CV_8UC1);
+        for (std::size_t i = 0; i < n; ++i) inv.data[i] = s.mask[i] ? 0 : 1;
+        cv::Mat bl;
+        const int nb = cv::connectedComponents(inv, bl, 4, CV_32S);
+        std::vector<std::uint8_t> border(static_cast<std::size_t>(nb), 0);
+        const auto* b = bl.ptr<std::int32_t>(0);
+        for (std::size_t c = 0; c < w; ++c) {
+            border[static_cast<std::size_t>(b[c])] = 1;
+            border[static_cast<std::size_t>(b[(h - 1) * w + c])] = 1;
+        }
+        for (std::size_t r = 0; r < h; ++r) {
+            border[static_cast<std::size_t>(b[r * w])] = 1;
+            border[static_cast<std::size_t>(b[r * w + w - 1])] = 1;
+        }
+        for (std::size_t i = 0; i < n; ++i)
+            if (!s.mask[i] && !border[static_cast<std::size_t>(b[i])]) s.mask[i] = 1;
+    }
+
+    // Counts, centroid, bounding box, border contacts.
+    double sx = 0, sy = 0;
+    s.col_min = w;
+    s.row_min = h;
+    for (std::size_t r = 0; r < h; ++r) {
+        const std::uint8_t* m = s.mask.data() + r * w;
+        std::size_t row_count = 0;
+        double row_sx = 0;
+        for (std::size_t c = 0; c < w; ++c)
+            if (m[c]) {
+                ++row_count;
+                row_sx += static_cast<double>(c);
+                s.col_min = std::min(s.col_min, c);
+                s.col_max = std::max(s.col_max, c + 1);
+            }
+        if (row_count) {
+            s.row_min = std::min(s.row_min, r);
+            s.row_max = r + 1;
+            s.pixel_count += row_count;
+            sx += row_sx;
+            sy += static_cast<double>(r) * static_cast<double>(row_count);
+        }
+    }
+    const auto np = static_cast<double>(s.pixel_count);
+    s.centroid_x_px = sx / np + 0.5;
+    s.centroid_y_px = sy / np + 0.5;
+    s.touches_left = s.col_min == 0;
+    s.touches_right = s.col_max == w;
+    s.touches_top = s.row_min == 0;
+    s.touches_bottom = s.row_max == h;
+
+    // Sub-pixel boundary: along rows where the outline is more vertical than horizontal, along
+    // columns elsewhere.
+    auto add_point = [&](std::size_t ci, std::size_t ri, std::size_t co, std::size_t ro,
+                         double frac) {
+        std::array<int, 2> g = mask_gradient(s.mask, w, h, ci, ri);
+        const std::array<int, 2> g2 = mask_gradient(s.mask, w, h, co, ro);
+        g[0] += g2[0];
+        g[1] += g2[1];
+        const bool along_row = ri == ro;
+        if (along_row ? std::abs(g[0]) < std::abs(g[1]) : std::abs(g[1]) <= std::abs(g[0])) return;
+        EdgePoint p;
+        p.x_px = static_cast<double>(ci) + 0.5 +
+                 frac * (static_cast<double>(co) - static_cast<double>(ci));
+        p.y_px = static_cast<double>(ri) + 0.5 +
+                 frac * (static_cast<double>(ro) - static_cast<double>(ri));
+        const double norm = std::hypot(static_cast<double>(g[0]), static_cast<double>(g[1]));
+        if (norm > 0) {  // the mask gradient points inwards
+            p.normal_x = -g[0] / norm;
+            p.normal_y = -g[1] / norm;
+        }
+        s.boundary.push_back(p);
+    };
+    const std::size_t r0 = s.row_min, r1 = s.row_max;
+    const std::size_t c0 = s.col_min > 0 ? s.col_min - 1 : 0;
+    const std::size_t c1 = std::min(w, s.col_max + 1);
+    for (std::size_t r = r0; r < r1; ++r) {
+        const std::uint8_t* m = s.mask.data() + r * w;
+        const float* a = avg.data() + r * w;
+        for (std::size_t c = c0; c + 1 < c1; ++c) {
+            if (m[c] == m[c + 1]) continue;
+            const bool inside_left = m[c] != 0;
+            const std::size_t i = inside_left ? c : c + 1, o = inside_left ? c + 1 : c;
+            std::size_t i2 = i, o2 = o;
+            if (inside_left) {
+                if (i > 0 && m[i - 1]) i2 = i - 1;
+                if (o + 1 < w && !m[o + 1]) o2 = o + 1;
+            } else {
+                if (i + 1 < w && m[i + 1]) i2 = i + 1;
+                if (o > 0 && !m[o - 1]) o2 = o - 1;
+            }
+            add_point(i, r, o, r, crossing_fraction(a[i], a[o], a[i2], a[o2]));
+        }
+    }
+    const std::size_t rr0 = r0 > 0 ? r0 - 1 : 0, rr1 = std::min(h, r1 + 1);
+    for (std::size_t r = rr0; r + 1 < rr1; ++r) {
+        const std::uint8_t* m0 = s.mask.data() + r * w;
+        const std::uint8_t* m1 = m0 + w;
+        for (std::size_t c = s.col_min; c < s.col_max; ++c) {
+            if (m0[c] == m1[c]) continue;
+            const bool inside_top = m0[c] != 0;
+            const std::size_t ri = inside_top ? r : r + 1, ro = inside_top ? r + 1 : r;
+            std::size_t ri2 = ri, ro2 = ro;
+            auto in = [&](std::size_t rr) { return s.mask[rr * w + c] != 0; };
+            if (inside_top) {
+                if (ri > 0 && in(ri - 1)) ri2 = ri - 1;
+                if (ro + 1 < h && !in(ro + 1)) ro2 = ro + 1;
+            } else {
+                if (ri + 1 < h && in(ri + 1)) ri2 = ri + 1;
+                if (ro > 0 && !in(ro - 1)) ro2 = ro - 1;
+            }
+            add_point(c, ri, c, ro,
+                      crossing_fraction(avg[ri * w + c], avg[ro * w + c], avg[ri2 * w + c],
+                                        avg[ro2 * w + c]));
+        }
+    }
+    return s;
+}
+
+// ---------------------------------------------------------------------------------------------
+
+CircleFit fit_circle(const std::vector<EdgePoint>& points) {
+    const std::size_t n = points.size();
+    if (n < 3)
+        throw InvalidArgument(
+            concat("a circle fit needs at least 3 points, got ", std::to_string(n)));
+    double mx = 0, my = 0;
+    for (const EdgePoint& p : points) {
+        if (!std::isfinite(p.x_px) || !std::isfinite(p.y_px))
+            throw InvalidArgument("circle fit: a point has a non-finite coordinate");
+        mx += p.x_px;
+        my += p.y_px;
+    }
+    mx /= static_cast<double>(n);
+    my /= static_cast<double>(n);
+    // Kåsa: x² + y² + D x + E y + F = 0 in least squares (coordinates about the mean).
+    Eigen::MatrixXd A(static_cast<Eigen::Index>(n), 3);
+    Eigen::VectorXd b(static_cast<Eigen::Index>(n));
+    double spread = 0;
+    for (std::size_t k = 0; k < n; ++k) {
+        const double x = points[k].x_px - mx, y = points[k].y_px - my;
+        const auto i = static_cast<Eigen::Index>(k);
+        A(i, 0) = x;
+        A(i, 1) = y;
+        A(i, 2) = 1.0;
+        b(i) = -(x * x + y * y);
+        spread = std::max(spread, std::hypot(x, y));
+    }
+    const Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(A);
+    const auto no_circle = [] {
+        return DataError("circle fit: the points are collinear or coincide (no circle)");
+    };
+    if (qr.rank() < 3 || !(spread > 0)) throw no_circle();
+    const Eigen::Vector3d sol = qr.solve(b);
+    double cx = -0.5 * sol(0), cy = -0.5 * sol(1);
+    double R2 = cx * cx + cy * cy - sol(2);
+    if (!(R2 > 0) || std::sqrt(R2) > 1e6 * spread) throw no_circle();
+    double R = std::sqrt(R2);
+    // Gauss–Newton on the geometric residuals |p − c| − R.
+    for (int it = 0; it < 50; ++it) {
+        Eigen::Matrix3d JtJ = Eigen::Matrix3d::Zero();
+        Eigen::Vector3d Jtr = Eigen::Vector3d::Zero();
+        for (const EdgePoint& p : points) {
+            const double dx = p.x_px - mx - cx, dy = p.y_px - my - cy;
+            const double rho = std::hypot(dx, dy);
+            if (!(rho > 0)) continue;
+            const Eigen::Vector3d J(-dx / rho, -dy / rho, -1.0);
+            JtJ += J * J.transpose();
+            Jtr += J * (rho - R);
+        }
+        const Eigen::Vector3d step = JtJ.ldlt().solve(-Jtr);
+        if (!step.allFinite()) break;
+        cx += step(0);
+        cy += step(1);
+        R += step(2);
+        if (step.norm() < 1e-12 * (1.0 + R)) break;
+    }
+    if (!(R > 0) || !std::isfinite(R)) throw no_circle();
+    double ss = 0;
+    for (const EdgePoint& p : points) {
+        const double e = std::hypot(p.x_px - mx - cx, p.y_px - my - cy) - R;
+        ss += e * e;
+    }
+    CircleFit fit;
+    fit.centre_x_px = cx + mx;
+    fit.centre_y_px = cy + my;
+    fit.radius_px = R;
+    fit.rms_residual_px = std::sqrt(ss / static_cast<double>(n));
+    fit.points = n;
+    return fit;
+}
+
+CircleFit fit_sphere_circle(const Silhouette& silhouette, const CircleFitOptions& options) {
+    check::non_negative("circle max_rms_px", options.max_rms_px);
+    check::non_negative("circle max_rms_fraction", options.max_rms_fraction);
+    if (silhouette.touches_border())
+        throw DataError(
+            concat("the object touches the image border (", silhouette.touches_left ? "left " : "",
+                   silhouette.touches_right ? "right " : "", silhouette.touches_top ? "top " : "",
+                   silhouette.touches_bottom ? "bottom " : "",
+                   "): part of the sphere's outline is missing; frame the whole sphere or give the "
+                   "circle"));
+    if (silhouette.boundary.size() < 8)
+        throw DataError(concat("the silhouette has ", std::to_string(silhouette.boundary.size()),
+                               " edge points, too few for a circle (at least 8)"));
+    const CircleFit fit = fit_circle(silhouette.boundary);
+    const double limit = std::max(options.max_rms_px, options.max_rms_fraction * fit.radius_px);
+    if (fit.rms_residual_px > limit)
+        throw DataError(concat(
+            "the silhouette is not circular: the RMS distance of its edge from "
+            "the best circle is ",
+            format_number(fit.rms_residual_px), " px, above the limit ", format_number(limit),
+            " px (", format_number(fit.rms_residual_px / limit), " times)"));
+    return fit;
+}
+
+// ---------------------------------------------------------------------------------------------
+
+double CylinderAxis::across_x() const {
+    double ux = -direction_y, uy = direction_x;
+    if (ux < -1e-12 || (std::abs(ux) <= 1e-12 && uy > 0)) {
+        ux = -ux;
+        uy = -uy;
+    }
+    (void)uy;
+    return ux;
+}
+
+double CylinderAxis::across_y() const {
+    double ux = -direction_y, uy = direction_x;
+    if (ux < -1e-12 || (std::abs(ux) <= 1e-12 && uy > 0)) uy = -uy;
+    return uy;
+}
+
+double CylinderAxis::across_distance_px(double x_px, double y_px) const {
+    return (x_px - point_x_px) * across_x() + (y_px - point_y_px) * across_y();
+}
+
+CylinderAxis cylinder_axis_from_line(double point_x_px, double point_y_px, double direction_x,
+                                     double direction_y, double radius_px) {
+    check::finite("cylinder axis point x", point_x_px);
+    check::finite("cylinder axis point y", point_y_px);
+    check::positive("cylinder radius", radius_px, " px");
+    const double norm = std::hypot(direction_x, direction_y);
+    if (!(norm > 0) || !std::isfinite(norm))
+        throw InvalidArgument(concat("cylinder axis direction (", format_number(direction_x), ", ",
+                                     format_number(direction_y), ") must be finite and not zero"));
+    CylinderAxis axis;
+    axis.point_x_px = point_x_px;
+    axis.point_y_px = point_y_px;
+    axis.direction_x = direction_x / norm;
+    axis.direction_y = direction_y / norm;
+    axis.radius_px = radius_px;
+    return axis;
+}
+
+CylinderAxis cylinder_axis_from_edges(const EdgePoint& a0, const EdgePoint& a1, const EdgePoint& b0,
+                                      const EdgePoint& b1) {
+    for (const EdgePoint* p : {&a0, &a1, &b0, &b1})
+        if (!std::isfinite(p->x_px) || !std::isfinite(p->y_px))
+            throw InvalidArgument("cylinder edge: a point has a non-finite coordinate");
+    const Eigen::Vector2d pa0(a0.x_px, a0.y_px), pa1(a1.x_px, a1.y_px);
+    const Eigen::Vector2d pb0(b0.x_px, b0.y_px), pb1(b1.x_px, b1.y_px);
+    Eigen::Vector2d da = pa1 - pa0, db = pb1 - pb0;
+    if (!(da.norm() > 0) || !(db.norm() > 0))
+        throw InvalidArgument("cylinder edge: the two points of an edge coincide");
+    da.normalize();
+    db.normalize();
+    if (da.dot(db) < 0) db = -db;
+    const double angle = std::asin(std::min(1.0, std::abs(da.x() * db.y() - da.y() * db.x())));
+    if (angle > deg_to_rad(1.0))
+        throw InvalidArgument(concat("cylinder edges are not parallel: they differ by ",
+                                     format_number(rad_to_deg(angle)),
+                                     " deg, more than the 1 deg allowed"));
+    const Eigen::Vector2d dir = (da + db).normalized();
+    const Eigen::Vector2d u(-dir.y(), dir.x());
+    const double ca = 0.5 * (pa0 + pa1).dot(u), cb = 0.5 * (pb0 + pb1).dot(u);
+    if (!(std::abs(ca - cb) > 0)) throw InvalidArgument("cylinder edges coincide (zero radius)");
+    const Eigen::Vector2d mid = 0.25 * (pa0 + pa1 + pb0 + pb1);
+    return cylinder_axis_from_line(mid.x(), mid.y(), dir.x(), dir.y(), 0.5 * std::abs(ca - cb));
+}
+
+CylinderAxis fit_cylinder_axis(const Silhouette& silhouette, const CylinderAxisOptions& options) {
+    check::positive("cylinder axis outlier_px", options.outlier_px);
+    check::non_negative("cylinder axis max_rms_px", options.max_rms_px);
+    check::non_negative("cylinder axis max_rms_fraction", options.max_rms_fraction);
+    check::positive("cylinder axis max_angle_deg", options.max_angle_deg);
+    const std::vector<EdgePoint>& pts = silhouette.boundary;
+    if (pts.size() < 8)
+        throw DataError(concat("the silhouette has ", std::to_string(pts.size()),
+                               " edge points, too few for a cylinder's two edges"));
+    // Edge orientation: doubled-angle mean of the outward normals.
+    double c2 = 0, s2 = 0;
+    for (const EdgePoint& p : pts) {
+        c2 += p.normal_x * p.normal_x - p.normal_y * p.normal_y;
+        s2 += 2.0 * p.normal_x * p.normal_y;
+    }
+    if (!(std::hypot(c2, s2) > 0.5 * static_cast<double>(pts.size())))
+        throw DataError(
+            "the silhouette is not cylinder-like: its outline has no dominant "
+            "direction (two straight parallel edges)");
+    const double phi_n = 0.5 * std::atan2(s2, c2);  // normal direction
+    Eigen::Vector2d u(std::cos(phi_n), std::sin(phi_n));
+    Eigen::Vector2d a(-u.y(), u.x());
+    const Eigen::Vector2d centroid(silhouette.centroid_x_px, silhouette.centroid_y_px);
+
+    // Per side: line d = α + β t in the (a, u) frame about the centroid; outliers dropped.
+    struct Side {
+        std::vector<Eigen::Vector2d> tv;  // (t, d)
+        double alpha = 0, beta = 0, rms = 0;
+        std::size_t used = 0;
+    };
+    std::array<Side, 2> sides;
+    for (const EdgePoint& p : pts) {
+        const Eigen::Vector2d q = Eigen::Vector2d(p.x_px, p.y_px) - centroid;
+        const double d = q.dot(u);
+        sides[d > 0 ? 1 : 0].tv.emplace_back(q.dot(a), d);
+    }
+    const std::size_t most = std::max(sides[0].tv.size(), sides[1].tv.size());
+    for (std::size_t k = 0; k < 2; ++k)
+        if (sides[k].tv.size() < std::max<std::size_t>(4, most / 4))
+            throw DataError(concat(
+                "the cylinder's ", k == 0 ? "first" : "second", " edge is missing (",
+                std::to_string(sides[k].tv.size()), " edge points against ", std::to_string(most),
+                " on the other side): the object touches the image border along its side or is "
+                "not a cylinder seen side-on; frame both edges or give the axis"));
+    auto fit_side = [&](Side& side) {
+        std::vector<char> keep(side.tv.size(), 1);
+        // First pass: median of d (robust start), then least squares on the inliers twice.
+        std::vector<double> ds;
+        ds.reserve(side.tv.size());
+        for (const auto& v : side.tv) ds.push_back(v.y());
+        std::nth_element(ds.begin(), ds.begin() + static_cast<std::ptrdiff_t>(ds.size() / 2),
+                         ds.end());
+        side.alpha = ds[ds.size() / 2];
+        side.beta = 0;
+        for (int pass = 0; pass < 3; ++pass) {
+            double St = 0, Sd = 0, Stt = 0, Std = 0, N = 0;
+            for (std::size_t i = 0; i < side.tv.size(); ++i) {
+                const double t = side.tv[i].x(), d = side.tv[i].y();
+                keep[i] = std::abs(d - side.alpha - side.beta * t) <= options.outlier_px;
+                if (!keep[i]) continue;
+                St += t;
+                Sd += d;
+                Stt += t * t;
+                Std += t * d;
+                N += 1;
+            }
+            const double det = N * Stt - St * St;
+            if (N < 3 || !(det > 0)) break;
+            side.beta = (N * Std - St * Sd) / det;
+            side.alpha = (Sd - side.beta * St) / N;
+        }
+        double ss = 0;
+        side.used = 0;
+        for (std::size_t i = 0; i < side.tv.size(); ++i) {
+            const double e = side.tv[i].y() - side.alpha - side.beta * side.tv[i].x();
+            if (std::abs(e) > options.outlier_px) continue;
+            ss += e * e;
+            ++side.used;
+        }
+        side.rms = side.used ? std::sqrt(ss / static_cast<double>(side.used)) : 0.0;
+    };
+    fit_side(sides[0]);
+    fit_side(sides[1]);
+    for (std::size_t k = 0; k < 2; ++k)
+        if (sides[k].used < 4)
+            throw DataError(
+                "the silhouette is not cylinder-like: an edge has fewer than 4 points "
+                "on a straight line");
+    const double angle = std::abs(std::atan(sides[1].beta) - std::atan(sides[0].beta));
+    if (angle > deg_to_rad(options.max_angle_deg))
+        throw DataError(
+            concat("the silhouette is not cylinder-like: its edges differ in direction "
+                   "by ",
+                   format_number(rad_to_deg(angle)), " deg, more than the ",
+                   format_number(options.max_angle_deg), " deg allowed"));
+    const double beta = 0.5 * (sides[0].beta + sides[1].beta);
+    const double alpha = 0.5 * (sides[0].alpha + sides[1].alpha);
+    const double cosb = 1.0 / std::sqrt(1.0 + beta * beta);
+    const double radius = 0.5 * (sides[1].alpha - sides[0].alpha) * cosb;
+    const Eigen::Vector2d dir = (a + beta * u).normalized();
+    const Eigen::Vector2d point = centroid + alpha * u;
+    CylinderAxis axis = cylinder_axis_from_line(point.x(), point.y(), dir.x(), dir.y(), radius);
+    axis.detected = true;
+    axis.points = sides[0].used + sides[1].used;
+    const double n0 = static_cast<double>(sides[0].used), n1 = static_cast<double>(sides[1].used);
+    axis.rms_residual_px =
+        std::sqrt((sides[0].rms * sides[0].rms * n0 + sides[1].rms * sides[1].rms * n1) /
+                  (n0 + n1)) *
+        cosb;
+    const double limit = std::max(options.max_rms_px, options.max_rms_fraction * radius);
+    if (axis.rms_residual_px > limit)
+        throw DataError(concat(
+            "the silhouette is not cylinder-like: the RMS distance of its edges "
+            "from two straight lines is ",
+            format_number(axis.rms_residual_px), " px, above the limit ", format_number(limit),
+            " px (", format_number(axis.rms_residual_px / limit), " times)"));
+    // Outliers beyond outlier_px are allowed (a cylinder ending inside the image) but not most.
+    const std::size_t total = sides[0].tv.size() + sides[1].tv.size();
+    if (static_cast<double>(axis.points) < 0.5 * static_cast<double>(total))
+        throw DataError(concat("the silhouette is not cylinder-like: only ",
+                               std::to_string(axis.points), " of ", std::to_string(total),
+                               " edge points lie within ", format_number(options.outlier_px),
+                               " px of two straight lines"));
+    return axis;
+}
+
+}  // namespace roughscope::image

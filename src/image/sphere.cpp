@@ -1,0 +1,203 @@
+#include "roughscope/image/sphere.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "object_profile.hpp"
+#include "roughscope/core/errors.hpp"
+#include "roughscope/core/text.hpp"
+
+namespace roughscope::image {
+namespace {
+
+using check::format_number;
+
+std::string image_name(const LinearImage& image) {
+    return image.info.source.empty() ? std::string("image") : image.info.source;
+}
+
+struct CellSums {
+    double sum = 0, sum2 = 0, diff2 = 0;
+    double nx = 0, ny = 0, nz = 0;
+    std::uint32_t count = 0, diffs = 0;
+};
+
+}  // namespace
+
+void check_sphere_options(const SphereOptions& options) {
+    detail::check_unit_direction("sphere light", options.light);
+    detail::check_unit_direction("sphere view", options.view);
+    if (!(options.limb_fraction > 0.0 && options.limb_fraction <= 1.0))
+        throw InvalidArgument(
+            concat("sphere limb_fraction = ", format_number(options.limb_fraction),
+                   " is outside the valid range (0, 1]"));
+    if (!(options.max_angle_deg > 0.0 && options.max_angle_deg <= 90.0))
+        throw InvalidArgument(
+            concat("sphere max_angle_deg = ", format_number(options.max_angle_deg),
+                   " is outside the valid range (0, 90] deg"));
+    if (options.max_cells < 1) throw InvalidArgument("sphere max_cells must be at least 1");
+    if (!(options.min_cell_fraction >= 0.0 && options.min_cell_fraction <= 1.0))
+        throw InvalidArgument(
+            concat("sphere min_cell_fraction = ", format_number(options.min_cell_fraction),
+                   " is outside the valid range [0, 1]"));
+    if (options.circle) {
+        check::finite("sphere circle centre x", options.circle->centre_x_px);
+        check::finite("sphere circle centre y", options.circle->centre_y_px);
+        check::positive("sphere circle radius", options.circle->radius_px, " px");
+    }
+    validate(options.comparison);
+}
+
+SphereResult measure_sphere(const LinearImage& image, const std::vector<std::uint8_t>* region_mask,
+                            const SphereOptions& options) {
+    check_sphere_options(options);
+    check_linear_image(image);
+    const std::size_t w = image.width, h = image.height;
+    if (region_mask && region_mask->size() != image.pixel_count())
+        throw InvalidArgument(concat("sphere region mask has ", std::to_string(region_mask->size()),
+                                     " entries, the image ", image_name(image), " has ",
+                                     std::to_string(image.pixel_count()), " pixels"));
+    SphereResult out;
+    if (options.circle) {
+        out.circle = *options.circle;
+    } else {
+        out.circle =
+            fit_sphere_circle(find_silhouette(image, options.silhouette), options.circle_fit);
+        out.circle_detected = true;
+    }
+    const double cx = out.circle.centre_x_px, cy = out.circle.centre_y_px;
+    const double R = out.circle.radius_px;
+    const double rho_max = options.limb_fraction;
+    const double disc_px = kPi * (rho_max * R) * (rho_max * R);
+    const std::size_t k =
+        options.cell_px > 0
+            ? options.cell_px
+            : std::max<std::size_t>(1, static_cast<std::size_t>(std::ceil(std::sqrt(
+                                           disc_px / static_cast<double>(options.max_cells)))));
+    out.cell_px = k;
+    const std::size_t gw = (w + k - 1) / k, gh = (h + k - 1) / k;
+    std::vector<CellSums> cells(gw * gh);
+
+    const double cos_max = std::cos(deg_to_rad(options.max_angle_deg));
+    const Eigen::Vector3d L = options.light, V = options.view;
+    const float* p0 = image.plane(0);
+    const float* p1 = image.channels == 3 ? image.plane(1) : nullptr;
+    const float* p2 = image.channels == 3 ? image.plane(2) : nullptr;
+    const std::uint8_t* reg = region_mask ? region_mask->data() : nullptr;
+    const double inv_R = 1.0 / R, rho2_max = rho_max * rho_max;
+    // Rows and columns that can hold the disc.
+    const auto r_lo = static_cast<std::size_t>(std::clamp(std::floor(cy - R), 0.0, double(h)));
+    const auto r_hi = static_cast<std::size_t>(std::clamp(std::ceil(cy + R), 0.0, double(h)));
+    const auto c_lo = static_cast<std::size_t>(std::clamp(std::floor(cx - R), 0.0, double(w)));
+    const auto c_hi = static_cast<std::size_t>(std::clamp(std::ceil(cx + R), 0.0, double(w)));
+    for (std::size_t r = r_lo; r < r_hi; ++r) {
+        const double ny = (cy - (static_cast<double>(r) + 0.5)) * inv_R;
+        CellSums* row_cells = cells.data() + (r / k) * gw;
+        std::int64_t left_cell = -1;
+        float left_value = 0.0F;
+        for (std::size_t c = c_lo; c < c_hi; ++c) {
+            const double nx = (static_cast<double>(c) + 0.5 - cx) * inv_R;
+            const double rho2 = nx * nx + ny * ny;
+            const std::size_t i = r * w + c;
+            std::int64_t cell = -1;
+            if (rho2 <= rho2_max && (!reg || reg[i])) {
+                const double nz = std::sqrt(1.0 - rho2);
+                const double nl = nx * L.x() + ny * L.y() + nz * L.z();
+                const double nv = nx * V.x() + ny * V.y() + nz * V.z();
+                if (nl > cos_max && nv > cos_max) {
+                    if (image.flags[i] != 0) {
+                        ++out.pixels_flagged;
+                    } else {
+                        float v = p0[i];
+                        if (p1) v = (v + p1[i] + p2[i]) * (1.0F / 3.0F);
+                        const double vd = v;
+                        cell = static_cast<std::int64_t>(c / k);
+                        CellSums& cs = row_cells[c / k];
+                        cs.sum += vd;
+                        cs.sum2 += vd * vd;
+                        cs.nx += nx;
+                        cs.ny += ny;
+                        cs.nz += nz;
+                        ++cs.count;
+                        if (left_cell == cell) {
+                            const double diff = vd - left_value;
+                            cs.diff2 += diff * diff;
+                            ++cs.diffs;
+                        }
+                        left_value = v;
+                        ++out.pixels_used;
+                    }
+                }
+            }
+            left_cell = cell;
+        }
+    }
+    if (out.pixels_flagged)
+        out.warnings.push_back(concat(std::to_string(out.pixels_flagged),
+                                      " flagged pixel(s) (saturated, clipped) left out"));
+
+    // Cells → BRDF measurements.
+    struct Row {
+        Geometry g;
+        double f = 0, se = 0;
+    };
+    std::vector<Row> rows;
+    const double min_count = options.min_cell_fraction * static_cast<double>(k * k);
+    std::size_t dropped = 0;
+    for (const CellSums& cs : cells) {
+        if (cs.count == 0) continue;
+        const auto n = static_cast<double>(cs.count);
+        if (n < min_count) {
+            ++dropped;
+            continue;
+        }
+        const Eigen::Vector3d normal = Eigen::Vector3d(cs.nx, cs.ny, cs.nz).normalized();
+        const auto g = geometry_from_vectors(normal, L, V);
+        if (!g || g->theta_i_rad >= kPi / 2 || g->theta_s_rad >= kPi / 2) {
+            ++dropped;
+            continue;
+        }
+        const double mean = cs.sum / n;
+        const double var =
+            cs.count > 1 ? std::max(0.0, (cs.sum2 - n * mean * mean) / (n - 1.0)) : 0.0;
+        const double noise_var =
+            cs.diffs >= 2 ? cs.diff2 / (2.0 * static_cast<double>(cs.diffs)) : var;
+        const double cos_i = std::cos(g->theta_i_rad);
+        rows.push_back(Row{*g, mean / cos_i, std::sqrt(noise_var / n) / cos_i});
+    }
+    if (dropped)
+        out.warnings.push_back(
+            concat(std::to_string(dropped), " cell(s) with too few usable pixels left out"));
+    if (rows.size() < 3)
+        throw DataError(concat(image_name(image), ": the sphere has ", std::to_string(rows.size()),
+                               " usable cell(s); at least 3 are needed"));
+    // Weights 1/σ_f², scaled to a mean of 1 (all 1 when no cell has a noise estimate).
+    double mean_inv = 0;
+    std::size_t with_noise = 0;
+    for (const Row& rw : rows)
+        if (rw.se > 0) {
+            mean_inv += 1.0 / (rw.se * rw.se);
+            ++with_noise;
+        }
+    const bool weighted = with_noise == rows.size();
+    if (weighted) mean_inv /= static_cast<double>(rows.size());
+    out.table.name = image.info.source.empty() ? std::string("sphere") : image.info.source;
+    out.table.channel = image.channels == 3 ? "mean" : "grey";
+    out.table.measurements.reserve(rows.size());
+    int index = 0;
+    for (const Row& rw : rows) {
+        const double weight = weighted ? 1.0 / (rw.se * rw.se) / mean_inv : 1.0;
+        out.table.measurements.push_back(make_brdf_measurement(
+            ++index, rw.g.theta_i_rad, kPi, rw.g.theta_s_rad, rw.g.phi_s_rad, rw.f, weight));
+    }
+    if (!weighted)
+        out.warnings.push_back("no pixel-noise estimate in some cells: all cells weighted 1");
+    out.comparison = compare_brdf(out.table, options.comparison);
+    return out;
+}
+
+}  // namespace roughscope::image

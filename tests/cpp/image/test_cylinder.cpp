@@ -1,0 +1,300 @@
+// Brightness profiles across rough cylinders (image/cylinder.hpp, paper §5.2, Fig. 8) against
+// synthetic captures of known σ/T (simulation/capture.hpp) and the retro-reflection closed forms
+// (scattering/retro.hpp, Eq. 7, 9, 10).
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "object_captures.hpp"
+#include "roughscope/core/errors.hpp"
+#include "roughscope/image/cylinder.hpp"
+#include "roughscope/scattering/retro.hpp"
+#include "roughscope/scattering/validity.hpp"
+#include "roughscope/simulation/capture.hpp"
+
+namespace {
+
+using namespace roughscope;
+using namespace roughscope::image;
+using roughscope::testing::camera_for;
+using roughscope::testing::linear_from_capture;
+using roughscope::testing::linear_from_radiance;
+using roughscope::testing::very_rough_truth;
+namespace sim = roughscope::simulation;
+
+constexpr std::size_t kSize = 160;  // R = 64 px
+
+sim::Scene cylinder_scene(const Eigen::Vector3d& light) {
+    sim::Scene scene;
+    scene.shape = sim::SceneShape::Cylinder;
+    scene.width = kSize;
+    scene.height = kSize;
+    scene.pixel_size_um = 1.0;
+    scene.light = light;
+    return scene;
+}
+
+// The true axis of cylinder_scene: vertical through the image centre, R = 0.4 · 160.
+CylinderAxis true_axis() { return cylinder_axis_from_line(80.0, 80.0, 0.0, 1.0, 64.0); }
+
+sim::Capture render(const sim::Scene& scene, const sim::SurfaceTruth& truth,
+                    const sim::CameraModel& camera, bool geometry = false) {
+    sim::CaptureOptions co;
+    co.keep_geometry = geometry;
+    co.threads = 1;
+    return sim::render_capture(scene, {truth}, {}, camera, co);
+}
+
+// A noisy capture whose brightest pixel fills 60 % of the full well.
+LinearImage noisy_capture(const sim::Scene& scene, const sim::SurfaceTruth& truth, int bits,
+                          std::uint64_t seed) {
+    const double e_max =
+        roughscope::testing::max_radiance(render(scene, truth, camera_for(bits, 1, 0.5, 1)));
+    const sim::CameraModel camera = camera_for(bits, e_max, 0.6, seed);
+    return linear_from_capture(render(scene, truth, camera), camera);
+}
+
+TEST(CylinderProfile, BinIncidenceAnglesMatchTheRenderersPerPixelAngles) {
+    for (const double light_deg : {0.0, 30.0}) {
+        const Eigen::Vector3d L = sim::direction_from_angles(deg_to_rad(light_deg), kPi);
+        const sim::Scene scene = cylinder_scene(L);
+        const sim::SurfaceTruth truth = very_rough_truth(1.0, Correlation::Gaussian);
+        const sim::Capture cap = render(scene, truth, camera_for(14, 1, 0.5, 1, false), true);
+        CylinderOptions o;
+        o.light = L;
+        o.axis = true_axis();
+        const CylinderProfile p = measure_cylinder_profile(linear_from_radiance(cap), nullptr, o);
+        ASSERT_GE(p.bins.size(), 20U);
+        // Per bin: the renderer's own θi averaged over the pixels whose normal angle α about the
+        // axis (from the renderer's normal) falls in the bin.
+        for (const ProfileBin& b : p.bins) {
+            const double lo = std::floor(b.alpha_rad / p.bin_width_rad) * p.bin_width_rad;
+            double sum = 0;
+            std::size_t n = 0;
+            for (std::size_t i = 0; i < cap.normal.size() / 3; ++i) {
+                const double nx = cap.normal[3 * i];
+                if (std::isnan(nx) || std::isnan(cap.theta_i_rad[i])) continue;
+                const double alpha = std::asin(std::clamp(nx, -1.0, 1.0));
+                if (alpha < lo || alpha >= lo + p.bin_width_rad) continue;
+                sum += cap.theta_i_rad[i];
+                ++n;
+            }
+            ASSERT_GT(n, 0U);
+            EXPECT_NEAR(b.theta_i_rad, sum / static_cast<double>(n), 0.1 * p.bin_width_rad)
+                << "light " << light_deg << " deg, bin at " << rad_to_deg(b.alpha_rad) << " deg";
+            if (light_deg == 0.0) {  // L = V: retro geometry
+                EXPECT_NEAR(b.geometry.theta_s_rad, b.theta_i_rad, 1e-9);
+                EXPECT_NEAR(b.geometry.phi_s_rad, kPi, 1e-6);
+            }
+        }
+    }
+}
+
+TEST(CylinderProfile, NoiseFreeVhGaussianCaptureEqualsEq9) {
+    for (const double s : {0.3, 0.6, 1.0}) {
+        const sim::Scene scene = cylinder_scene(Eigen::Vector3d(0, 0, 1));
+        const sim::Capture cap =
+            render(scene, very_rough_truth(s, Correlation::Gaussian), camera_for(14, 1, 0.5, 1));
+        CylinderOptions o;
+        o.axis = true_axis();
+        o.sigma_over_T = s;
+        const CylinderProfile p = measure_cylinder_profile(linear_from_radiance(cap), nullptr, o);
+        const ProfileModelCurve& vh = p.curve(ProfileModel::VhGaussian);
+        double worst = 0;
+        for (std::size_t b = 0; b < p.bins.size(); ++b)
+            worst = std::max(worst, std::abs(vh.prediction[b] - p.bins[b].brightness));
+        EXPECT_LT(worst, 1e-3) << "sigma/T " << s;
+        EXPECT_FALSE(vh.departure_bin.has_value());
+        // The fit recovers σ/T (no noise: the model is exact).
+        ASSERT_TRUE(p.gaussian_fit.sigma_over_T.has_value());
+        EXPECT_NEAR(*p.gaussian_fit.sigma_over_T / s, 1.0, 1e-4);
+        EXPECT_NEAR(*p.theta_K_rad, caron_theta_K_rad(s), 1e-12);
+    }
+}
+
+TEST(CylinderProfile, GeneralFormsAtRetroGeometryAreEq7Eq9Eq10) {
+    for (const double s : {0.2, 0.5, 1.3}) {
+        double r7 = 0, r9 = 0, r10 = 0;
+        for (int k = 0; k <= 85; k += 5) {
+            const Geometry g = retro_geometry(deg_to_rad(k));
+            if (retro_beckmann_gaussian_very_rough(g.theta_i_rad, s) < 1e-250) continue;
+            const double a7 = profile_model_brightness(ProfileModel::BkGaussian, g, s) /
+                              retro_beckmann_gaussian_very_rough(g.theta_i_rad, s);
+            const double a9 = profile_model_brightness(ProfileModel::VhGaussian, g, s) /
+                              retro_vh_gaussian_very_rough(g.theta_i_rad, s);
+            const double a10 = profile_model_brightness(ProfileModel::VhExponential, g, s) /
+                               retro_vh_exponential_very_rough(g.theta_i_rad, s);
+            if (k == 0) {
+                r7 = a7;
+                r9 = a9;
+                r10 = a10;
+            }
+            EXPECT_NEAR(a7 / r7, 1.0, 1e-12) << k;
+            EXPECT_NEAR(a9 / r9, 1.0, 1e-12) << k;
+            EXPECT_NEAR(a10 / r10, 1.0, 1e-12) << k;
+        }
+        EXPECT_NEAR(profile_model_brightness(ProfileModel::Lambert, retro_geometry(0.7), s),
+                    std::cos(0.7), 1e-15);
+    }
+}
+
+TEST(CylinderProfile, FittedSigmaOverTCoverage) {
+    struct Case {
+        double s;
+        Correlation c;
+        int bits;
+    };
+    std::vector<Case> cases;
+    const double sigmas[] = {0.4, 0.7, 1.2};
+    const int bits[] = {8, 12, 14, 16};
+    for (const double s : sigmas)
+        for (const Correlation c : {Correlation::Gaussian, Correlation::Exponential})
+            for (const int b : bits) cases.push_back({s, c, b});
+    const sim::Scene scene = cylinder_scene(Eigen::Vector3d(0, 0, 1));
+    int inside = 0, total = 0;
+    std::uint64_t seed = 100;
+    for (const Case& c : cases)
+        for (int rep = 0; rep < 2; ++rep) {
+            const LinearImage img =
+                noisy_capture(scene, very_rough_truth(c.s, c.c), c.bits, seed++);
+            CylinderOptions o;
+            o.axis = true_axis();
+            const CylinderProfile p = measure_cylinder_profile(img, nullptr, o);
+            const ProfileFit& f = c.c == Correlation::Gaussian ? p.gaussian_fit : p.exponential_fit;
+            ASSERT_TRUE(f.sigma_over_T.has_value()) << f.message;
+            ASSERT_GT(f.sigma_over_T_stderr, 0.0);
+            ++total;
+            const bool ok = std::abs(*f.sigma_over_T - c.s) <= 2.0 * f.sigma_over_T_stderr;
+            inside += ok;
+            if (!ok)
+                std::printf("  outside: sigma/T %.2f %s %d bit: %.5f +/- %.5f\n", c.s,
+                            c.c == Correlation::Gaussian ? "gaussian" : "exponential", c.bits,
+                            *f.sigma_over_T, f.sigma_over_T_stderr);
+        }
+    const double fraction = static_cast<double>(inside) / total;
+    std::printf("cylinder coverage: %d of %d trials (%.1f %%) within the reported 2 sigma\n",
+                inside, total, 100.0 * fraction);
+    EXPECT_GE(total, 40);
+    EXPECT_GE(fraction, 0.9);
+}
+
+TEST(CylinderProfile, DepartureAngleOfADataSetThatLeavesEq9At46Degrees) {
+    const double s = 0.8, edge = deg_to_rad(46.0);
+    sim::SurfaceTruth truth;
+    truth.model = sim::BrightnessModel::Tabulated;
+    truth.tabulated = [&](const Geometry& g) {
+        const double e = very_rough_brightness(g, s, Correlation::Gaussian);
+        return g.theta_i_rad < edge ? e : 0.7 * e;
+    };
+    const sim::Scene scene = cylinder_scene(Eigen::Vector3d(0, 0, 1));
+    for (std::uint64_t seed = 1; seed <= 3; ++seed) {
+        const LinearImage img = noisy_capture(scene, truth, 14, seed);
+        for (const bool given : {true, false}) {
+            CylinderOptions o;
+            o.axis = true_axis();
+            if (given)
+                o.sigma_over_T = s;
+            else
+                o.fit_max_theta_i_deg = 40.0;  // fit where the data follow Eq. 9
+            const CylinderProfile p = measure_cylinder_profile(img, nullptr, o);
+            const ProfileModelCurve& vh = p.curve(ProfileModel::VhGaussian);
+            ASSERT_TRUE(vh.departure_theta_i_rad.has_value());
+            EXPECT_NEAR(*vh.departure_theta_i_rad, edge, p.bin_width_rad)
+                << "departure at " << rad_to_deg(*vh.departure_theta_i_rad) << " deg";
+            ASSERT_TRUE(p.theta_K_rad.has_value());
+            EXPECT_NEAR(*p.theta_K_rad, caron_theta_K_rad(*vh.sigma_over_T), 1e-12);
+            // Lambert leaves these data far earlier (the V–H lobe is not cos θi).
+            const ProfileModelCurve& lam = p.curve(ProfileModel::Lambert);
+            ASSERT_TRUE(lam.departure_theta_i_rad.has_value());
+            EXPECT_LT(*lam.departure_theta_i_rad, edge - 3 * p.bin_width_rad);
+        }
+    }
+}
+
+TEST(CylinderProfile, DetectedAxisOnALambertCylinderGivesCosine) {
+    sim::SurfaceTruth lambert;
+    lambert.model = sim::BrightnessModel::Lambert;
+    const LinearImage img = noisy_capture(cylinder_scene(Eigen::Vector3d(0, 0, 1)), lambert, 14, 9);
+    const CylinderProfile p = measure_cylinder_profile(img, nullptr, CylinderOptions{});
+    EXPECT_TRUE(p.axis.detected);
+    EXPECT_NEAR(p.axis.radius_px, 64.0, 0.2);
+    const ProfileModelCurve& lam = p.curve(ProfileModel::Lambert);
+    EXPECT_LT(lam.rms_difference, 5e-3);
+    EXPECT_FALSE(lam.departure_bin.has_value());
+    // The left half and both halves see the same cosine.
+    CylinderOptions left;
+    left.half = CylinderHalf::Left;
+    EXPECT_LT(
+        measure_cylinder_profile(img, nullptr, left).curve(ProfileModel::Lambert).rms_difference,
+        5e-3);
+    CylinderOptions both;
+    both.half = CylinderHalf::Both;
+    const CylinderProfile pb = measure_cylinder_profile(img, nullptr, both);
+    EXPECT_GT(pb.bins.size(), p.bins.size() + 10);
+    // A region mask keeps only its rows.
+    std::vector<std::uint8_t> mask(img.pixel_count(), 0);
+    for (std::size_t i = 0; i < 40 * kSize; ++i) mask[i] = 1;
+    const CylinderProfile pm = measure_cylinder_profile(img, &mask, CylinderOptions{});
+    EXPECT_LT(pm.pixels_used, p.pixels_used / 3);
+}
+
+TEST(CylinderProfile, BadInputIsAnError) {
+    sim::SurfaceTruth lambert;
+    lambert.model = sim::BrightnessModel::Lambert;
+    const LinearImage img = noisy_capture(cylinder_scene(Eigen::Vector3d(0, 0, 1)), lambert, 12, 2);
+    auto with = [](auto change) {
+        CylinderOptions o;
+        change(o);
+        return o;
+    };
+    EXPECT_THROW(measure_cylinder_profile(img, nullptr, with([](CylinderOptions& o) {
+                                              o.light = {0, 1, 0};
+                                          })),
+                 InvalidArgument);  // light on the horizon
+    EXPECT_THROW(measure_cylinder_profile(img, nullptr, with([](CylinderOptions& o) {
+                                              o.light = {0, 0, -1};
+                                          })),
+                 InvalidArgument);  // light below it
+    EXPECT_THROW(measure_cylinder_profile(img, nullptr, with([](CylinderOptions& o) {
+                                              o.view = {0, 0, 2};
+                                          })),
+                 InvalidArgument);  // not a unit vector
+    EXPECT_THROW(measure_cylinder_profile(img, nullptr,
+                                          with([](CylinderOptions& o) { o.bin_width_deg = 0.0; })),
+                 InvalidArgument);
+    EXPECT_THROW(measure_cylinder_profile(img, nullptr,
+                                          with([](CylinderOptions& o) { o.bin_width_deg = 50.0; })),
+                 InvalidArgument);
+    EXPECT_THROW(measure_cylinder_profile(img, nullptr,
+                                          with([](CylinderOptions& o) { o.limb_fraction = 0.0; })),
+                 InvalidArgument);
+    EXPECT_THROW(measure_cylinder_profile(img, nullptr,
+                                          with([](CylinderOptions& o) { o.sigma_over_T = -1.0; })),
+                 InvalidArgument);
+    EXPECT_THROW(measure_cylinder_profile(
+                     img, nullptr, with([](CylinderOptions& o) { o.fit_max_theta_i_deg = 90; })),
+                 InvalidArgument);
+    EXPECT_THROW(measure_cylinder_profile(img, nullptr,
+                                          with([](CylinderOptions& o) { o.departure_bins = 0; })),
+                 InvalidArgument);
+    EXPECT_THROW(measure_cylinder_profile(img, nullptr, with([](CylinderOptions& o) {
+                                              o.min_pixels_per_bin = 1000000;
+                                          })),
+                 DataError);  // no bin keeps enough pixels
+    const std::vector<std::uint8_t> short_mask(10, 1);
+    EXPECT_THROW(measure_cylinder_profile(img, &short_mask, {}), InvalidArgument);
+    LinearImage dark = img;
+    std::fill(dark.values.begin(), dark.values.end(), 0.0F);
+    EXPECT_THROW(measure_cylinder_profile(dark, nullptr, {}), DataError);  // no object
+    EXPECT_THROW(parse_cylinder_half("middle"), InvalidArgument);
+    EXPECT_THROW(parse_profile_model("phong"), InvalidArgument);
+    EXPECT_EQ(parse_profile_model("vh_exponential"), ProfileModel::VhExponential);
+}
+
+}  // namespace

@@ -1,0 +1,507 @@
+// Roughness maps (image/maps.hpp) against synthetic captures of known roughness
+// (simulation::render_capture) and against the scalar estimators of estimation.hpp.
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <numeric>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "map_captures.hpp"
+#include "roughscope/core/errors.hpp"
+#include "roughscope/estimation/estimation.hpp"
+#include "roughscope/image/maps.hpp"
+
+namespace roughscope::image {
+namespace {
+
+using roughscope::testing::LitPair;
+using roughscope::testing::render_lit_pair;
+using roughscope::testing::very_rough_truth;
+namespace sim = roughscope::simulation;
+
+const double kTheta1 = deg_to_rad(30.0);
+const double kTheta2 = deg_to_rad(45.0);
+
+std::vector<MapCapture> flat_captures(const LitPair& p) {
+    std::vector<MapCapture> c(2);
+    c[0].image = &p.a;
+    c[0].name = "lit at 30°";
+    c[0].geometry = normal_view_geometry(kTheta1);
+    c[1].image = &p.b;
+    c[1].name = "lit at 45°";
+    c[1].geometry = normal_view_geometry(kTheta2);
+    return c;
+}
+
+sim::Scene plane(std::size_t w, std::size_t h) {
+    sim::Scene s;
+    s.width = w;
+    s.height = h;
+    return s;
+}
+
+// Three vertical strips of 128 px: σ/T = 0.1 (slightly), 1 (moderately), 5 (very rough).
+constexpr std::array<double, 3> kStripTruth{0.1, 1.0, 5.0};
+std::vector<std::int32_t> strip_labels(std::size_t w, std::size_t h, std::ptrdiff_t shift = 0) {
+    std::vector<std::int32_t> labels(w * h);
+    for (std::size_t r = 0; r < h; ++r)
+        for (std::size_t x = 0; x < w; ++x) {
+            const auto xs = std::clamp<std::ptrdiff_t>(static_cast<std::ptrdiff_t>(x) - shift, 0,
+                                                       static_cast<std::ptrdiff_t>(w) - 1);
+            labels[r * w + x] = static_cast<std::int32_t>(static_cast<std::size_t>(xs) / 128);
+        }
+    return labels;
+}
+std::vector<sim::SurfaceTruth> strip_truths() {
+    return {very_rough_truth(kStripTruth[0]), very_rough_truth(kStripTruth[1]),
+            very_rough_truth(kStripTruth[2])};
+}
+
+TEST(RoughnessMap, ThreeRegionsOneClassEach) {
+    const std::size_t W = 384, H = 192;
+    const auto labels = strip_labels(W, H);
+    const LitPair p =
+        render_lit_pair(plane(W, H), strip_truths(), labels, labels, kTheta1, kTheta2, 11);
+    MapOptions o;
+    o.window_px = 16;
+    o.region_labels = labels;
+    o.region_names = {"slight", "moderate", "very"};
+    const RoughnessMap map = roughness_map(flat_captures(p), o);
+    ASSERT_EQ(map.width, 24u);
+    ASSERT_EQ(map.height, 12u);
+    ASSERT_TRUE(map.registration.has_value());
+    EXPECT_LT(map.registration->magnitude_px, 0.5);
+    // Tiles farther than one window from a region border (strip columns 1..6 of each 8).
+    for (std::size_t k = 0; k < 3; ++k) {
+        std::size_t right = 0, total = 0;
+        for (std::size_t ty = 0; ty < map.height; ++ty)
+            for (std::size_t tx = 8 * k + 1; tx < 8 * k + 7; ++tx) {
+                if (k == 0 && tx == 1) continue;  // no border on the image side: keep symmetric
+                ++total;
+                if (map.roughness_class[ty * map.width + tx] == k) ++right;
+            }
+        const double fraction = static_cast<double>(right) / static_cast<double>(total);
+        std::printf("region %zu (σ/T = %g): %zu/%zu tiles in the right class (%.1f %%)\n", k,
+                    kStripTruth[k], right, total, 100.0 * fraction);
+        EXPECT_GE(fraction, 0.95) << "region " << k;
+        const RegionMapStatistics& s = map.regions[k];
+        ASSERT_TRUE(s.mean_sigma_over_T_gaussian.has_value());
+        const Estimate m = *s.mean_sigma_over_T_gaussian;
+        std::printf("region %s: mean σ/T = %.5f ± %.5f (truth %g, %zu tiles, z = %.2f)\n",
+                    s.name.c_str(), m.value, m.std_error, kStripTruth[k], s.count,
+                    (m.value - kStripTruth[k]) / m.std_error);
+        EXPECT_LT(std::abs(m.value - kStripTruth[k]), 2.0 * m.std_error) << s.name;
+        EXPECT_EQ(s.class_counts[k],
+                  *std::max_element(s.class_counts.begin(), s.class_counts.end()));
+    }
+    // Summaries never hold a NaN.
+    for (const auto& c : map.classes) {
+        EXPECT_TRUE(std::isfinite(c.fraction));
+        if (c.mean_sigma_over_T) {
+            EXPECT_TRUE(std::isfinite(c.mean_sigma_over_T->std_error));
+        }
+    }
+    EXPECT_EQ(map.valid + map.missing + map.no_solution, map.width * map.height);
+}
+
+// Tile means computed here, pixel by pixel, and the scalar estimator on them.
+TEST(RoughnessMap, NoiseFreeTilesEqualTheScalarEstimator) {
+    const std::size_t W = 96, H = 64;
+    std::vector<std::int32_t> halves(W * H);
+    for (std::size_t i = 0; i < W * H; ++i) halves[i] = (i % W) < W / 2 ? 0 : 1;
+    const std::vector<sim::SurfaceTruth> truths{very_rough_truth(0.4), very_rough_truth(2.0)};
+    const LitPair p = render_lit_pair(plane(W, H), truths, halves, halves, kTheta1, kTheta2, 3,
+                                      /*noise=*/false);
+    for (const std::size_t window : {std::size_t{1}, std::size_t{8}}) {
+        MapOptions o;
+        o.window_px = window;
+        o.check_registration = false;
+        const RoughnessMap map = roughness_map(flat_captures(p), o);
+        double worst = 0.0;
+        for (const std::size_t ty : {std::size_t{0}, map.height / 2, map.height - 1})
+            for (const std::size_t tx : {std::size_t{0}, map.width / 3, map.width - 1}) {
+                double s1 = 0, s2 = 0;
+                for (std::size_t r = ty * window; r < std::min(H, (ty + 1) * window); ++r)
+                    for (std::size_t x = tx * window; x < std::min(W, (tx + 1) * window); ++x) {
+                        s1 += p.a.values[r * W + x];
+                        s2 += p.b.values[r * W + x];
+                    }
+                for (const Correlation c : {Correlation::Gaussian, Correlation::Exponential}) {
+                    SlopeInput in;
+                    in.E1_over_E2 = s1 / s2;
+                    in.geom1 = normal_view_geometry(kTheta1);
+                    in.geom2 = normal_view_geometry(kTheta2);
+                    in.correlation = c;
+                    const double expected = estimate_slope(in).sigma_over_T->value;
+                    const float got = (c == Correlation::Gaussian
+                                           ? map.sigma_over_T_gaussian
+                                           : map.sigma_over_T_exponential)[ty * map.width + tx];
+                    worst = std::max(worst, std::abs(got - expected) / expected);
+                }
+            }
+        std::printf("window %zu: largest relative difference from estimate_slope %.2e\n", window,
+                    worst);
+        EXPECT_LT(worst, 1e-6);  // float layers: 6e-8 rounding
+    }
+}
+
+// The table against Eq. 17 / 19 over σ/T in [0.01, 100] (ratios from Eq. 16 / 18 via the
+// solver-free closed forms), and against the two-geometry solver for an oblique view.
+TEST(RatioInverseTable, MatchesTheClosedFormsAndTheSolver) {
+    const Geometry g1 = normal_view_geometry(kTheta1), g2 = normal_view_geometry(kTheta2);
+    for (const Correlation c : {Correlation::Gaussian, Correlation::Exponential}) {
+        const RatioInverseTable table = RatioInverseTable::sigma_over_T(g1, g2, c);
+        double worst = 0.0, worst_derivative = 0.0;
+        for (int k = 0; k <= 4000; ++k) {
+            const double s = std::pow(10.0, -2.0 + 4.0 * k / 4000.0);
+            // The model's ratio at s (Eq. 16 / 18) from the very-rough brightness itself.
+            const double ratio = model_ratio_very_rough(g1, g2, s, c);
+            if (!(ratio > 0.0) || !std::isfinite(ratio)) continue;
+            SlopeInput in;
+            in.E1_over_E2 = ratio;
+            in.geom1 = g1;
+            in.geom2 = g2;
+            in.correlation = c;
+            in.noise = {0.01, 0.0};
+            const RoughnessEstimate e = estimate_slope(in);
+            const auto v = table.lookup(std::log(ratio));
+            ASSERT_TRUE(v.has_value()) << s;
+            worst = std::max(worst, std::abs(v->x - e.sigma_over_T->value) / e.sigma_over_T->value);
+            // sd from the table's slope equals estimation's analytic propagation.
+            const double sd = std::abs(v->dx_dlog_ratio) * 0.01;
+            worst_derivative = std::max(worst_derivative, std::abs(sd - e.sigma_over_T->std_error) /
+                                                              e.sigma_over_T->std_error);
+        }
+        std::printf("%s: table vs Eq. 17/19: largest relative error %.2e (slope %.2e)\n",
+                    std::string(to_string(c)).c_str(), worst, worst_derivative);
+        EXPECT_LT(worst, 1e-6);
+        EXPECT_LT(worst_derivative, 1e-5);
+        // Outside the model's range: no value.
+        const RatioRange range = table.ratio_range();
+        EXPECT_FALSE(table.lookup(std::log(range.lower) - 0.1).has_value());
+        EXPECT_FALSE(table.lookup(std::nan("")).has_value());
+    }
+    // Oblique view: the table of the model ratio against the solver.
+    const Geometry o1 = make_geometry(kTheta1, deg_to_rad(20.0), 0.3);
+    const Geometry o2 = make_geometry(kTheta2, deg_to_rad(20.0), 0.3);
+    for (const Correlation c : {Correlation::Gaussian, Correlation::Exponential}) {
+        const RatioInverseTable table = RatioInverseTable::sigma_over_T(o1, o2, c);
+        double worst = 0.0;
+        for (int k = 0; k <= 200; ++k) {
+            const double s = std::pow(10.0, -1.0 + 2.5 * k / 200.0);
+            const double ratio = model_ratio_very_rough(o1, o2, s, c);
+            const double solved = sigma_over_T_two_geometries(ratio, o1, o2, c);
+            const auto v = table.lookup(std::log(ratio));
+            ASSERT_TRUE(v.has_value());
+            worst = std::max(worst, std::abs(v->x - solved) / solved);
+        }
+        std::printf("%s oblique: table vs solver %.2e\n", std::string(to_string(c)).c_str(), worst);
+        EXPECT_LT(worst, 1e-6);
+    }
+}
+
+TEST(RatioInverseTable, BadInput) {
+    const Geometry g = normal_view_geometry(kTheta1);
+    EXPECT_THROW(RatioInverseTable::sigma_over_T(g, g, Correlation::Gaussian), InvalidArgument);
+    RatioInverseTableOptions t;
+    t.nodes = 2;
+    EXPECT_THROW(RatioInverseTable::sigma_over_T(g, normal_view_geometry(kTheta2),
+                                                 Correlation::Gaussian, {}, t),
+                 InvalidArgument);
+    t = {};
+    t.lower = 2.0;
+    t.upper = 1.0;
+    EXPECT_THROW(RatioInverseTable::sigma_over_T(g, normal_view_geometry(kTheta2),
+                                                 Correlation::Gaussian, {}, t),
+                 InvalidArgument);
+}
+
+// z = (estimate − truth)/stderr over many tiles (and pixels) of a uniform sample, for each
+// correlation (a surface of that correlation).
+TEST(RoughnessMap, UncertaintyIsCalibrated) {
+    const std::size_t W = 256, H = 256;
+    const double truth = 1.0;
+    for (const Correlation c : {Correlation::Gaussian, Correlation::Exponential}) {
+        const LitPair p = render_lit_pair(plane(W, H), {very_rough_truth(truth, c)}, {}, {},
+                                          kTheta1, kTheta2, 21);
+        for (const std::size_t window : {std::size_t{1}, std::size_t{8}}) {
+            MapOptions o;
+            o.window_px = window;
+            const RoughnessMap map = roughness_map(flat_captures(p), o);
+            const auto& v = c == Correlation::Gaussian ? map.sigma_over_T_gaussian
+                                                       : map.sigma_over_T_exponential;
+            const auto& se = c == Correlation::Gaussian ? map.sigma_over_T_gaussian_stderr
+                                                        : map.sigma_over_T_exponential_stderr;
+            double sum = 0, sum2 = 0;
+            std::size_t n = 0;
+            for (std::size_t i = 0; i < v.size(); ++i) {
+                if (!std::isfinite(v[i])) continue;
+                const double z = (v[i] - truth) / se[i];
+                sum += z;
+                sum2 += z * z;
+                ++n;
+            }
+            const double mean = sum / n, sd = std::sqrt(sum2 / n - mean * mean);
+            std::printf("window %zu %s: %zu z-scores, mean %.3f, sd %.3f\n", window,
+                        std::string(to_string(c)).c_str(), n, mean, sd);
+            EXPECT_GT(n, v.size() * 9 / 10);
+            EXPECT_GE(sd, 0.8);
+            EXPECT_LE(sd, 1.25);
+            EXPECT_LT(std::abs(mean), 0.2);
+        }
+    }
+}
+
+TEST(RoughnessMap, MisregisteredPairIsRefusedUnlessAllowed) {
+    const std::size_t W = 384, H = 128;
+    const auto labels1 = strip_labels(W, H);
+    const auto labels2 = strip_labels(W, H, 5);  // the second capture moved 5 px right
+    const LitPair p =
+        render_lit_pair(plane(W, H), strip_truths(), labels1, labels2, kTheta1, kTheta2, 31);
+    MapOptions o;
+    o.window_px = 16;
+    try {
+        (void)roughness_map(flat_captures(p), o);
+        ADD_FAILURE() << "a 5 px shift was accepted";
+    } catch (const DataError& e) {
+        const std::string m = e.what();
+        std::printf("%s\n", m.c_str());
+        EXPECT_NE(m.find("max_shift_px is 1 px"), std::string::npos) << m;
+        EXPECT_NE(m.find("shifted by (5"), std::string::npos) << m;
+    }
+    o.allow_misregistration = true;
+    const RoughnessMap map = roughness_map(flat_captures(p), o);
+    ASSERT_TRUE(map.registration.has_value());
+    EXPECT_NEAR(map.registration->shift_x_px, 5.0, 0.3);
+    EXPECT_NEAR(map.registration->shift_y_px, 0.0, 0.3);
+    EXPECT_FALSE(map.warnings.empty());
+    // The same pair unshifted passes.
+    const LitPair q =
+        render_lit_pair(plane(W, H), strip_truths(), labels1, labels1, kTheta1, kTheta2, 31);
+    o.allow_misregistration = false;
+    EXPECT_NO_THROW((void)roughness_map(flat_captures(q), o));
+}
+
+// T given σ: a very rough surface (T = σ/(σ/T)) and a slightly rough one (Eq. 15 through the
+// table of the slightly-rough diffuse term), each with its class by g.
+TEST(RoughnessMap, CorrelationLengthGivenSigma) {
+    const std::size_t W = 64, H = 64;
+    {
+        sim::SurfaceTruth t = very_rough_truth(1.0);
+        t.sigma_um = 3.0;
+        t.T_um = 3.0;
+        const LitPair p = render_lit_pair(plane(W, H), {t}, {}, {}, kTheta1, kTheta2, 41);
+        MapOptions o;
+        o.sigma_um = 3.0;
+        o.sigma_um_stderr = 0.03;
+        const RoughnessMap map = roughness_map(flat_captures(p), o);
+        ASSERT_EQ(map.T_um.size(), map.width * map.height);
+        std::vector<float> T;
+        for (std::size_t i = 0; i < map.T_um.size(); ++i) {
+            EXPECT_EQ(map.roughness_class_g[i], kClassVeryRough);
+            if (std::isfinite(map.T_um[i])) T.push_back(map.T_um[i]);
+        }
+        std::nth_element(T.begin(), T.begin() + T.size() / 2, T.end());
+        std::printf("very rough: median T = %.4f µm (truth 3), %zu tiles\n", T[T.size() / 2],
+                    T.size());
+        EXPECT_NEAR(T[T.size() / 2], 3.0, 0.05);
+    }
+    {
+        // g = (2π σ/λ)² (cos θi + 1)² ≈ 0.045 at 30°: slightly rough. A long patch (X) makes
+        // the coherent term (∝ 1/X², Eq. 1) negligible beside the diffuse one (∝ 1/X).
+        sim::SurfaceTruth t;
+        t.model = sim::BrightnessModel::MeanScatteredPower;
+        t.sigma_um = 0.01;
+        t.T_um = 0.5;
+        t.model_options.regime = Regime::SlightlyRough;
+        t.model_options.patch_x_um = 1e7;
+        const std::vector<Geometry> geoms{normal_view_geometry(kTheta1),
+                                          normal_view_geometry(kTheta2)};
+        const LitPair p = render_lit_pair(plane(W, H), {t}, {}, {}, kTheta1, kTheta2, 43);
+        MapOptions o;
+        o.sigma_um = 0.01;
+        const RoughnessMap map = roughness_map(flat_captures(p), o);
+        std::vector<float> T;
+        for (std::size_t i = 0; i < map.T_um.size(); ++i) {
+            EXPECT_EQ(map.roughness_class_g[i], kClassSlightlyRough);
+            if (std::isfinite(map.T_um[i])) T.push_back(map.T_um[i]);
+        }
+        ASSERT_FALSE(T.empty());
+        std::nth_element(T.begin(), T.begin() + T.size() / 2, T.end());
+        // Against Eq. 15 on the noise-free ratio (the scalar estimator).
+        const double ratio =
+            sim::surface_brightness(t, geoms[0]) / sim::surface_brightness(t, geoms[1]);
+        const double eq15 = correlation_length_from_ratio(ratio, 0.01, kTheta1, kTheta2, 0.555);
+        std::printf(
+            "slightly rough: median T = %.4f µm (truth 0.5, Eq. 15 on the exact ratio "
+            "%.4f), %zu tiles\n",
+            T[T.size() / 2], eq15, T.size());
+        EXPECT_NEAR(eq15, 0.5, 2e-3);  // the coherent term, ~1e-3 of the diffuse one
+        EXPECT_NEAR(T[T.size() / 2], 0.5, 0.01);
+    }
+}
+
+// A sphere: every tile has its own geometry from the normal map (camera frame = scene frame for
+// a camera on +Z).
+TEST(RoughnessMap, NormalMapOfASphere) {
+    sim::Scene scene;
+    scene.shape = sim::SceneShape::Sphere;
+    scene.width = 128;
+    scene.height = 128;
+    const double truth = 0.8;
+    const LitPair p = render_lit_pair(scene, {very_rough_truth(truth)}, {}, {}, kTheta1, kTheta2,
+                                      51, true, /*keep_geometry=*/true);
+    std::vector<MapCapture> c(2);
+    c[0].image = &p.a;
+    c[0].light = sim::direction_from_angles(kTheta1, kPi);
+    c[0].view = Eigen::Vector3d(0, 0, 1);
+    c[1].image = &p.b;
+    c[1].light = sim::direction_from_angles(kTheta2, kPi);
+    c[1].view = Eigen::Vector3d(0, 0, 1);
+    MapOptions o;
+    o.window_px = 8;
+    o.normal_map = p.c1.normal;
+    const RoughnessMap map = roughness_map(c, o);
+    std::vector<double> rel;
+    std::size_t within = 0;
+    for (std::size_t i = 0; i < map.sigma_over_T_gaussian.size(); ++i) {
+        const float v = map.sigma_over_T_gaussian[i];
+        if (!std::isfinite(v)) continue;
+        rel.push_back(std::abs(v - truth) / truth);
+        if (std::abs(v - truth) < 3.0 * map.sigma_over_T_gaussian_stderr[i] + 0.01 * truth)
+            ++within;
+    }
+    ASSERT_GT(rel.size(), 80u);
+    std::nth_element(rel.begin(), rel.begin() + rel.size() / 2, rel.end());
+    std::printf(
+        "sphere: %zu tiles with σ/T, %zu missing; median |error| %.2f %%, %zu within 3 "
+        "sd\n",
+        map.valid, map.missing, 100.0 * rel[rel.size() / 2], within);
+    EXPECT_LT(rel[rel.size() / 2], 0.02);
+    EXPECT_GT(static_cast<double>(within), 0.9 * static_cast<double>(rel.size()));
+    EXPECT_GT(map.missing, 0u);  // the corners off the sphere
+}
+
+TEST(RoughnessMap, BadInputIsRefused) {
+    const LitPair p =
+        render_lit_pair(plane(32, 32), {very_rough_truth(1.0)}, {}, {}, kTheta1, kTheta2, 61);
+    auto c = flat_captures(p);
+    MapOptions o;
+    EXPECT_THROW(roughness_map({c[0]}, o), InvalidArgument);
+    EXPECT_THROW(roughness_map({}, o), InvalidArgument);
+    {
+        auto bad = c;
+        bad[1].image = nullptr;
+        EXPECT_THROW(roughness_map(bad, o), InvalidArgument);
+    }
+    {
+        LinearImage small = p.b;
+        small.width = 16;
+        small.values.resize(16 * 32);
+        small.flags.resize(16 * 32);
+        auto bad = c;
+        bad[1].image = &small;
+        EXPECT_THROW(roughness_map(bad, o), InvalidArgument);
+    }
+    {
+        MapOptions w = o;
+        w.window_px = 0;
+        EXPECT_THROW(roughness_map(c, w), InvalidArgument);
+        w.window_px = 5000;
+        EXPECT_THROW(roughness_map(c, w), InvalidArgument);
+    }
+    {
+        auto bad = c;
+        bad[1].geometry = bad[0].geometry;  // no information in the ratio
+        EXPECT_THROW(roughness_map(bad, o), InvalidArgument);
+        bad[1].exposure_scale = 0.0;
+        EXPECT_THROW(roughness_map(bad, o), InvalidArgument);
+    }
+    {
+        MapOptions n = o;
+        std::vector<float> normals(10, 0.0f);
+        n.normal_map = normals;
+        EXPECT_THROW(roughness_map(c, n), InvalidArgument);  // wrong size and no light/view
+    }
+    {
+        MapOptions r = o;
+        std::vector<std::int32_t> labels(32 * 32, 3);
+        r.region_labels = labels;
+        r.region_names = {"a"};
+        EXPECT_THROW(roughness_map(c, r), InvalidArgument);
+    }
+    {
+        MapOptions s = o;
+        s.sigma_um = -1.0;
+        EXPECT_THROW(roughness_map(c, s), InvalidArgument);
+    }
+}
+
+// A ratio outside what the model produces is counted, not thrown; flagged pixels are never used.
+TEST(RoughnessMap, RatioOutsideTheModelIsCountedAsNoSolution) {
+    LinearImage a, b;
+    for (LinearImage* im : {&a, &b}) {
+        im->width = 32;
+        im->height = 32;
+        im->channels = 1;
+        im->values.assign(32 * 32, 0.5f);
+        im->flags.assign(32 * 32, 0);
+    }
+    const RatioRange range = ratio_range_gaussian(kTheta1, kTheta2);
+    // E1/E2 = lower / 2: below the Gaussian model's range (and the exponential's).
+    for (float& v : b.values) v = static_cast<float>(0.5 * 2.0 / range.lower);
+    // The top-left tile: every pixel flagged.
+    for (std::size_t r = 0; r < 8; ++r)
+        for (std::size_t x = 0; x < 8; ++x) a.flags[r * 32 + x] = kPixelSaturated;
+    std::vector<MapCapture> c(2);
+    c[0].image = &a;
+    c[0].geometry = normal_view_geometry(kTheta1);
+    c[1].image = &b;
+    c[1].geometry = normal_view_geometry(kTheta2);
+    MapOptions o;
+    o.window_px = 8;
+    const RoughnessMap map = roughness_map(c, o);
+    EXPECT_EQ(map.valid, 0u);
+    EXPECT_EQ(map.missing, 1u);
+    EXPECT_EQ(map.no_solution, 15u);
+    EXPECT_TRUE(std::isnan(map.sigma_over_T_gaussian[0]));
+    EXPECT_EQ(map.roughness_class[5], kClassNone);
+    for (const auto& s : map.classes) {
+        EXPECT_EQ(s.count, 0u);
+        EXPECT_EQ(s.fraction, 0.0);
+        EXPECT_FALSE(s.mean_sigma_over_T.has_value());
+    }
+    EXPECT_FALSE(map.warnings.empty());
+    // Per pixel as well.
+    o.window_px = 1;
+    const RoughnessMap pixels = roughness_map(c, o);
+    EXPECT_EQ(pixels.missing, 64u);
+    EXPECT_EQ(pixels.no_solution, 32u * 32u - 64u);
+}
+
+TEST(RoughnessMap, MoreThanTwoCapturesUseTheFirstTwoWithAWarning) {
+    const LitPair p =
+        render_lit_pair(plane(32, 32), {very_rough_truth(1.0)}, {}, {}, kTheta1, kTheta2, 71);
+    auto c = flat_captures(p);
+    c.push_back(c[1]);
+    const RoughnessMap three = roughness_map(c, MapOptions{});
+    c.pop_back();
+    const RoughnessMap two = roughness_map(c, MapOptions{});
+    EXPECT_EQ(three.sigma_over_T_gaussian, two.sigma_over_T_gaussian);
+    EXPECT_EQ(three.warnings.size(), two.warnings.size() + 1);
+}
+
+TEST(RoughnessClassOfSigmaOverT, Thresholds) {
+    EXPECT_EQ(roughness_class_of_sigma_over_T(0.3), RoughnessClass::SlightlyRough);
+    EXPECT_EQ(roughness_class_of_sigma_over_T(0.33), RoughnessClass::ModeratelyRough);
+    EXPECT_EQ(roughness_class_of_sigma_over_T(3.1), RoughnessClass::ModeratelyRough);
+    EXPECT_EQ(roughness_class_of_sigma_over_T(3.2), RoughnessClass::VeryRough);
+    // One decade of (σ/T)² either side of 1.
+    EXPECT_NEAR(kSlightlyRoughMaxSigmaOverT * kSlightlyRoughMaxSigmaOverT, 0.1, 1e-15);
+    EXPECT_NEAR(kVeryRoughMinSigmaOverT * kVeryRoughMinSigmaOverT, 10.0, 1e-14);
+}
+
+}  // namespace
+}  // namespace roughscope::image

@@ -1,0 +1,180 @@
+// A rough sphere as a BRDF table (image/sphere.hpp) against synthetic captures of known σ/T
+// (simulation/capture.hpp), compared with every model of brdf/comparison.hpp.
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "object_captures.hpp"
+#include "roughscope/core/errors.hpp"
+#include "roughscope/image/sphere.hpp"
+#include "roughscope/simulation/capture.hpp"
+
+namespace {
+
+using namespace roughscope;
+using namespace roughscope::image;
+using roughscope::testing::camera_for;
+using roughscope::testing::linear_from_capture;
+using roughscope::testing::very_rough_truth;
+namespace sim = roughscope::simulation;
+
+constexpr std::size_t kSize = 160;  // R = 64 px
+
+sim::Capture render(const sim::Scene& scene, const sim::SurfaceTruth& truth,
+                    const sim::CameraModel& camera) {
+    sim::CaptureOptions co;
+    co.keep_geometry = false;
+    co.threads = 1;
+    return sim::render_capture(scene, {truth}, {}, camera, co);
+}
+
+sim::Scene sphere_scene(const Eigen::Vector3d& light) {
+    sim::Scene scene;
+    scene.shape = sim::SceneShape::Sphere;
+    scene.width = kSize;
+    scene.height = kSize;
+    scene.pixel_size_um = 1.0;
+    scene.light = light;
+    return scene;
+}
+
+LinearImage noisy_sphere(const sim::Scene& scene, const sim::SurfaceTruth& truth, int bits,
+                         std::uint64_t seed) {
+    const double e_max =
+        roughscope::testing::max_radiance(render(scene, truth, camera_for(bits, 1, 0.5, 1)));
+    const sim::CameraModel camera = camera_for(bits, e_max, 0.6, seed);
+    return linear_from_capture(render(scene, truth, camera), camera);
+}
+
+CircleFit true_circle() {
+    CircleFit c;
+    c.centre_x_px = 80.0;
+    c.centre_y_px = 80.0;
+    c.radius_px = 64.0;
+    return c;
+}
+
+TEST(SphereTable, VhGaussianFitCoversTheTruthAndWins) {
+    int inside = 0, total = 0, wins = 0;
+    std::uint64_t seed = 500;
+    for (const double light_deg : {0.0, 30.0})
+        for (const double s : {0.4, 0.7, 1.1})
+            for (const int bits : {12, 14})
+                for (int rep = 0; rep < 2; ++rep) {
+                    const Eigen::Vector3d L =
+                        sim::direction_from_angles(deg_to_rad(light_deg), kPi);
+                    const LinearImage img = noisy_sphere(
+                        sphere_scene(L), very_rough_truth(s, Correlation::Gaussian), bits, seed++);
+                    SphereOptions o;
+                    o.light = L;
+                    o.circle = true_circle();
+                    const SphereResult r = measure_sphere(img, nullptr, o);
+                    EXPECT_LE(r.table.size(), 2000U);
+                    EXPECT_GE(r.table.size(), 500U);
+                    EXPECT_FALSE(r.comparison.two_point.available);  // CUReT's pair: not here
+                    const ModelResult& vh = r.comparison.result(ComparisonModel::VhGaussianFit);
+                    ASSERT_TRUE(vh.available) << vh.reason;
+                    const std::optional<double> fit = vh.parameter("sigma_over_T");
+                    ASSERT_TRUE(fit.has_value());
+                    double se = 0;
+                    for (const ModelParameter& p : vh.parameters)
+                        if (p.name == "sigma_over_T") se = p.standard_error.value_or(0.0);
+                    ASSERT_GT(se, 0.0);
+                    ++total;
+                    const bool ok = std::abs(*fit - s) <= 2.0 * se;
+                    inside += ok;
+                    if (!ok)
+                        std::printf("  outside: light %.0f sigma/T %.2f %d bit: %.5f +/- %.5f\n",
+                                    light_deg, s, bits, *fit, se);
+                    ASSERT_TRUE(r.comparison.winner.has_value());
+                    const ComparisonModel w = *r.comparison.winner;
+                    const bool won =
+                        w == ComparisonModel::VhGaussianFit ||
+                        vh.errors.gain_sse <= r.comparison.result(w).errors.gain_sse * (1.0 + 1e-3);
+                    wins += won;
+                    EXPECT_TRUE(won) << "winner " << to_string(w) << " at light " << light_deg
+                                     << " sigma/T " << s;
+                }
+    const double fraction = static_cast<double>(inside) / total;
+    std::printf(
+        "sphere coverage: %d of %d trials (%.1f %%) within the reported 2 sigma; "
+        "vh_gaussian_fit won (or tied) %d of %d\n",
+        inside, total, 100.0 * fraction, wins, total);
+    EXPECT_GE(fraction, 0.9);
+}
+
+TEST(SphereTable, DetectedCircleOnALambertSphere) {
+    sim::SurfaceTruth lambert;
+    lambert.model = sim::BrightnessModel::Lambert;
+    const LinearImage img = noisy_sphere(sphere_scene(Eigen::Vector3d(0, 0, 1)), lambert, 14, 3);
+    const SphereResult r = measure_sphere(img, nullptr, SphereOptions{});
+    EXPECT_TRUE(r.circle_detected);
+    EXPECT_NEAR(r.circle.radius_px, 64.0, 0.2);
+    // Lambert: f = Ē / cos θi is constant over the sphere (to the noise).
+    double lo = 1e300, hi = 0;
+    for (const BrdfMeasurement& m : r.table.measurements) {
+        lo = std::min(lo, m.value);
+        hi = std::max(hi, m.value);
+        EXPECT_NEAR(m.geometry.theta_s_rad, m.geometry.theta_i_rad, 1e-9);  // L = V
+    }
+    EXPECT_LT(hi / lo - 1.0, 0.1);
+    // Small cells on request; and a region mask halves the pixels.
+    SphereOptions small;
+    small.cell_px = 2;
+    EXPECT_GT(measure_sphere(img, nullptr, small).table.size(), r.table.size());
+    std::vector<std::uint8_t> mask(img.pixel_count(), 0);
+    for (std::size_t i = 0; i < 80 * kSize; ++i) mask[i] = 1;
+    EXPECT_NEAR(static_cast<double>(measure_sphere(img, &mask, SphereOptions{}).pixels_used) /
+                    static_cast<double>(r.pixels_used),
+                0.5, 0.02);
+}
+
+TEST(SphereTable, BadInputIsAnError) {
+    sim::SurfaceTruth lambert;
+    lambert.model = sim::BrightnessModel::Lambert;
+    const LinearImage img = noisy_sphere(sphere_scene(Eigen::Vector3d(0, 0, 1)), lambert, 12, 4);
+    auto with = [](auto change) {
+        SphereOptions o;
+        change(o);
+        return o;
+    };
+    EXPECT_THROW(measure_sphere(img, nullptr, with([](SphereOptions& o) {
+                                    o.light = {1, 0, 0};
+                                })),
+                 InvalidArgument);
+    EXPECT_THROW(measure_sphere(img, nullptr, with([](SphereOptions& o) {
+                                    o.view = {0, 0, -1};
+                                })),
+                 InvalidArgument);
+    EXPECT_THROW(
+        measure_sphere(img, nullptr, with([](SphereOptions& o) { o.limb_fraction = 0.0; })),
+        InvalidArgument);
+    EXPECT_THROW(measure_sphere(img, nullptr, with([](SphereOptions& o) { o.max_cells = 0; })),
+                 InvalidArgument);
+    EXPECT_THROW(
+        measure_sphere(img, nullptr, with([](SphereOptions& o) { o.max_angle_deg = 95.0; })),
+        InvalidArgument);
+    EXPECT_THROW(measure_sphere(img, nullptr, with([](SphereOptions& o) {
+                                    o.circle = CircleFit{80, 80, -3, 0, 0};
+                                })),
+                 InvalidArgument);
+    EXPECT_THROW(measure_sphere(img, nullptr, with([](SphereOptions& o) {
+                                    o.circle = CircleFit{-500, -500, 3, 0, 0};  // off the image
+                                })),
+                 DataError);
+    const std::vector<std::uint8_t> short_mask(3, 1);
+    EXPECT_THROW(measure_sphere(img, &short_mask, {}), InvalidArgument);
+    LinearImage dark = img;
+    std::fill(dark.values.begin(), dark.values.end(), 0.0F);
+    EXPECT_THROW(measure_sphere(dark, nullptr, {}), DataError);
+    // A sphere cut by the border.
+    const LinearImage cut = roughscope::testing::cropped(img, 30, 0, 130, 160);
+    EXPECT_THROW(measure_sphere(cut, nullptr, {}), DataError);
+}
+
+}  // namespace
