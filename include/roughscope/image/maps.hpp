@@ -156,6 +156,9 @@ struct MapOptions {
     std::span<const std::int32_t> region_labels;
     std::vector<std::string> region_names;
     RatioInverseTableOptions table;
+    // Worker threads over bands of rows (0 = all cores; maps below 65536 cells and normal maps
+    // use one). The result does not depend on it.
+    std::size_t threads = 0;
 };
 
 // ---------------------------------------------------------------------------------------------
