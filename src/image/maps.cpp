@@ -797,11 +797,11 @@ void allocate_layer(std::vector<T>& layer, std::size_t n, T fill) {
     constexpr std::size_t kHugePage = std::size_t{2} << 20;
     const std::size_t bytes = n * sizeof(T);
     if (bytes >= 4 * kHugePage) {
-        const auto begin = reinterpret_cast<std::uintptr_t>(layer.data());
-        const std::uintptr_t first = (begin + kHugePage - 1) / kHugePage * kHugePage;
-        const std::uintptr_t last = (begin + bytes) / kHugePage * kHugePage;
-        if (last > first)
-            (void)madvise(reinterpret_cast<void*>(first), last - first, MADV_HUGEPAGE);
+        auto* base = reinterpret_cast<char*>(layer.data());
+        const std::size_t misalign = reinterpret_cast<std::uintptr_t>(base) % kHugePage;
+        const std::size_t skip = misalign == 0 ? 0 : kHugePage - misalign;
+        if (bytes > skip + kHugePage)
+            (void)madvise(base + skip, (bytes - skip) / kHugePage * kHugePage, MADV_HUGEPAGE);
     }
 #endif
     layer.assign(n, fill);
