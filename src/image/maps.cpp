@@ -190,6 +190,7 @@ RatioInverseTable RatioInverseTable::sigma_over_T(const Geometry& geom1, const G
                 },
                 table, out.y_, out.x_, out.dxdy_);
         }
+        out.build_coefficients();
         return out;
     }
     // Any other pair of geometries: the very-rough model ratio of the two-geometry solver.
@@ -203,6 +204,7 @@ RatioInverseTable RatioInverseTable::sigma_over_T(const Geometry& geom1, const G
                 lx);
         },
         table, out.y_, out.x_, out.dxdy_);
+    out.build_coefficients();
     return out;
 }
 
@@ -228,6 +230,7 @@ RatioInverseTable RatioInverseTable::correlation_length(const Geometry& geom1,
                 lx);
         },
         table, out.y_, out.x_, out.dxdy_);
+    out.build_coefficients();
     return out;
 }
 
@@ -269,20 +272,24 @@ std::optional<RatioInverseTable::Value> RatioInverseTable::lookup(double log_rat
         }
     }
     hint = j;
-    // Cubic Hermite in y between nodes j and j + 1.
-    const double dy = y_[j + 1] - y_[j];
-    const double t = (log_ratio - y_[j]) / dy;
-    const double t2 = t * t, t3 = t2 * t;
-    const double h00 = 2.0 * t3 - 3.0 * t2 + 1.0, h10 = t3 - 2.0 * t2 + t;
-    const double h01 = -2.0 * t3 + 3.0 * t2, h11 = t3 - t2;
-    const double x0 = x_[j], x1 = x_[j + 1], d0 = dxdy_[j] * dy, d1 = dxdy_[j + 1] * dy;
+    // The cubic Hermite interpolant in y between nodes j and j + 1.
+    const std::array<double, 5>& c = coefficients_[j];
+    const double t = (log_ratio - y_[j]) * c[4];
     Value v;
-    v.x = h00 * x0 + h10 * d0 + h01 * x1 + h11 * d1;
-    v.dx_dlog_ratio = ((6.0 * t2 - 6.0 * t) * x0 + (3.0 * t2 - 4.0 * t + 1.0) * d0 +
-                       (6.0 * t - 6.0 * t2) * x1 + (3.0 * t2 - 2.0 * t) * d1) /
-                      dy;
+    v.x = c[0] + t * (c[1] + t * (c[2] + t * c[3]));
+    v.dx_dlog_ratio = (c[1] + t * (2.0 * c[2] + t * 3.0 * c[3])) * c[4];
     if (!(v.x > 0.0) || !std::isfinite(v.x)) return std::nullopt;
     return v;
+}
+
+void RatioInverseTable::build_coefficients() {
+    coefficients_.resize(y_.size() - 1);
+    for (std::size_t j = 0; j + 1 < y_.size(); ++j) {
+        const double dy = y_[j + 1] - y_[j];
+        const double x0 = x_[j], x1 = x_[j + 1], d0 = dxdy_[j] * dy, d1 = dxdy_[j + 1] * dy;
+        coefficients_[j] = {x0, d0, 3.0 * (x1 - x0) - 2.0 * d0 - d1, 2.0 * (x0 - x1) + d0 + d1,
+                            1.0 / dy};
+    }
 }
 
 RatioRange RatioInverseTable::ratio_range() const {

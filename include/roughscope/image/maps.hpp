@@ -105,7 +105,10 @@ class RatioInverseTable {
     std::size_t size() const { return y_.size(); }
 
   private:
+    void build_coefficients();
     std::vector<double> y_, x_, dxdy_;  // y increasing
+    // Per interval j: x = c0 + c1 t + c2 t² + c3 t³, t = (y − y_j)·c4 (the Hermite cubic).
+    std::vector<std::array<double, 5>> coefficients_;
 };
 
 // ---------------------------------------------------------------------------------------------
