@@ -3,9 +3,16 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <exception>
 #include <limits>
 #include <string>
+#include <thread>
 #include <utility>
+
+#if defined(__linux__)
+#include <sys/mman.h>
+#endif
 
 #include "roughscope/core/errors.hpp"
 #include "roughscope/core/text.hpp"
@@ -183,6 +190,7 @@ RatioInverseTable RatioInverseTable::sigma_over_T(const Geometry& geom1, const G
                 },
                 table, out.y_, out.x_, out.dxdy_);
         }
+        out.build_coefficients();
         return out;
     }
     // Any other pair of geometries: the very-rough model ratio of the two-geometry solver.
@@ -196,6 +204,7 @@ RatioInverseTable RatioInverseTable::sigma_over_T(const Geometry& geom1, const G
                 lx);
         },
         table, out.y_, out.x_, out.dxdy_);
+    out.build_coefficients();
     return out;
 }
 
@@ -221,6 +230,7 @@ RatioInverseTable RatioInverseTable::correlation_length(const Geometry& geom1,
                 lx);
         },
         table, out.y_, out.x_, out.dxdy_);
+    out.build_coefficients();
     return out;
 }
 
@@ -228,33 +238,58 @@ std::optional<RatioInverseTable::Value> RatioInverseTable::lookup(double log_rat
                                                                   std::size_t& hint) const {
     const std::size_t n = y_.size();
     if (!(log_ratio >= y_.front() && log_ratio <= y_.back())) return std::nullopt;
+    // Galloping search from the last interval: nearby ratios cost a few comparisons.
     std::size_t j = std::min(hint, n - 2);
-    if (!(y_[j] <= log_ratio && log_ratio <= y_[j + 1])) {
-        if (j + 2 < n && y_[j + 1] <= log_ratio && log_ratio <= y_[j + 2]) {
-            ++j;
-        } else if (j > 0 && y_[j - 1] <= log_ratio && log_ratio <= y_[j]) {
-            --j;
-        } else {
-            const auto it = std::upper_bound(y_.begin(), y_.end(), log_ratio);
-            j = static_cast<std::size_t>(std::clamp<std::ptrdiff_t>(
-                it - y_.begin() - 1, 0, static_cast<std::ptrdiff_t>(n - 2)));
+    if (log_ratio < y_[j]) {
+        std::size_t step = 1, hi = j;
+        while (true) {
+            const std::size_t lo = hi >= step ? hi - step : 0;
+            if (y_[lo] <= log_ratio) {
+                // y_[lo] ≤ log_ratio < y_[hi]
+                const auto it =
+                    std::upper_bound(y_.begin() + static_cast<std::ptrdiff_t>(lo),
+                                     y_.begin() + static_cast<std::ptrdiff_t>(hi), log_ratio);
+                j = static_cast<std::size_t>(it - y_.begin()) - 1;
+                break;
+            }
+            hi = lo;
+            step *= 2;
+        }
+    } else if (log_ratio > y_[j + 1]) {
+        std::size_t step = 1, lo = j + 1;
+        while (true) {
+            const std::size_t hi = std::min(n - 1, lo + step);
+            if (log_ratio <= y_[hi]) {
+                // y_[lo] < log_ratio ≤ y_[hi]
+                const auto it =
+                    std::lower_bound(y_.begin() + static_cast<std::ptrdiff_t>(lo),
+                                     y_.begin() + static_cast<std::ptrdiff_t>(hi), log_ratio);
+                j = std::min(n - 2, static_cast<std::size_t>(it - y_.begin()) - 1);
+                break;
+            }
+            lo = hi;
+            step *= 2;
         }
     }
     hint = j;
-    // Cubic Hermite in y between nodes j and j + 1.
-    const double dy = y_[j + 1] - y_[j];
-    const double t = (log_ratio - y_[j]) / dy;
-    const double t2 = t * t, t3 = t2 * t;
-    const double h00 = 2.0 * t3 - 3.0 * t2 + 1.0, h10 = t3 - 2.0 * t2 + t;
-    const double h01 = -2.0 * t3 + 3.0 * t2, h11 = t3 - t2;
-    const double x0 = x_[j], x1 = x_[j + 1], d0 = dxdy_[j] * dy, d1 = dxdy_[j + 1] * dy;
+    // The cubic Hermite interpolant in y between nodes j and j + 1.
+    const std::array<double, 5>& c = coefficients_[j];
+    const double t = (log_ratio - y_[j]) * c[4];
     Value v;
-    v.x = h00 * x0 + h10 * d0 + h01 * x1 + h11 * d1;
-    v.dx_dlog_ratio = ((6.0 * t2 - 6.0 * t) * x0 + (3.0 * t2 - 4.0 * t + 1.0) * d0 +
-                       (6.0 * t - 6.0 * t2) * x1 + (3.0 * t2 - 2.0 * t) * d1) /
-                      dy;
+    v.x = c[0] + t * (c[1] + t * (c[2] + t * c[3]));
+    v.dx_dlog_ratio = (c[1] + t * (2.0 * c[2] + t * 3.0 * c[3])) * c[4];
     if (!(v.x > 0.0) || !std::isfinite(v.x)) return std::nullopt;
     return v;
+}
+
+void RatioInverseTable::build_coefficients() {
+    coefficients_.resize(y_.size() - 1);
+    for (std::size_t j = 0; j + 1 < y_.size(); ++j) {
+        const double dy = y_[j + 1] - y_[j];
+        const double x0 = x_[j], x1 = x_[j + 1], d0 = dxdy_[j] * dy, d1 = dxdy_[j + 1] * dy;
+        coefficients_[j] = {x0, d0, 3.0 * (x1 - x0) - 2.0 * d0 - d1, 2.0 * (x0 - x1) + d0 + d1,
+                            1.0 / dy};
+    }
 }
 
 RatioRange RatioInverseTable::ratio_range() const {
@@ -349,6 +384,7 @@ void check_map_input(const std::vector<MapCapture>& captures, const MapOptions& 
 // What one map cell (pixel or tile) needs: ln(E1/E2), its variance and, for a normal map, the
 // (mean) normal.
 struct Cell {
+    double ratio = 1.0;
     double log_ratio = 0.0;
     double var_log_ratio = 0.0;
     Eigen::Vector3d normal = Eigen::Vector3d::Zero();
@@ -394,7 +430,20 @@ void load_row(const MapCapture& c, std::size_t r, std::vector<double>& out) {
         out[x] = (static_cast<double>(p0[x]) + p1[x] + p2[x]) * scale;
 }
 
-// Evaluates cells into the layers of the map.
+// What a band of rows counted.
+struct Counts {
+    std::size_t valid = 0, missing = 0, no_solution = 0, no_solution_exponential = 0,
+                no_solution_T = 0;
+    void add(const Counts& c) {
+        valid += c.valid;
+        missing += c.missing;
+        no_solution += c.no_solution;
+        no_solution_exponential += c.no_solution_exponential;
+        no_solution_T += c.no_solution_T;
+    }
+};
+
+// Evaluates cells into the layers of the map (one copy per thread: its own hints and counts).
 class Evaluator {
   public:
     Evaluator(const std::vector<MapCapture>& captures, const MapOptions& o, RoughnessMap& map)
@@ -442,7 +491,7 @@ class Evaluator {
 
     void evaluate(std::size_t index, const Cell& cell) {
         const double lr = cell.log_ratio;
-        map_.E1_over_E2[index] = static_cast<float>(std::exp(lr));
+        map_.E1_over_E2[index] = static_cast<float>(cell.ratio);
         const double sd_lr = std::sqrt(cell.var_log_ratio);
         std::optional<Estimate> g, e;
         std::optional<Geometry> geom1, geom2;
@@ -459,7 +508,7 @@ class Evaluator {
                 geom2 = geometry_from_vectors(n, *c2_.light, *c2_.view);
             }
             if (!geom1 || !geom2) {
-                ++map_.missing;
+                ++counts_.missing;
                 map_.roughness_class[index] = kClassNone;
                 if (!map_.roughness_class_g.empty()) map_.roughness_class_g[index] = kClassNone;
                 return;
@@ -477,14 +526,14 @@ class Evaluator {
         }
         const std::optional<Estimate>& primary = o_.correlation == Correlation::Gaussian ? g : e;
         const std::optional<Estimate>& other = o_.correlation == Correlation::Gaussian ? e : g;
-        if (!other) ++map_.no_solution_exponential;
+        if (!other) ++counts_.no_solution_exponential;
         if (o_.sigma_um) estimate_T(index, lr, sd_lr, primary, geom1, geom2);
         if (!primary) {
-            ++map_.no_solution;
+            ++counts_.no_solution;
             map_.roughness_class[index] = kClassNone;
             return;
         }
-        ++map_.valid;
+        ++counts_.valid;
         map_.roughness_class[index] = class_code(roughness_class_of_sigma_over_T(
             primary->value, o_.slightly_rough_max_sigma_over_T, o_.very_rough_min_sigma_over_T));
     }
@@ -541,11 +590,11 @@ class Evaluator {
             map_.T_um[index] = static_cast<float>(T->value);
             map_.T_um_stderr[index] = static_cast<float>(T->std_error);
         } else {
-            ++no_solution_T_;
+            ++counts_.no_solution_T;
         }
     }
 
-    std::size_t no_solution_T() const { return no_solution_T_; }
+    Counts& counts() { return counts_; }
     std::optional<RoughnessClass> flat_g_class() const { return flat_g_class_; }
 
   private:
@@ -577,7 +626,7 @@ class Evaluator {
     double sigma_step_ = 0.0;
     std::optional<RoughnessClass> flat_g_class_;
     std::size_t hint_g_ = 0, hint_e_ = 0, hint_t_ = 0, hint_t2_ = 0;
-    std::size_t no_solution_T_ = 0;
+    Counts counts_;
 };
 
 bool pixel_used(const MapCapture& c1, const MapCapture& c2, const MapOptions& o, std::size_t p) {
@@ -591,7 +640,8 @@ bool pixel_used(const MapCapture& c1, const MapCapture& c2, const MapOptions& o,
 
 // Tiles: one pass over the rows, the sums of each tile of a row of tiles.
 void tile_map(const std::vector<MapCapture>& captures, const MapOptions& o, Evaluator& ev,
-              RoughnessMap& map, std::vector<std::int32_t>& cell_region) {
+              RoughnessMap& map, std::vector<std::int32_t>& cell_region, std::size_t ty_begin,
+              std::size_t ty_end) {
     const MapCapture& c1 = captures[0];
     const MapCapture& c2 = captures[1];
     const std::size_t W = c1.image->width, H = c1.image->height, w = o.window_px;
@@ -600,7 +650,7 @@ void tile_map(const std::vector<MapCapture>& captures, const MapOptions& o, Eval
     std::vector<Eigen::Vector3d> normals(map.width);
     std::vector<std::int32_t> region(map.width);
     const bool labels = !o.region_labels.empty();
-    for (std::size_t ty = 0; ty < map.height; ++ty) {
+    for (std::size_t ty = ty_begin; ty < ty_end; ++ty) {
         std::fill(sums.begin(), sums.end(), Sums{});
         std::fill(normals.begin(), normals.end(), Eigen::Vector3d::Zero());
         std::fill(region.begin(), region.end(), -2);
@@ -635,20 +685,21 @@ void tile_map(const std::vector<MapCapture>& captures, const MapOptions& o, Eval
             const Sums& s = sums[tx];
             double m1 = 0, m2 = 0, var = 0;
             if (s.n < std::max(2.0, o.min_used_fraction * area)) {
-                ++map.missing;
+                ++ev.counts().missing;
                 map.roughness_class[index] = kClassNone;
                 if (!map.roughness_class_g.empty()) map.roughness_class_g[index] = kClassNone;
                 continue;
             }
             if (!s.pixel_log_variance(m1, m2, var)) {
-                ++map.no_solution;
-                ++map.no_solution_exponential;
+                ++ev.counts().no_solution;
+                ++ev.counts().no_solution_exponential;
                 map.roughness_class[index] = kClassNone;
                 if (!map.roughness_class_g.empty()) map.roughness_class_g[index] = kClassNone;
                 continue;
             }
             Cell cell;
-            cell.log_ratio = std::log(m1 / m2);
+            cell.ratio = m1 / m2;
+            cell.log_ratio = std::log(cell.ratio);
             cell.var_log_ratio = var / s.n;
             cell.normal = normals[tx];
             ev.evaluate(index, cell);
@@ -658,7 +709,8 @@ void tile_map(const std::vector<MapCapture>& captures, const MapOptions& o, Eval
 
 // Per pixel: the pixel's ratio, the noise from the (2R + 1)² neighbourhood (running sums).
 void pixel_map(const std::vector<MapCapture>& captures, const MapOptions& o, Evaluator& ev,
-               RoughnessMap& map, std::vector<std::int32_t>& cell_region) {
+               RoughnessMap& map, std::vector<std::int32_t>& cell_region, std::size_t r_begin,
+               std::size_t r_end) {
     const MapCapture& c1 = captures[0];
     const MapCapture& c2 = captures[1];
     const std::size_t W = c1.image->width, H = c1.image->height, R = kPixelNoiseRadius;
@@ -667,7 +719,6 @@ void pixel_map(const std::vector<MapCapture>& captures, const MapOptions& o, Eva
         x2(ring, std::vector<double>(W));
     std::vector<std::vector<std::uint8_t>> used(ring, std::vector<std::uint8_t>(W));
     std::vector<Sums> col(W);
-    std::vector<double> tmp1(W), tmp2(W);
     auto load = [&](std::size_t r) {
         const std::size_t k = r % ring;
         load_row(c1, r, x1[k]);
@@ -688,17 +739,15 @@ void pixel_map(const std::vector<MapCapture>& captures, const MapOptions& o, Eva
             s.s12 += sign * a * b;
         }
     };
-    for (std::size_t r = 0; r < std::min(H, R + 1); ++r) {
-        load(r);
-        add_row(r, 1.0);
-    }
+    // The column sums hold rows [removed, added) = [r − R, r + R] ∩ [0, H) at row r.
+    std::size_t added = r_begin >= R ? r_begin - R : 0, removed = added;
     const bool labels = !o.region_labels.empty();
-    for (std::size_t r = 0; r < H; ++r) {
-        if (r >= 1 && r + R < H) {
-            load(r + R);
-            add_row(r + R, 1.0);
+    for (std::size_t r = r_begin; r < r_end; ++r) {
+        for (; added < std::min(H, r + R + 1); ++added) {
+            load(added);
+            add_row(added, 1.0);
         }
-        if (r >= R + 1) add_row(r - R - 1, -1.0);
+        for (; removed + R < r; ++removed) add_row(removed, -1.0);
         const std::size_t k = r % ring;
         Sums window;
         auto add_col = [&](const Sums& s, double sign) {
@@ -718,21 +767,22 @@ void pixel_map(const std::vector<MapCapture>& captures, const MapOptions& o, Eva
             double m1 = 0, m2 = 0, var = 0;
             // Running sums of ±1 stay exact integers in n.
             if (!used[k][x] || window.n < 3.0) {
-                ++map.missing;
+                ++ev.counts().missing;
                 map.roughness_class[index] = kClassNone;
                 if (!map.roughness_class_g.empty()) map.roughness_class_g[index] = kClassNone;
                 continue;
             }
             const double a = x1[k][x], b = x2[k][x];
             if (!(a > 0.0) || !(b > 0.0) || !window.pixel_log_variance(m1, m2, var)) {
-                ++map.no_solution;
-                ++map.no_solution_exponential;
+                ++ev.counts().no_solution;
+                ++ev.counts().no_solution_exponential;
                 map.roughness_class[index] = kClassNone;
                 if (!map.roughness_class_g.empty()) map.roughness_class_g[index] = kClassNone;
                 continue;
             }
             Cell cell;
-            cell.log_ratio = std::log(a / b);
+            cell.ratio = a / b;
+            cell.log_ratio = std::log(cell.ratio);
             cell.var_log_ratio = var;
             if (!o.normal_map.empty()) {
                 const float* n = o.normal_map.data() + 3 * index;
@@ -741,6 +791,27 @@ void pixel_map(const std::vector<MapCapture>& captures, const MapOptions& o, Eva
             ev.evaluate(index, cell);
         }
     }
+}
+
+// A layer of n cells set to `fill`. Large layers ask the kernel for transparent huge pages
+// first (Linux; a hint, ignored elsewhere): filling 100 MB of 4 kB pages costs more in page
+// faults than the map's arithmetic.
+template <class T>
+void allocate_layer(std::vector<T>& layer, std::size_t n, T fill) {
+    layer.clear();
+    layer.reserve(n);
+#if defined(__linux__) && defined(MADV_HUGEPAGE)
+    constexpr std::size_t kHugePage = std::size_t{2} << 20;
+    const std::size_t bytes = n * sizeof(T);
+    if (bytes >= 4 * kHugePage) {
+        auto* base = reinterpret_cast<char*>(layer.data());
+        const std::size_t misalign = reinterpret_cast<std::uintptr_t>(base) % kHugePage;
+        const std::size_t skip = misalign == 0 ? 0 : kHugePage - misalign;
+        if (bytes > skip + kHugePage)
+            (void)madvise(base + skip, (bytes - skip) / kHugePage * kHugePage, MADV_HUGEPAGE);
+    }
+#endif
+    layer.assign(n, fill);
 }
 
 void summarise(const MapOptions& o, RoughnessMap& map,
@@ -836,28 +907,57 @@ RoughnessMap roughness_map(const std::vector<MapCapture>& captures, const MapOpt
     for (auto* layer :
          {&map.E1_over_E2, &map.sigma_over_T_gaussian, &map.sigma_over_T_gaussian_stderr,
           &map.sigma_over_T_exponential, &map.sigma_over_T_exponential_stderr})
-        layer->assign(cells, kNaN);
-    map.roughness_class.assign(cells, kClassNone);
+        allocate_layer(*layer, cells, kNaN);
+    allocate_layer(map.roughness_class, cells, kClassNone);
     if (o.sigma_um) {
-        map.T_um.assign(cells, kNaN);
-        map.T_um_stderr.assign(cells, kNaN);
-        map.roughness_class_g.assign(cells, kClassNone);
+        allocate_layer(map.T_um, cells, kNaN);
+        allocate_layer(map.T_um_stderr, cells, kNaN);
+        allocate_layer(map.roughness_class_g, cells, kClassNone);
     }
     std::vector<std::int32_t> cell_region;
     if (!o.region_labels.empty()) cell_region.assign(cells, -1);
-    Evaluator ev(captures, o, map);
-    if (o.window_px == 1)
-        pixel_map(captures, o, ev, map, cell_region);
-    else
-        tile_map(captures, o, ev, map, cell_region);
+    const Evaluator prototype(captures, o, map);
+    // Bands of rows (pixel rows, or rows of tiles), one thread each; the result does not depend
+    // on the number of threads (each cell is computed from its own pixels).
+    const std::size_t rows = map.height;
+    std::size_t threads =
+        o.threads == 0 ? std::max(1u, std::thread::hardware_concurrency()) : o.threads;
+    threads = std::clamp<std::size_t>(threads, 1, std::max<std::size_t>(1, rows / 16));
+    if (!o.normal_map.empty() || cells < 65536) threads = std::min<std::size_t>(threads, 1);
+    std::vector<Evaluator> evaluators(threads, prototype);
+    std::vector<std::exception_ptr> errors(threads);
+    auto run = [&](std::size_t t) {
+        try {
+            const std::size_t begin = rows * t / threads, end = rows * (t + 1) / threads;
+            if (o.window_px == 1)
+                pixel_map(captures, o, evaluators[t], map, cell_region, begin, end);
+            else
+                tile_map(captures, o, evaluators[t], map, cell_region, begin, end);
+        } catch (...) {
+            errors[t] = std::current_exception();
+        }
+    };
+    {
+        std::vector<std::jthread> workers;
+        for (std::size_t t = 1; t < threads; ++t) workers.emplace_back(run, t);
+        run(0);
+    }
+    for (const auto& e : errors)
+        if (e) std::rethrow_exception(e);
+    Counts counts;
+    for (auto& ev : evaluators) counts.add(ev.counts());
+    map.valid = counts.valid;
+    map.missing = counts.missing;
+    map.no_solution = counts.no_solution;
+    map.no_solution_exponential = counts.no_solution_exponential;
     summarise(o, map, cell_region);
     if (map.no_solution > 0)
         map.warnings.push_back(concat("roughness map: ", std::to_string(map.no_solution), " of ",
                                       std::to_string(cells),
                                       " pixels/tiles have a ratio E1/E2 the model does not produce "
                                       "(no σ/T)"));
-    if (o.sigma_um && ev.no_solution_T() > 0)
-        map.warnings.push_back(concat("roughness map: ", std::to_string(ev.no_solution_T()),
+    if (o.sigma_um && counts.no_solution_T > 0)
+        map.warnings.push_back(concat("roughness map: ", std::to_string(counts.no_solution_T),
                                       " pixels/tiles with σ/T have no T given σ"));
     if (map.valid == 0) map.warnings.push_back("roughness map: no pixel or tile has an estimate");
     return map;

@@ -105,7 +105,10 @@ class RatioInverseTable {
     std::size_t size() const { return y_.size(); }
 
   private:
+    void build_coefficients();
     std::vector<double> y_, x_, dxdy_;  // y increasing
+    // Per interval j: x = c0 + c1 t + c2 t² + c3 t³, t = (y − y_j)·c4 (the Hermite cubic).
+    std::vector<std::array<double, 5>> coefficients_;
 };
 
 // ---------------------------------------------------------------------------------------------
@@ -156,6 +159,9 @@ struct MapOptions {
     std::span<const std::int32_t> region_labels;
     std::vector<std::string> region_names;
     RatioInverseTableOptions table;
+    // Worker threads over bands of rows (0 = all cores; maps below 65536 cells and normal maps
+    // use one). The result does not depend on it.
+    std::size_t threads = 0;
 };
 
 // ---------------------------------------------------------------------------------------------

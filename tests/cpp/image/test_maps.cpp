@@ -505,3 +505,33 @@ TEST(RoughnessClassOfSigmaOverT, Thresholds) {
 
 }  // namespace
 }  // namespace roughscope::image
+
+namespace roughscope::image {
+namespace {
+
+// Bands of rows on several threads give the same map as one thread, per pixel and per tile.
+TEST(RoughnessMap, ThreadsDoNotChangeTheResult) {
+    const LitPair p =
+        render_lit_pair(plane(300, 260), {very_rough_truth(0.7)}, {}, {}, kTheta1, kTheta2, 81);
+    for (const std::size_t window : {std::size_t{1}, std::size_t{2}}) {
+        MapOptions o;
+        o.window_px = window;
+        o.threads = 1;
+        const RoughnessMap one = roughness_map(flat_captures(p), o);
+        o.threads = 3;
+        const RoughnessMap three = roughness_map(flat_captures(p), o);
+        ASSERT_EQ(one.sigma_over_T_gaussian.size(), three.sigma_over_T_gaussian.size());
+        for (std::size_t i = 0; i < one.sigma_over_T_gaussian.size(); ++i) {
+            const float a = one.sigma_over_T_gaussian[i], b = three.sigma_over_T_gaussian[i];
+            ASSERT_TRUE((std::isnan(a) && std::isnan(b)) || a == b) << window << " " << i;
+            ASSERT_EQ(one.sigma_over_T_exponential_stderr[i],
+                      three.sigma_over_T_exponential_stderr[i]);
+        }
+        EXPECT_EQ(one.valid, three.valid);
+        EXPECT_EQ(one.missing, three.missing);
+        EXPECT_EQ(one.no_solution, three.no_solution);
+    }
+}
+
+}  // namespace
+}  // namespace roughscope::image
