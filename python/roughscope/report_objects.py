@@ -229,9 +229,9 @@ DEMO_BITS = 14
 DEMO_BLACK = 64.0
 CYLINDER_SIGMA_OVER_T = 0.71   # a sandpaper of Table 2 (V–H Gaussian)
 SPHERE_SIGMA_OVER_T = 0.5
-MAP_REGIONS = (("slightly rough", 0.25), ("moderately rough", 1.0), ("very rough", 5.0))
-MAP_SIZE = 192
-MAP_WINDOW_PX = 8
+MAP_REGIONS = (("slightly rough", 0.2), ("moderately rough", 1.0), ("very rough", 4.0))
+MAP_SIZE = 256
+MAP_WINDOW_PX = 16
 
 
 def _camera():
@@ -246,7 +246,8 @@ def _exposure(peak_brightness, fill=0.6):
 
 
 def _peak(**scene):
-    out = _core.render_capture(width=64, height=64, shot_noise=False, **scene)
+    scene = dict(scene, width=64, height=64)
+    out = _core.render_capture(shot_noise=False, **scene)
     return float(out["radiance"].max())
 
 
@@ -276,7 +277,11 @@ def write_cylinder_demo(folder):
     spec = {"format": "roughscope-measure",
             "description": "synthetic cylinder, L = V (§5.2)",
             "black_level_dn": DEMO_BLACK,
-            "object": {"shape": "cylinder"},
+            # The known geometry, as in §5.2 (the renderer's axis: the vertical centre line,
+            # radius 0.4 · 160 px). Found from the silhouette instead, the radius of a very
+            # rough cylinder lit from the camera comes out short: its limb is dark.
+            "object": {"shape": "cylinder",
+                       "axis": {"point_px": [100, 80], "direction": [0, 1], "radius_px": 64}},
             "captures": [{"image": "capture.tiff", "light": [0, 0, 1], "view": [0, 0, 1]}]}
     path = folder / "capture-file.json"
     path.write_text(json.dumps(spec, indent=2) + "\n", encoding="utf-8")
@@ -295,44 +300,61 @@ def write_sphere_demo(folder):
     spec = {"format": "roughscope-measure",
             "description": "synthetic sphere, light at 30°",
             "black_level_dn": DEMO_BLACK,
-            "object": {"shape": "sphere"},
+            # The known circle (centred, radius 0.4 · 160 px): beyond the terminator the sphere
+            # is dark and its outline cannot be seen.
+            "object": {"shape": "sphere", "circle": [80, 80, 64]},
             "captures": [{"image": "capture.tiff", "light": light, "view": [0, 0, 1]}]}
     path = folder / "capture-file.json"
     path.write_text(json.dumps(spec, indent=2) + "\n", encoding="utf-8")
     return path
 
 
-def write_map_demo(folder):
-    """A flat sample with three vertical bands of known σ/T, lit at 30° and 45°; its capture
-    file with the three bands as named map regions."""
+def map_demo_labels(shift_px=0):
+    """The demo's three regions: the top left quarter (slightly rough), the top right quarter
+    (moderately rough) and the bottom half (very rough) — borders in both directions, so that
+    the pair's registration is determined — optionally moved `shift_px` columns to the right."""
     import numpy as np
 
+    half = MAP_SIZE // 2
+    yy, xx = np.mgrid[0:MAP_SIZE, 0:MAP_SIZE]
+    xx = xx - shift_px
+    labels = np.where(yy >= half, 2, np.where(xx >= half, 1, 0))
+    return labels.astype(np.int32)
+
+
+def map_demo_regions():
+    """The named regions of the map demo, one window inside each region's borders."""
+    half, w = MAP_SIZE // 2, MAP_WINDOW_PX
+    rects = ([w, w, half - 2 * w, half - 2 * w], [half + w, w, half - 2 * w, half - 2 * w],
+             [w, half + w, MAP_SIZE - 2 * w, half - 2 * w])
+    return [{"name": name, "rect": rect} for (name, _), rect in zip(MAP_REGIONS, rects)]
+
+
+def write_map_capture(folder, k, theta, exposure, shift_px=0, seed=None):
+    _core.write_capture(str(folder), "tiff", scene="plane", width=MAP_SIZE, height=MAP_SIZE,
+                        theta_i_deg=theta, sigma_over_T=[r for _, r in MAP_REGIONS],
+                        labels=map_demo_labels(shift_px), correlation="gaussian",
+                        exposure_s=exposure, seed=31 + k if seed is None else seed, **_camera())
+
+
+def write_map_demo(folder):
+    """A flat sample with three regions of known σ/T (one per class), lit at 30° and 45°; its
+    capture file with the regions named for the map's statistics."""
     folder = pathlib.Path(folder)
-    band = MAP_SIZE // 3
-    cols = np.arange(MAP_SIZE)
-    labels = np.repeat(np.minimum(cols // band, 2)[None, :], MAP_SIZE, axis=0).astype(np.int32)
-    ratios = [r for _, r in MAP_REGIONS]
     captures = []
     for k, theta in enumerate((30.0, 45.0)):
         sub = folder / f"capture{k + 1}"
         sub.mkdir(parents=True, exist_ok=True)
         peak = max(_peak(scene="plane", theta_i_deg=theta, sigma_over_T=r,
-                         correlation="gaussian") for r in ratios)
+                         correlation="gaussian") for _, r in MAP_REGIONS)
         exposure = _exposure(peak)
-        _core.write_capture(str(sub), "tiff", scene="plane", width=MAP_SIZE, height=MAP_SIZE,
-                            theta_i_deg=theta, sigma_over_T=ratios, labels=labels,
-                            correlation="gaussian", exposure_s=exposure, seed=31 + k,
-                            **_camera())
+        write_map_capture(sub, k, theta, exposure)
         captures.append({"image": f"capture{k + 1}/capture.tiff", "theta_i_deg": theta,
                          "exposure_s": exposure})
-    regions = []
-    for k, (name, _) in enumerate(MAP_REGIONS):
-        x0 = k * band + MAP_WINDOW_PX
-        regions.append({"name": name, "rect": [x0, 0, band - 2 * MAP_WINDOW_PX, MAP_SIZE]})
     spec = {"format": "roughscope-measure",
             "description": "synthetic flat sample, three regions",
             "black_level_dn": DEMO_BLACK,
-            "maps": {"window_px": MAP_WINDOW_PX, "regions": regions},
+            "maps": {"window_px": MAP_WINDOW_PX, "regions": map_demo_regions()},
             "captures": captures}
     path = folder / "capture-file.json"
     path.write_text(json.dumps(spec, indent=2) + "\n", encoding="utf-8")

@@ -60,6 +60,7 @@ struct Accumulator {
 
 struct RegionAccumulator {
     Accumulator gaussian, exponential, T;
+    Accumulator log_ratio;  // ln(E1/E2) of the region's tiles/pixels
     std::size_t missing = 0;
     std::array<std::size_t, 3> classes{};
 };
@@ -814,7 +815,20 @@ void allocate_layer(std::vector<T>& layer, std::size_t n, T fill) {
     layer.assign(n, fill);
 }
 
-void summarise(const MapOptions& o, RoughnessMap& map,
+// σ/T of a region of a flat sample: the inverse at the mean of its cells' ln(E1/E2), with the
+// standard error of that mean through the inverse's slope. Averaging the cells' σ/T instead is
+// biased where the inverse is curved and the cells are noisy (large σ/T, where E1/E2 hardly
+// changes with σ/T).
+std::optional<Estimate> pooled_sigma_over_T(const RatioInverseTable& table,
+                                            const Accumulator& log_ratio) {
+    const auto mean = log_ratio.mean();
+    if (!mean) return std::nullopt;
+    const auto v = table.lookup(mean->value);
+    if (!v) return std::nullopt;
+    return Estimate{v->x, std::abs(v->dx_dlog_ratio) * mean->std_error};
+}
+
+void summarise(const std::vector<MapCapture>& captures, const MapOptions& o, RoughnessMap& map,
                const std::vector<std::int32_t>& cell_region) {
     std::array<Accumulator, 3> classes;
     std::vector<RegionAccumulator> regions(o.region_names.size());
@@ -827,6 +841,9 @@ void summarise(const MapOptions& o, RoughnessMap& map,
         const std::int32_t region = cell_region.empty() ? -1 : cell_region[i];
         if (region >= 0 && !map.T_um.empty() && std::isfinite(map.T_um[i]))
             regions[static_cast<std::size_t>(region)].T.add(map.T_um[i]);
+        if (region >= 0 && std::isfinite(map.E1_over_E2[i]) && map.E1_over_E2[i] > 0.0f)
+            regions[static_cast<std::size_t>(region)].log_ratio.add(
+                std::log(static_cast<double>(map.E1_over_E2[i])));
         if (c == kClassNone) {
             if (region >= 0) ++regions[static_cast<std::size_t>(region)].missing;
             continue;
@@ -848,14 +865,29 @@ void summarise(const MapOptions& o, RoughnessMap& map,
             map.valid > 0 ? static_cast<double>(s.count) / static_cast<double>(map.valid) : 0.0;
         s.mean_sigma_over_T = classes[c].mean();
     }
+    std::optional<RatioInverseTable> table_g, table_e;
+    if (o.normal_map.empty() && !regions.empty()) {
+        TwoGeometryOptions model;
+        model.factor = o.factor;
+        model.radiometry = o.radiometry;
+        model.wavelength_um = o.wavelength_um;
+        table_g = RatioInverseTable::sigma_over_T(captures[0].geometry, captures[1].geometry,
+                                                  Correlation::Gaussian, model, o.table);
+        table_e = RatioInverseTable::sigma_over_T(captures[0].geometry, captures[1].geometry,
+                                                  Correlation::Exponential, model, o.table);
+    }
     for (std::size_t k = 0; k < regions.size(); ++k) {
         RegionMapStatistics s;
         s.name = o.region_names[k];
         const RegionAccumulator& ra = regions[k];
         s.count = ra.classes[0] + ra.classes[1] + ra.classes[2];
         s.missing = ra.missing;
-        s.mean_sigma_over_T_gaussian = ra.gaussian.mean();
-        s.mean_sigma_over_T_exponential = ra.exponential.mean();
+        // A flat sample: pooled over the region (one geometry); a normal map: the mean of the
+        // cells' σ/T (each cell has its own geometry).
+        s.mean_sigma_over_T_gaussian =
+            table_g ? pooled_sigma_over_T(*table_g, ra.log_ratio) : ra.gaussian.mean();
+        s.mean_sigma_over_T_exponential =
+            table_e ? pooled_sigma_over_T(*table_e, ra.log_ratio) : ra.exponential.mean();
         s.mean_T_um = ra.T.mean();
         s.class_counts = ra.classes;
         map.regions.push_back(std::move(s));
@@ -950,7 +982,7 @@ RoughnessMap roughness_map(const std::vector<MapCapture>& captures, const MapOpt
     map.missing = counts.missing;
     map.no_solution = counts.no_solution;
     map.no_solution_exponential = counts.no_solution_exponential;
-    summarise(o, map, cell_region);
+    summarise(captures, o, map, cell_region);
     if (map.no_solution > 0)
         map.warnings.push_back(concat("roughness map: ", std::to_string(map.no_solution), " of ",
                                       std::to_string(cells),

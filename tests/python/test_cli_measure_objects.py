@@ -110,16 +110,18 @@ def test_cylinder_text_report_lists_the_departures(cylinder):
 def test_cylinder_given_axis_agrees_with_the_detected_one(cylinder):
     doc = json.loads(run(cylinder, "--json").stdout)
     axis = doc["cylinder"]["axis"]
-    assert axis["source"] == "detected"
+    assert axis["source"] == "given"
+    assert axis["point_px"] == [100, 80] and axis["radius_px"] == 64
 
-    def given(d):
-        d["object"]["axis"] = {"point_px": axis["point_px"], "direction": axis["direction"],
-                               "radius_px": axis["radius_px"]}
+    def detected(d):
+        del d["object"]["axis"]
 
-    doc2 = json.loads(run(edited(cylinder, "axis", given), "--json").stdout)
-    assert doc2["cylinder"]["axis"]["source"] == "given"
-    assert doc2["cylinder"]["sigma_over_T_gaussian"] == pytest.approx(
-        doc["cylinder"]["sigma_over_T_gaussian"], rel=1e-6)
+    doc2 = json.loads(run(edited(cylinder, "axis", detected), "--json").stdout)
+    axis2 = doc2["cylinder"]["axis"]
+    assert axis2["source"] == "detected"
+    # The axis line itself is found to a fraction of a pixel (the radius is short: a dark limb).
+    assert axis2["point_px"][0] == pytest.approx(100, abs=0.5)
+    assert abs(axis2["direction"][0]) < 0.01 and axis2["radius_px"] < 64
 
 
 @pytest.mark.parametrize("change,words", [
@@ -167,10 +169,7 @@ def test_sphere_comparison_prefers_the_true_model(sphere):
     fit = comp["models"]["vh_gaussian_fit"]
     value, err = fit["parameters"]["sigma_over_T"], fit["standard_errors"]["sigma_over_T"]
     assert err > 0 and abs(value - report_objects.SPHERE_SIGMA_OVER_T) <= 4 * err, (value, err)
-    circle = sph["circle"]
-    # The renderer's default radius: 0.4 · min(width, height) pixels, centred.
-    assert circle["radius_px"] == pytest.approx(0.4 * 160, abs=0.5)
-    assert circle["centre_x_px"] == pytest.approx(80, abs=0.5)
+    assert sph["circle"]["source"] == "given" and sph["circle"]["radius_px"] == 64
 
 
 def test_sphere_with_a_map_request_is_refused(sphere):
@@ -205,10 +204,10 @@ def test_map_regions_recover_the_truth_and_files_are_written(flat_map, tmp_path)
     assert sorted(m["files"]) == sorted(p.name for p in out.iterdir())
     layer = np.load(out / "sigma_over_T_gaussian.npy")
     assert layer.shape == (m["height"], m["width"]) and layer.dtype == np.float32
-    # The .npy agrees with the region statistics: the mean over the middle band's tiles.
-    band = report_objects.MAP_SIZE // 3 // report_objects.MAP_WINDOW_PX
-    middle = layer[:, band + 1:2 * band - 1]
-    assert np.nanmean(middle) == pytest.approx(truth["moderately rough"], rel=0.1)
+    # The .npy agrees with the region statistics: the mean over the top right quarter's tiles.
+    q = report_objects.MAP_SIZE // 2 // report_objects.MAP_WINDOW_PX
+    quarter = layer[1:q - 1, q + 1:2 * q - 1]
+    assert np.nanmean(quarter) == pytest.approx(truth["moderately rough"], rel=0.1)
     # The Python module returns the same layers.
     import roughscope
 
@@ -220,28 +219,15 @@ def test_map_regions_recover_the_truth_and_files_are_written(flat_map, tmp_path)
 
 
 def test_a_shifted_pair_is_refused_with_the_shift(flat_map, tmp_path):
-    import roughscope
-
     folder = pathlib.Path(flat_map).parent
     spec = json.loads(pathlib.Path(flat_map).read_text())
-    # The second photograph moved 5 px to the right.
-    second = roughscope.read_image(str(folder / spec["captures"][1]["image"]))
-    assert second["values"].shape[0] == 1
     from roughscope import report_objects
-    import numpy as np
 
+    # The second photograph moved 5 px to the right.
     shifted_dir = folder / "shifted"
     shifted_dir.mkdir(exist_ok=True)
-    # Re-render the second capture with labels and truth moved by 5 columns.
-    size = report_objects.MAP_SIZE
-    band = size // 3
-    cols = np.arange(size) - 5
-    labels = np.repeat(np.clip(cols // band, 0, 2)[None, :], size, axis=0).astype(np.int32)
-    roughscope.write_capture(str(shifted_dir), "tiff", scene="plane", width=size, height=size,
-                             theta_i_deg=45.0, sigma_over_T=[r for _, r in report_objects.MAP_REGIONS],
-                             labels=labels, correlation="gaussian",
-                             exposure_s=spec["captures"][1]["exposure_s"], seed=32,
-                             **report_objects._camera())
+    report_objects.write_map_capture(shifted_dir, 1, 45.0, spec["captures"][1]["exposure_s"],
+                                     shift_px=5)
     spec["captures"][1]["image"] = "shifted/capture.tiff"
     path = folder / "shifted.json"
     path.write_text(json.dumps(spec))

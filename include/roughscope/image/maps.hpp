@@ -178,8 +178,12 @@ struct RegionMapStatistics {
     std::string name;
     std::size_t count = 0;  // valid pixels/tiles wholly in the region
     std::size_t missing = 0;
-    std::optional<Estimate> mean_sigma_over_T_gaussian;     // mean, its standard error
-    std::optional<Estimate> mean_sigma_over_T_exponential;  // (sd / √count)
+    // σ/T of the region with its standard error. A flat sample: the inverse (Eq. 17 / 19 or the
+    // two-geometry model) at the mean of the cells' ln(E1/E2), its error the standard error of
+    // that mean through the inverse's slope (unbiased where the cells' σ/T are noisy and the
+    // inverse curved). A normal map: the mean of the cells' σ/T, error sd / √count.
+    std::optional<Estimate> mean_sigma_over_T_gaussian;
+    std::optional<Estimate> mean_sigma_over_T_exponential;
     std::optional<Estimate> mean_T_um;                      // σ known
     std::array<std::size_t, 3> class_counts{};              // by σ/T (RoughnessClass order)
 };
