@@ -20,7 +20,8 @@ namespace roughscope::image {
 
 struct SilhouetteOptions {
     // Level (linear scale, channel average) separating object from background. None: automatic
-    // — Otsu's threshold t_O on the channel average (OpenCV), then the edge level
+    // — Otsu's threshold t_O on the channel average (OpenCV; of a regular subsample of at most
+    // 2^20 pixels), then the edge level
     // t = min(t_O, μ_b + max(6 s_b, edge_fraction · (μ_o − μ_b))) with μ_b, s_b the median and
     // 1.4826 · MAD of the pixels below t_O (robust to the object's dark limb, which is below t_O
     // too) and μ_o the mean of those above: low enough to follow a limb that darkens towards the
@@ -63,10 +64,11 @@ struct Silhouette {
     }
 };
 
-// Finds the object: the largest 8-connected component above the level, with its holes (dark
-// areas not connected to the image border) filled. Throws InvalidArgument for an inconsistent image
-// (check_linear_image) or bad options, DataError when no object is found (uniform image, component
-// below min_object_fraction, no background pixel).
+// Finds the object: the largest 8-connected component above the level, with the gaps along each
+// row between its first and last pixel filled (dark texture, a flagged pixel: the objects here,
+// cylinders and spheres seen whole, are convex along image rows). Throws InvalidArgument for an
+// inconsistent image (check_linear_image) or bad options, DataError when no object is found
+// (uniform image, component below min_object_fraction, no background pixel).
 Silhouette find_silhouette(const LinearImage& image, const SilhouetteOptions& options = {});
 
 // ---------------------------------------------------------------------------------------------
