@@ -90,7 +90,6 @@ Silhouette find_silhouette(const LinearImage& image, const SilhouetteOptions& op
                                      "3 x 3 and below 2^31 pixels"));
     std::vector<float> avg_storage;
     const std::span<const float> avg = channel_average(image, avg_storage);
-    const int rows = static_cast<int>(h), cols = static_cast<int>(w);
 
     Silhouette s;
     s.width = w;
@@ -98,34 +97,35 @@ Silhouette find_silhouette(const LinearImage& image, const SilhouetteOptions& op
     if (options.threshold) {
         s.threshold = *options.threshold;
     } else {
-        const auto [lo_it, hi_it] = std::minmax_element(avg.begin(), avg.end());
+        // Every statistic of the level from a regular subsample of at most 2^20 pixels.
+        const std::size_t step = std::max<std::size_t>(1, n >> 20);
+        std::vector<float> sample;
+        sample.reserve(n / step + 1);
+        for (std::size_t i = 0; i < n; i += step) sample.push_back(avg[i]);
+        const auto [lo_it, hi_it] = std::minmax_element(sample.begin(), sample.end());
         const double lo = *lo_it, hi = *hi_it;
         if (!(hi > lo))
             throw DataError(concat(image_name(image), ": no object found (the image is uniform, ",
                                    format_number(lo), ")"));
-        // Otsu on a regular subsample of at most 2^20 pixels (its histogram is the image's to
-        // sampling noise), scaled to 8 bits between the image's extremes.
-        const std::size_t step = std::max<std::size_t>(1, n >> 20);
-        cv::Mat u8(1, static_cast<int>((n + step - 1) / step), CV_8UC1);
+        // Otsu on the subsample scaled to 8 bits between its extremes.
+        cv::Mat u8(1, static_cast<int>(sample.size()), CV_8UC1);
         const double scale = 255.0 / (hi - lo);
-        for (std::size_t i = 0, k = 0; i < n; i += step, ++k)
+        for (std::size_t k = 0; k < sample.size(); ++k)
             u8.data[k] =
-                static_cast<std::uint8_t>((static_cast<double>(avg[i]) - lo) * scale + 0.5);
+                static_cast<std::uint8_t>((static_cast<double>(sample[k]) - lo) * scale + 0.5);
         cv::Mat unused;
         const double t8 = cv::threshold(u8, unused, 0, 255, cv::THRESH_BINARY | cv::THRESH_OTSU);
         const double t_otsu = lo + (t8 + 0.5) / scale;
         s.otsu_threshold = t_otsu;
         // Background level and noise: median and 1.4826 · MAD of the pixels below t_O (robust
-        // to the dark limb of the object, which falls below t_O too), on a regular subsample of
-        // at most 2^20 pixels; object level: mean of the pixels above t_O.
-        const std::size_t stride = std::max<std::size_t>(1, n >> 20);
+        // to the dark limb of the object, which falls below t_O too); object level: mean of the
+        // pixels above t_O.
         std::vector<float> below;
         double so = 0;
         std::size_t no = 0;
-        for (std::size_t i = 0; i < n; ++i) {
-            const float v = avg[i];
+        for (const float v : sample) {
             if (v <= t_otsu) {
-                if (i % stride == 0) below.push_back(v);
+                below.push_back(v);
             } else {
                 so += v;
                 ++no;
@@ -145,12 +145,26 @@ Silhouette find_silhouette(const LinearImage& image, const SilhouetteOptions& op
         s.threshold = std::min(t_otsu, mb + std::max(6.0 * sdb, options.edge_fraction * (mo - mb)));
     }
 
-    // Largest 8-connected component above the level.
-    cv::Mat bin(rows, cols, CV_8UC1);
+    // Largest 8-connected component above the level, found on the mask reduced by f × f blocks
+    // (a block is on when any of its pixels is; f = ⌊√(n / 2^20)⌋, 1 below 2^21 pixels): the
+    // object's mask is then its pixels above the level in the blocks of that component.
+    const std::size_t f =
+        std::max<std::size_t>(1, static_cast<std::size_t>(std::sqrt(static_cast<double>(n >> 20))));
+    const std::size_t sw = (w + f - 1) / f, sh = (h + f - 1) / f;
     const auto t = static_cast<float>(s.threshold);
-    for (std::size_t i = 0; i < n; ++i) bin.data[i] = avg[i] > t ? 1 : 0;
+    cv::Mat small = cv::Mat::zeros(static_cast<int>(sh), static_cast<int>(sw), CV_8UC1);
+    for (std::size_t r = 0; r < h; ++r) {
+        const float* a = avg.data() + r * w;
+        std::uint8_t* b = small.data + (r / f) * sw;
+        if (f == 1) {
+            for (std::size_t c = 0; c < w; ++c) b[c] = a[c] > t ? 1 : 0;
+        } else {
+            for (std::size_t c = 0; c < w; ++c)
+                if (a[c] > t) b[c / f] = 1;
+        }
+    }
     cv::Mat labels, stats, centroids;
-    const int count = cv::connectedComponentsWithStats(bin, labels, stats, centroids, 8, CV_32S);
+    const int count = cv::connectedComponentsWithStats(small, labels, stats, centroids, 8, CV_32S);
     int best = 0, best_area = 0;
     for (int k = 1; k < count; ++k) {
         const int area = stats.at<int>(k, cv::CC_STAT_AREA);
@@ -159,29 +173,35 @@ Silhouette find_silhouette(const LinearImage& image, const SilhouetteOptions& op
             best = k;
         }
     }
+    const auto* lab = labels.ptr<std::int32_t>(0);
+    s.mask.assign(n, 0);
+    std::size_t object_pixels = 0;
+    if (best != 0) {
+        // The mask, with the gaps along each row between its first and last pixel filled (the
+        // objects measured here — a cylinder or a sphere seen whole — are convex along rows).
+        for (std::size_t r = 0; r < h; ++r) {
+            const float* a = avg.data() + r * w;
+            const std::int32_t* lr = lab + (r / f) * sw;
+            std::uint8_t* m = s.mask.data() + r * w;
+            std::size_t first = w, last = 0;
+            for (std::size_t c = 0; c < w; ++c)
+                if (a[c] > t && lr[c / f] == best) {
+                    if (first == w) first = c;
+                    last = c;
+                }
+            if (first < w) {
+                std::fill(m + first, m + last + 1, std::uint8_t{1});
+                object_pixels += last + 1 - first;
+            }
+        }
+    }
     if (best == 0 ||
-        static_cast<double>(best_area) < options.min_object_fraction * static_cast<double>(n))
+        static_cast<double>(object_pixels) < options.min_object_fraction * static_cast<double>(n))
         throw DataError(
             concat(image_name(image), ": no object found: the largest region brighter than ",
-                   format_number(s.threshold), " covers ", std::to_string(best_area), " of ",
+                   format_number(s.threshold), " covers ", std::to_string(object_pixels), " of ",
                    std::to_string(n), " pixels, below the minimum object fraction ",
                    format_number(options.min_object_fraction)));
-    s.mask.assign(n, 0);
-    const auto* lab = labels.ptr<std::int32_t>(0);
-    for (std::size_t i = 0; i < n; ++i) s.mask[i] = lab[i] == best ? 1 : 0;
-
-    // Fill holes along rows: every pixel between a row's first and last object pixel (the
-    // objects measured here — a cylinder or a sphere seen whole — are convex along image rows).
-    for (std::size_t r = 0; r < h; ++r) {
-        std::uint8_t* m = s.mask.data() + r * w;
-        std::size_t first = w, last = 0;
-        for (std::size_t c = 0; c < w; ++c)
-            if (m[c]) {
-                first = std::min(first, c);
-                last = c;
-            }
-        if (first < w) std::fill(m + first, m + last + 1, std::uint8_t{1});
-    }
 
     // Counts, centroid, bounding box, border contacts.
     double sx = 0, sy = 0;
