@@ -111,8 +111,8 @@ Silhouette find_silhouette(const LinearImage& image, const SilhouetteOptions& op
         cv::Mat u8(1, static_cast<int>(sample.size()), CV_8UC1);
         const double scale = 255.0 / (hi - lo);
         for (std::size_t k = 0; k < sample.size(); ++k)
-            u8.data[k] =
-                static_cast<std::uint8_t>((static_cast<double>(sample[k]) - lo) * scale + 0.5);
+            u8.data[k] = static_cast<std::uint8_t>(
+                std::lround((static_cast<double>(sample[k]) - lo) * scale));
         cv::Mat unused;
         const double t8 = cv::threshold(u8, unused, 0, 255, cv::THRESH_BINARY | cv::THRESH_OTSU);
         const double t_otsu = lo + (t8 + 0.5) / scale;
@@ -510,7 +510,6 @@ CylinderAxis fit_cylinder_axis(const Silhouette& silhouette, const CylinderAxisO
                 " on the other side): the object touches the image border along its side or is "
                 "not a cylinder seen side-on; frame both edges or give the axis"));
     auto fit_side = [&](Side& side) {
-        std::vector<char> keep(side.tv.size(), 1);
         // First pass: median of d (robust start), then least squares on the inliers twice.
         std::vector<double> ds;
         ds.reserve(side.tv.size());
@@ -523,8 +522,7 @@ CylinderAxis fit_cylinder_axis(const Silhouette& silhouette, const CylinderAxisO
             double St = 0, Sd = 0, Stt = 0, Std = 0, N = 0;
             for (std::size_t i = 0; i < side.tv.size(); ++i) {
                 const double t = side.tv[i].x(), d = side.tv[i].y();
-                keep[i] = std::abs(d - side.alpha - side.beta * t) <= options.outlier_px;
-                if (!keep[i]) continue;
+                if (std::abs(d - side.alpha - side.beta * t) > options.outlier_px) continue;
                 St += t;
                 Sd += d;
                 Stt += t * t;
