@@ -13,6 +13,7 @@
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "object_profile.hpp"
 #include "roughscope/core/errors.hpp"
 #include "roughscope/core/text.hpp"
 #include "roughscope/scattering/geometry.hpp"
@@ -79,6 +80,11 @@ double crossing_fraction(float ai, float ao, float ai2, float ao2) {
 
 Silhouette find_silhouette(const LinearImage& image, const SilhouetteOptions& options) {
     check_linear_image(image);
+    return detail::find_silhouette_of_checked_image(image, options);
+}
+
+Silhouette detail::find_silhouette_of_checked_image(const LinearImage& image,
+                                                    const SilhouetteOptions& options) {
     check_fraction("silhouette edge_fraction", options.edge_fraction);
     check_fraction("silhouette min_object_fraction", options.min_object_fraction);
     if (options.threshold && !std::isfinite(*options.threshold))
@@ -176,6 +182,9 @@ Silhouette find_silhouette(const LinearImage& image, const SilhouetteOptions& op
     const auto* lab = labels.ptr<std::int32_t>(0);
     s.mask.assign(n, 0);
     std::size_t object_pixels = 0;
+    double sx = 0, sy = 0;
+    s.col_min = w;
+    s.row_min = h;
     if (best != 0) {
         // The mask, with the gaps along each row between its first and last pixel filled (the
         // objects measured here — a cylinder or a sphere seen whole — are convex along rows).
@@ -191,7 +200,15 @@ Silhouette find_silhouette(const LinearImage& image, const SilhouetteOptions& op
                 }
             if (first < w) {
                 std::fill(m + first, m + last + 1, std::uint8_t{1});
-                object_pixels += last + 1 - first;
+                const std::size_t run = last + 1 - first;
+                object_pixels += run;
+                // Counts, centroid, bounding box of the filled rows.
+                sx += 0.5 * static_cast<double>(first + last) * static_cast<double>(run);
+                sy += static_cast<double>(r) * static_cast<double>(run);
+                s.col_min = std::min(s.col_min, first);
+                s.col_max = std::max(s.col_max, last + 1);
+                s.row_min = std::min(s.row_min, r);
+                s.row_max = r + 1;
             }
         }
     }
@@ -203,29 +220,7 @@ Silhouette find_silhouette(const LinearImage& image, const SilhouetteOptions& op
                    std::to_string(n), " pixels, below the minimum object fraction ",
                    format_number(options.min_object_fraction)));
 
-    // Counts, centroid, bounding box, border contacts.
-    double sx = 0, sy = 0;
-    s.col_min = w;
-    s.row_min = h;
-    for (std::size_t r = 0; r < h; ++r) {
-        const std::uint8_t* m = s.mask.data() + r * w;
-        std::size_t row_count = 0;
-        double row_sx = 0;
-        for (std::size_t c = 0; c < w; ++c)
-            if (m[c]) {
-                ++row_count;
-                row_sx += static_cast<double>(c);
-                s.col_min = std::min(s.col_min, c);
-                s.col_max = std::max(s.col_max, c + 1);
-            }
-        if (row_count) {
-            s.row_min = std::min(s.row_min, r);
-            s.row_max = r + 1;
-            s.pixel_count += row_count;
-            sx += row_sx;
-            sy += static_cast<double>(r) * static_cast<double>(row_count);
-        }
-    }
+    s.pixel_count = object_pixels;
     const auto np = static_cast<double>(s.pixel_count);
     s.centroid_x_px = sx / np + 0.5;
     s.centroid_y_px = sy / np + 0.5;

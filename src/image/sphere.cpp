@@ -71,7 +71,8 @@ SphereResult measure_sphere(const LinearImage& image, const std::vector<std::uin
         out.circle = *options.circle;
     } else {
         out.circle =
-            fit_sphere_circle(find_silhouette(image, options.silhouette), options.circle_fit);
+            fit_sphere_circle(detail::find_silhouette_of_checked_image(image, options.silhouette),
+                              options.circle_fit);
         out.circle_detected = true;
     }
     const double cx = out.circle.centre_x_px, cy = out.circle.centre_y_px;
