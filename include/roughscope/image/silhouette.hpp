@@ -3,6 +3,10 @@
 // or the two straight edges (cylinder) that give the object's geometry. Formulas in
 // docs/curved-objects.md.
 //
+// The silhouette is the lit outline: where the surface darkens to the background before its limb
+// (light at the camera, a narrow very-rough lobe) the detected circle or edges are short of the
+// object's — give them instead (docs/curved-objects.md).
+//
 // Image coordinates: x to the right, y down, pixel (col, row) has its centre at (col + ½, row + ½)
 // (docs/image-regions.md). All lengths here are pixels (_px).
 #pragma once
