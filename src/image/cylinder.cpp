@@ -174,7 +174,7 @@ CylinderProfile measure_cylinder_profile(const LinearImage& image,
                                            options.axis->direction_x, options.axis->direction_y,
                                            options.axis->radius_px);
     } else {
-        Silhouette s = find_silhouette(image, options.silhouette);
+        Silhouette s = detail::find_silhouette_of_checked_image(image, options.silhouette);
         out.axis = fit_cylinder_axis(s, options.axis_fit);
         object = std::move(s.mask);
     }

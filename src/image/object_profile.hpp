@@ -13,6 +13,11 @@
 
 namespace roughscope::image::detail {
 
+// find_silhouette without check_linear_image (the caller has checked the image: one pass over
+// the pixels less).
+Silhouette find_silhouette_of_checked_image(const LinearImage& image,
+                                            const SilhouetteOptions& options);
+
 // InvalidArgument unless v is finite with |‖v‖ − 1| ≤ 1e−6.
 void check_unit_direction(std::string_view name, const Eigen::Vector3d& v);
 

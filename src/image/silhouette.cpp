@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -12,6 +13,7 @@
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "object_profile.hpp"
 #include "roughscope/core/errors.hpp"
 #include "roughscope/core/text.hpp"
 #include "roughscope/scattering/geometry.hpp"
@@ -25,16 +27,17 @@ std::string image_name(const LinearImage& image) {
     return image.info.source.empty() ? std::string("image") : image.info.source;
 }
 
-// The per-pixel channel average (R + G + B)/3, row-major.
-std::vector<float> channel_average(const LinearImage& image) {
+// The per-pixel channel average (R + G + B)/3, row-major: the plane itself for a grey image
+// (no copy), else computed into `storage`.
+std::span<const float> channel_average(const LinearImage& image, std::vector<float>& storage) {
     const std::size_t n = image.pixel_count();
-    std::vector<float> avg(image.plane(0), image.plane(0) + n);
-    if (image.channels == 3) {
-        const float* g = image.plane(1);
-        const float* b = image.plane(2);
-        for (std::size_t i = 0; i < n; ++i) avg[i] = (avg[i] + g[i] + b[i]) * (1.0F / 3.0F);
-    }
-    return avg;
+    if (image.channels == 1) return {image.plane(0), n};
+    storage.resize(n);
+    const float* r = image.plane(0);
+    const float* g = image.plane(1);
+    const float* b = image.plane(2);
+    for (std::size_t i = 0; i < n; ++i) storage[i] = (r[i] + g[i] + b[i]) * (1.0F / 3.0F);
+    return storage;
 }
 
 void check_fraction(std::string_view name, double value) {
@@ -77,6 +80,11 @@ double crossing_fraction(float ai, float ao, float ai2, float ao2) {
 
 Silhouette find_silhouette(const LinearImage& image, const SilhouetteOptions& options) {
     check_linear_image(image);
+    return detail::find_silhouette_of_checked_image(image, options);
+}
+
+Silhouette detail::find_silhouette_of_checked_image(const LinearImage& image,
+                                                    const SilhouetteOptions& options) {
     check_fraction("silhouette edge_fraction", options.edge_fraction);
     check_fraction("silhouette min_object_fraction", options.min_object_fraction);
     if (options.threshold && !std::isfinite(*options.threshold))
@@ -86,8 +94,8 @@ Silhouette find_silhouette(const LinearImage& image, const SilhouetteOptions& op
         throw InvalidArgument(concat(image_name(image),
                                      ": a silhouette needs an image of at least "
                                      "3 x 3 and below 2^31 pixels"));
-    const std::vector<float> avg = channel_average(image);
-    const int rows = static_cast<int>(h), cols = static_cast<int>(w);
+    std::vector<float> avg_storage;
+    const std::span<const float> avg = channel_average(image, avg_storage);
 
     Silhouette s;
     s.width = w;
@@ -95,31 +103,35 @@ Silhouette find_silhouette(const LinearImage& image, const SilhouetteOptions& op
     if (options.threshold) {
         s.threshold = *options.threshold;
     } else {
-        const auto [lo_it, hi_it] = std::minmax_element(avg.begin(), avg.end());
+        // Every statistic of the level from a regular subsample of at most 2^20 pixels.
+        const std::size_t step = std::max<std::size_t>(1, n >> 20);
+        std::vector<float> sample;
+        sample.reserve(n / step + 1);
+        for (std::size_t i = 0; i < n; i += step) sample.push_back(avg[i]);
+        const auto [lo_it, hi_it] = std::minmax_element(sample.begin(), sample.end());
         const double lo = *lo_it, hi = *hi_it;
         if (!(hi > lo))
             throw DataError(concat(image_name(image), ": no object found (the image is uniform, ",
                                    format_number(lo), ")"));
-        cv::Mat u8(rows, cols, CV_8UC1);
+        // Otsu on the subsample scaled to 8 bits between its extremes.
+        cv::Mat u8(1, static_cast<int>(sample.size()), CV_8UC1);
         const double scale = 255.0 / (hi - lo);
-        for (std::size_t i = 0; i < n; ++i)
-            u8.data[i] =
-                static_cast<std::uint8_t>(std::lround((static_cast<double>(avg[i]) - lo) * scale));
+        for (std::size_t k = 0; k < sample.size(); ++k)
+            u8.data[k] = static_cast<std::uint8_t>(
+                std::lround((static_cast<double>(sample[k]) - lo) * scale));
         cv::Mat unused;
         const double t8 = cv::threshold(u8, unused, 0, 255, cv::THRESH_BINARY | cv::THRESH_OTSU);
         const double t_otsu = lo + (t8 + 0.5) / scale;
         s.otsu_threshold = t_otsu;
         // Background level and noise: median and 1.4826 · MAD of the pixels below t_O (robust
-        // to the dark limb of the object, which falls below t_O too), on a regular subsample of
-        // at most 2^20 pixels; object level: mean of the pixels above t_O.
-        const std::size_t stride = std::max<std::size_t>(1, n >> 20);
+        // to the dark limb of the object, which falls below t_O too); object level: mean of the
+        // pixels above t_O.
         std::vector<float> below;
         double so = 0;
         std::size_t no = 0;
-        for (std::size_t i = 0; i < n; ++i) {
-            const float v = avg[i];
+        for (const float v : sample) {
             if (v <= t_otsu) {
-                if (i % stride == 0) below.push_back(v);
+                below.push_back(v);
             } else {
                 so += v;
                 ++no;
@@ -139,12 +151,26 @@ Silhouette find_silhouette(const LinearImage& image, const SilhouetteOptions& op
         s.threshold = std::min(t_otsu, mb + std::max(6.0 * sdb, options.edge_fraction * (mo - mb)));
     }
 
-    // Largest 8-connected component above the level.
-    cv::Mat bin(rows, cols, CV_8UC1);
+    // Largest 8-connected component above the level, found on the mask reduced by f × f blocks
+    // (a block is on when any of its pixels is; f = ⌊√(n / 2^20)⌋, 1 below 2^21 pixels): the
+    // object's mask is then its pixels above the level in the blocks of that component.
+    const std::size_t f =
+        std::max<std::size_t>(1, static_cast<std::size_t>(std::sqrt(static_cast<double>(n >> 20))));
+    const std::size_t sw = (w + f - 1) / f, sh = (h + f - 1) / f;
     const auto t = static_cast<float>(s.threshold);
-    for (std::size_t i = 0; i < n; ++i) bin.data[i] = avg[i] > t ? 1 : 0;
+    cv::Mat small = cv::Mat::zeros(static_cast<int>(sh), static_cast<int>(sw), CV_8UC1);
+    for (std::size_t r = 0; r < h; ++r) {
+        const float* a = avg.data() + r * w;
+        std::uint8_t* b = small.data + (r / f) * sw;
+        if (f == 1) {
+            for (std::size_t c = 0; c < w; ++c) b[c] = a[c] > t ? 1 : 0;
+        } else {
+            for (std::size_t c = 0; c < w; ++c)
+                if (a[c] > t) b[c / f] = 1;
+        }
+    }
     cv::Mat labels, stats, centroids;
-    const int count = cv::connectedComponentsWithStats(bin, labels, stats, centroids, 8, CV_32S);
+    const int count = cv::connectedComponentsWithStats(small, labels, stats, centroids, 8, CV_32S);
     int best = 0, best_area = 0;
     for (int k = 1; k < count; ++k) {
         const int area = stats.at<int>(k, cv::CC_STAT_AREA);
@@ -153,60 +179,48 @@ Silhouette find_silhouette(const LinearImage& image, const SilhouetteOptions& op
             best = k;
         }
     }
-    if (best == 0 ||
-        static_cast<double>(best_area) < options.min_object_fraction * static_cast<double>(n))
-        throw DataError(
-            concat(image_name(image), ": no object found: the largest region brighter than ",
-                   format_number(s.threshold), " covers ", std::to_string(best_area), " of ",
-                   std::to_string(n), " pixels, below the minimum object fraction ",
-                   format_number(options.min_object_fraction)));
-    s.mask.assign(n, 0);
     const auto* lab = labels.ptr<std::int32_t>(0);
-    for (std::size_t i = 0; i < n; ++i) s.mask[i] = lab[i] == best ? 1 : 0;
-
-    // Fill holes: background components (4-connected) that do not reach the image border.
-    {
-        cv::Mat inv(rows, cols, CV_8UC1);
-        for (std::size_t i = 0; i < n; ++i) inv.data[i] = s.mask[i] ? 0 : 1;
-        cv::Mat bl;
-        const int nb = cv::connectedComponents(inv, bl, 4, CV_32S);
-        std::vector<std::uint8_t> border(static_cast<std::size_t>(nb), 0);
-        const auto* b = bl.ptr<std::int32_t>(0);
-        for (std::size_t c = 0; c < w; ++c) {
-            border[static_cast<std::size_t>(b[c])] = 1;
-            border[static_cast<std::size_t>(b[(h - 1) * w + c])] = 1;
-        }
-        for (std::size_t r = 0; r < h; ++r) {
-            border[static_cast<std::size_t>(b[r * w])] = 1;
-            border[static_cast<std::size_t>(b[r * w + w - 1])] = 1;
-        }
-        for (std::size_t i = 0; i < n; ++i)
-            if (!s.mask[i] && !border[static_cast<std::size_t>(b[i])]) s.mask[i] = 1;
-    }
-
-    // Counts, centroid, bounding box, border contacts.
+    s.mask.assign(n, 0);
+    std::size_t object_pixels = 0;
     double sx = 0, sy = 0;
     s.col_min = w;
     s.row_min = h;
-    for (std::size_t r = 0; r < h; ++r) {
-        const std::uint8_t* m = s.mask.data() + r * w;
-        std::size_t row_count = 0;
-        double row_sx = 0;
-        for (std::size_t c = 0; c < w; ++c)
-            if (m[c]) {
-                ++row_count;
-                row_sx += static_cast<double>(c);
-                s.col_min = std::min(s.col_min, c);
-                s.col_max = std::max(s.col_max, c + 1);
+    if (best != 0) {
+        // The mask, with the gaps along each row between its first and last pixel filled (the
+        // objects measured here — a cylinder or a sphere seen whole — are convex along rows).
+        for (std::size_t r = 0; r < h; ++r) {
+            const float* a = avg.data() + r * w;
+            const std::int32_t* lr = lab + (r / f) * sw;
+            std::uint8_t* m = s.mask.data() + r * w;
+            std::size_t first = w, last = 0;
+            for (std::size_t c = 0; c < w; ++c)
+                if (a[c] > t && lr[c / f] == best) {
+                    if (first == w) first = c;
+                    last = c;
+                }
+            if (first < w) {
+                std::fill(m + first, m + last + 1, std::uint8_t{1});
+                const std::size_t run = last + 1 - first;
+                object_pixels += run;
+                // Counts, centroid, bounding box of the filled rows.
+                sx += 0.5 * static_cast<double>(first + last) * static_cast<double>(run);
+                sy += static_cast<double>(r) * static_cast<double>(run);
+                s.col_min = std::min(s.col_min, first);
+                s.col_max = std::max(s.col_max, last + 1);
+                s.row_min = std::min(s.row_min, r);
+                s.row_max = r + 1;
             }
-        if (row_count) {
-            s.row_min = std::min(s.row_min, r);
-            s.row_max = r + 1;
-            s.pixel_count += row_count;
-            sx += row_sx;
-            sy += static_cast<double>(r) * static_cast<double>(row_count);
         }
     }
+    if (best == 0 ||
+        static_cast<double>(object_pixels) < options.min_object_fraction * static_cast<double>(n))
+        throw DataError(
+            concat(image_name(image), ": no object found: the largest region brighter than ",
+                   format_number(s.threshold), " covers ", std::to_string(object_pixels), " of ",
+                   std::to_string(n), " pixels, below the minimum object fraction ",
+                   format_number(options.min_object_fraction)));
+
+    s.pixel_count = object_pixels;
     const auto np = static_cast<double>(s.pixel_count);
     s.centroid_x_px = sx / np + 0.5;
     s.centroid_y_px = sy / np + 0.5;
@@ -491,7 +505,6 @@ CylinderAxis fit_cylinder_axis(const Silhouette& silhouette, const CylinderAxisO
                 " on the other side): the object touches the image border along its side or is "
                 "not a cylinder seen side-on; frame both edges or give the axis"));
     auto fit_side = [&](Side& side) {
-        std::vector<char> keep(side.tv.size(), 1);
         // First pass: median of d (robust start), then least squares on the inliers twice.
         std::vector<double> ds;
         ds.reserve(side.tv.size());
@@ -504,8 +517,7 @@ CylinderAxis fit_cylinder_axis(const Silhouette& silhouette, const CylinderAxisO
             double St = 0, Sd = 0, Stt = 0, Std = 0, N = 0;
             for (std::size_t i = 0; i < side.tv.size(); ++i) {
                 const double t = side.tv[i].x(), d = side.tv[i].y();
-                keep[i] = std::abs(d - side.alpha - side.beta * t) <= options.outlier_px;
-                if (!keep[i]) continue;
+                if (std::abs(d - side.alpha - side.beta * t) > options.outlier_px) continue;
                 St += t;
                 Sd += d;
                 Stt += t * t;

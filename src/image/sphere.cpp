@@ -22,9 +22,14 @@ std::string image_name(const LinearImage& image) {
 
 struct CellSums {
     double sum = 0, sum2 = 0, diff2 = 0;
-    double nx = 0, ny = 0, nz = 0;
+    double sx = 0, sy = 0, sxx = 0, syy = 0;  // pixel centres about the circle's centre, px
     std::uint32_t count = 0, diffs = 0;
 };
+
+// The second derivative at x1 of the parabola through (x0, y0), (x1, y1), (x2, y2).
+double second_derivative(double x0, double y0, double x1, double y1, double x2, double y2) {
+    return 2.0 * ((y2 - y1) / (x2 - x1) - (y1 - y0) / (x1 - x0)) / (x2 - x0);
+}
 
 }  // namespace
 
@@ -66,7 +71,8 @@ SphereResult measure_sphere(const LinearImage& image, const std::vector<std::uin
         out.circle = *options.circle;
     } else {
         out.circle =
-            fit_sphere_circle(find_silhouette(image, options.silhouette), options.circle_fit);
+            fit_sphere_circle(detail::find_silhouette_of_checked_image(image, options.silhouette),
+                              options.circle_fit);
         out.circle_detected = true;
     }
     const double cx = out.circle.centre_x_px, cy = out.circle.centre_y_px;
@@ -119,9 +125,11 @@ SphereResult measure_sphere(const LinearImage& image, const std::vector<std::uin
                         CellSums& cs = row_cells[c / k];
                         cs.sum += vd;
                         cs.sum2 += vd * vd;
-                        cs.nx += nx;
-                        cs.ny += ny;
-                        cs.nz += nz;
+                        const double px = nx * R, py = ny * R;
+                        cs.sx += px;
+                        cs.sy += py;
+                        cs.sxx += px * px;
+                        cs.syy += py * py;
                         ++cs.count;
                         if (left_cell == cell) {
                             const double diff = vd - left_value;
@@ -148,27 +156,60 @@ SphereResult measure_sphere(const LinearImage& image, const std::vector<std::uin
     std::vector<Row> rows;
     const double min_count = options.min_cell_fraction * static_cast<double>(k * k);
     std::size_t dropped = 0;
-    for (const CellSums& cs : cells) {
-        if (cs.count == 0) continue;
-        const auto n = static_cast<double>(cs.count);
-        if (n < min_count) {
-            ++dropped;
-            continue;
+    auto usable = [&](std::size_t gx, std::size_t gy) -> const CellSums* {
+        if (gx >= gw || gy >= gh) return nullptr;
+        const CellSums& cs = cells[gy * gw + gx];
+        return cs.count > 0 && static_cast<double>(cs.count) >= min_count ? &cs : nullptr;
+    };
+    const auto mean_of = [](const CellSums& c) { return c.sum / c.count; };
+    const auto cx_of = [](const CellSums& c) { return c.sx / c.count; };
+    const auto cy_of = [](const CellSums& c) { return c.sy / c.count; };
+    for (std::size_t gy = 0; gy < gh; ++gy)
+        for (std::size_t gx = 0; gx < gw; ++gx) {
+            const CellSums& cs = cells[gy * gw + gx];
+            if (cs.count == 0) continue;
+            if (!usable(gx, gy)) {
+                ++dropped;
+                continue;
+            }
+            const auto n = static_cast<double>(cs.count);
+            const double xm = cs.sx / n, ym = cs.sy / n;  // centroid, px about the centre
+            const double mean = cs.sum / n;
+            // Ē = E(centroid) + ½ (E_xx var_x + E_yy var_y) + ... (Taylor expansion over the
+            // cell): the value at the centroid, with the curvature from the parabola through
+            // the means of the cell and its two neighbours along each axis.
+            double value = mean;
+            if (k > 1) {
+                const CellSums* l = gx > 0 ? usable(gx - 1, gy) : nullptr;
+                const CellSums* rt = usable(gx + 1, gy);
+                if (l && rt)
+                    value -= 0.5 *
+                             second_derivative(cx_of(*l), mean_of(*l), xm, mean, cx_of(*rt),
+                                               mean_of(*rt)) *
+                             std::max(0.0, cs.sxx / n - xm * xm);
+                // Image rows go down, y (camera frame) up: the cell above has the larger y.
+                const CellSums* up = gy > 0 ? usable(gx, gy - 1) : nullptr;
+                const CellSums* dn = usable(gx, gy + 1);
+                if (up && dn)
+                    value -= 0.5 *
+                             second_derivative(cy_of(*dn), mean_of(*dn), ym, mean, cy_of(*up),
+                                               mean_of(*up)) *
+                             std::max(0.0, cs.syy / n - ym * ym);
+            }
+            const double nx = xm * inv_R, ny = ym * inv_R;
+            const Eigen::Vector3d normal(nx, ny, std::sqrt(std::max(0.0, 1.0 - nx * nx - ny * ny)));
+            const auto g = geometry_from_vectors(normal.normalized(), L, V);
+            if (!g || g->theta_i_rad >= kPi / 2 || g->theta_s_rad >= kPi / 2) {
+                ++dropped;
+                continue;
+            }
+            const double var =
+                cs.count > 1 ? std::max(0.0, (cs.sum2 - n * mean * mean) / (n - 1.0)) : 0.0;
+            const double noise_var =
+                cs.diffs >= 2 ? cs.diff2 / (2.0 * static_cast<double>(cs.diffs)) : var;
+            const double cos_i = std::cos(g->theta_i_rad);
+            rows.push_back(Row{*g, value / cos_i, std::sqrt(noise_var / n) / cos_i});
         }
-        const Eigen::Vector3d normal = Eigen::Vector3d(cs.nx, cs.ny, cs.nz).normalized();
-        const auto g = geometry_from_vectors(normal, L, V);
-        if (!g || g->theta_i_rad >= kPi / 2 || g->theta_s_rad >= kPi / 2) {
-            ++dropped;
-            continue;
-        }
-        const double mean = cs.sum / n;
-        const double var =
-            cs.count > 1 ? std::max(0.0, (cs.sum2 - n * mean * mean) / (n - 1.0)) : 0.0;
-        const double noise_var =
-            cs.diffs >= 2 ? cs.diff2 / (2.0 * static_cast<double>(cs.diffs)) : var;
-        const double cos_i = std::cos(g->theta_i_rad);
-        rows.push_back(Row{*g, mean / cos_i, std::sqrt(noise_var / n) / cos_i});
-    }
     if (dropped)
         out.warnings.push_back(
             concat(std::to_string(dropped), " cell(s) with too few usable pixels left out"));

@@ -139,7 +139,7 @@ struct CylinderProfile {
     CylinderHalf half = CylinderHalf::Right;
     double bin_width_rad = 0.0;
     double maximum = 0.0;                   // the raw mean of the brightest bin (the normaliser)
-    std::vector<ProfileBin> bins;           // increasing θi (Both: increasing α)
+    std::vector<ProfileBin> bins;           // increasing θi (both halves too)
     std::vector<ProfileModelCurve> models;  // kProfileModels order
     ProfileFit gaussian_fit;
     ProfileFit exponential_fit;

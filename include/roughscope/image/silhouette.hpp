@@ -3,6 +3,10 @@
 // or the two straight edges (cylinder) that give the object's geometry. Formulas in
 // docs/curved-objects.md.
 //
+// The silhouette is the lit outline: where the surface darkens to the background before its limb
+// (light at the camera, a narrow very-rough lobe) the detected circle or edges are short of the
+// object's — give them instead (docs/curved-objects.md).
+//
 // Image coordinates: x to the right, y down, pixel (col, row) has its centre at (col + ½, row + ½)
 // (docs/image-regions.md). All lengths here are pixels (_px).
 #pragma once
@@ -20,13 +24,14 @@ namespace roughscope::image {
 
 struct SilhouetteOptions {
     // Level (linear scale, channel average) separating object from background. None: automatic
-    // — Otsu's threshold t_O on the channel average (OpenCV), then the edge level
+    // — every statistic from a regular subsample of at most 2^20 pixels — Otsu's threshold t_O on
+    // the channel average (OpenCV), then the edge level
     // t = min(t_O, μ_b + max(6 s_b, edge_fraction · (μ_o − μ_b))) with μ_b, s_b the median and
     // 1.4826 · MAD of the pixels below t_O (robust to the object's dark limb, which is below t_O
     // too) and μ_o the mean of those above: low enough to follow a limb that darkens towards the
     // edge, high enough to stay out of the background noise.
     std::optional<double> threshold;
-    double edge_fraction = 0.05;  // (0, 1)
+    double edge_fraction = 0.01;  // (0, 1)
     // The largest connected bright component must cover at least this fraction of the image.
     double min_object_fraction = 0.01;  // (0, 1)
 };
@@ -63,10 +68,14 @@ struct Silhouette {
     }
 };
 
-// Finds the object: the largest 8-connected component above the level, with its holes (dark
-// areas not connected to the image border) filled. Throws InvalidArgument for an inconsistent image
-// (check_linear_image) or bad options, DataError when no object is found (uniform image, component
-// below min_object_fraction, no background pixel).
+// Finds the object: the largest 8-connected component above the level (cv::connectedComponents-
+// WithStats on the mask reduced by f × f blocks, a block on when any of its pixels is,
+// f = ⌊√(n / 2^20)⌋ — 1, the exact mask, below 2^21 pixels; the object is then its pixels above
+// the level in that component's blocks), with the gaps along each row between its first and last
+// pixel filled (dark texture, a flagged pixel: the objects here,
+// cylinders and spheres seen whole, are convex along image rows). Throws InvalidArgument for an
+// inconsistent image (check_linear_image) or bad options, DataError when no object is found
+// (uniform image, component below min_object_fraction, no background pixel).
 Silhouette find_silhouette(const LinearImage& image, const SilhouetteOptions& options = {});
 
 // ---------------------------------------------------------------------------------------------

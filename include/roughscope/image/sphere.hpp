@@ -36,9 +36,14 @@ struct SphereOptions {
     double max_angle_deg = 85.0;
     // Cells: square blocks of cell_px × cell_px image pixels (grid from the top-left corner);
     // 0 = the smallest side for which the disc holds at most max_cells cells,
-    // ⌈√(π (limb_fraction · R)² / max_cells)⌉.
+    // ⌈√(π (limb_fraction · R)² / max_cells)⌉. A cell's mean is not the brightness at its
+    // centroid where the brightness curves (towards the limb it changes by tens of per cent per
+    // pixel): the second-order term is taken out (see SphereResult::table), but what is left
+    // still exceeds the noise of a 14-bit sphere of ~10⁴ pixels once cells are 2 px or more. The
+    // default keeps every pixel its own cell up to 16384 pixels (a sphere of radius ≈ 75 px at
+    // limb_fraction 0.95); larger spheres get blocks, whose angular size shrinks like 1/R.
     std::size_t cell_px = 0;
-    std::size_t max_cells = 2000;  // ≥ 1
+    std::size_t max_cells = 16384;  // ≥ 1
     // Cells with fewer used pixels than this fraction of cell_px² are dropped, [0, 1].
     double min_cell_fraction = 0.5;
     ComparisonOptions comparison;

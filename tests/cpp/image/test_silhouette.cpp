@@ -224,3 +224,38 @@ TEST(SilhouetteCylinder, AnEdgeCutByTheBorderIsAnError) {
 }
 
 }  // namespace
+
+namespace {
+
+// Above 2^21 pixels the components are found on a block-reduced mask (f = 2 here): the circle is
+// still the full-resolution one.
+TEST(SilhouetteCircle, LargeImageUsesTheBlockReducedComponents) {
+    using namespace roughscope::image;
+    const std::size_t w = 1500, h = 1450;
+    const double cx = 731.3, cy = 702.9, R = 600.4;
+    LinearImage img;
+    img.width = w;
+    img.height = h;
+    img.channels = 1;
+    img.flags.assign(w * h, 0);
+    img.values.resize(w * h);
+    for (std::size_t r = 0; r < h; ++r)
+        for (std::size_t c = 0; c < w; ++c) {
+            const double x = (c + 0.5 - cx) / R, y = (r + 0.5 - cy) / R;
+            const double rho2 = x * x + y * y;
+            // Lambert lit from the camera, a dark speck of texture, a noise speck outside.
+            img.values[r * w + c] = rho2 < 1 ? static_cast<float>(std::sqrt(1 - rho2)) : 0.0F;
+        }
+    for (std::size_t r = 600; r < 603; ++r)
+        for (std::size_t c = 700; c < 703; ++c) img.values[r * w + c] = 0.0F;  // a hole
+    img.values[20 * w + 20] = 0.9F;
+    const Silhouette s = find_silhouette(img);
+    EXPECT_EQ(s.mask[601 * w + 701], 1);  // the hole is filled
+    EXPECT_EQ(s.mask[20 * w + 20], 0);    // the speck is not the object
+    const CircleFit fit = fit_sphere_circle(s);
+    EXPECT_NEAR(fit.centre_x_px, cx, 0.2);
+    EXPECT_NEAR(fit.centre_y_px, cy, 0.2);
+    EXPECT_NEAR(fit.radius_px, R, 0.2);
+}
+
+}  // namespace

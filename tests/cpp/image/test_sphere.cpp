@@ -23,7 +23,7 @@ using roughscope::testing::linear_from_capture;
 using roughscope::testing::very_rough_truth;
 namespace sim = roughscope::simulation;
 
-constexpr std::size_t kSize = 160;  // R = 64 px
+constexpr std::size_t kSize = 120;  // R = 48 px
 
 sim::Capture render(const sim::Scene& scene, const sim::SurfaceTruth& truth,
                     const sim::CameraModel& camera) {
@@ -53,9 +53,9 @@ LinearImage noisy_sphere(const sim::Scene& scene, const sim::SurfaceTruth& truth
 
 CircleFit true_circle() {
     CircleFit c;
-    c.centre_x_px = 80.0;
-    c.centre_y_px = 80.0;
-    c.radius_px = 64.0;
+    c.centre_x_px = 60.0;
+    c.centre_y_px = 60.0;
+    c.radius_px = 48.0;
     return c;
 }
 
@@ -65,7 +65,7 @@ TEST(SphereTable, VhGaussianFitCoversTheTruthAndWins) {
     for (const double light_deg : {0.0, 30.0})
         for (const double s : {0.4, 0.7, 1.1})
             for (const int bits : {12, 14})
-                for (int rep = 0; rep < 2; ++rep) {
+                for (int rep = 0; rep < 2; ++rep) {  // 24 trials
                     const Eigen::Vector3d L =
                         sim::direction_from_angles(deg_to_rad(light_deg), kPi);
                     const LinearImage img = noisy_sphere(
@@ -74,8 +74,8 @@ TEST(SphereTable, VhGaussianFitCoversTheTruthAndWins) {
                     o.light = L;
                     o.circle = true_circle();
                     const SphereResult r = measure_sphere(img, nullptr, o);
-                    EXPECT_LE(r.table.size(), 2000U);
-                    EXPECT_GE(r.table.size(), 500U);
+                    EXPECT_EQ(r.cell_px, 1U);  // ~6000 pixels: each its own row
+                    EXPECT_GE(r.table.size(), 5000U);
                     EXPECT_FALSE(r.comparison.two_point.available);  // CUReT's pair: not here
                     const ModelResult& vh = r.comparison.result(ComparisonModel::VhGaussianFit);
                     ASSERT_TRUE(vh.available) << vh.reason;
@@ -114,7 +114,7 @@ TEST(SphereTable, DetectedCircleOnALambertSphere) {
     const LinearImage img = noisy_sphere(sphere_scene(Eigen::Vector3d(0, 0, 1)), lambert, 14, 3);
     const SphereResult r = measure_sphere(img, nullptr, SphereOptions{});
     EXPECT_TRUE(r.circle_detected);
-    EXPECT_NEAR(r.circle.radius_px, 64.0, 0.2);
+    EXPECT_NEAR(r.circle.radius_px, 48.0, 0.2);
     // Lambert: f = Ē / cos θi is constant over the sphere (to the noise).
     double lo = 1e300, hi = 0;
     for (const BrdfMeasurement& m : r.table.measurements) {
@@ -124,11 +124,17 @@ TEST(SphereTable, DetectedCircleOnALambertSphere) {
     }
     EXPECT_LT(hi / lo - 1.0, 0.1);
     // Small cells on request; and a region mask halves the pixels.
-    SphereOptions small;
-    small.cell_px = 2;
-    EXPECT_GT(measure_sphere(img, nullptr, small).table.size(), r.table.size());
+    // Blocks on request (at most max_cells of them), centroid geometry unchanged for L = V.
+    SphereOptions blocks;
+    blocks.max_cells = 1500;
+    const SphereResult rb = measure_sphere(img, nullptr, blocks);
+    EXPECT_EQ(rb.cell_px, 3U);
+    EXPECT_LE(rb.table.size(), 1500U);
+    EXPECT_GT(rb.table.size(), 500U);
+    for (const BrdfMeasurement& m : rb.table.measurements)
+        EXPECT_NEAR(m.value / r.table.measurements.front().value, 1.0, 0.1);
     std::vector<std::uint8_t> mask(img.pixel_count(), 0);
-    for (std::size_t i = 0; i < 80 * kSize; ++i) mask[i] = 1;
+    for (std::size_t i = 0; i < kSize * kSize / 2; ++i) mask[i] = 1;
     EXPECT_NEAR(static_cast<double>(measure_sphere(img, &mask, SphereOptions{}).pixels_used) /
                     static_cast<double>(r.pixels_used),
                 0.5, 0.02);
@@ -173,7 +179,7 @@ TEST(SphereTable, BadInputIsAnError) {
     std::fill(dark.values.begin(), dark.values.end(), 0.0F);
     EXPECT_THROW(measure_sphere(dark, nullptr, {}), DataError);
     // A sphere cut by the border.
-    const LinearImage cut = roughscope::testing::cropped(img, 30, 0, 130, 160);
+    const LinearImage cut = roughscope::testing::cropped(img, 20, 0, 100, 120);
     EXPECT_THROW(measure_sphere(cut, nullptr, {}), DataError);
 }
 
