@@ -80,29 +80,30 @@ std::string text_report(const serialize::Json& doc) {
         for (const auto& m : cyl["models"]) {
             const auto& d = m["departure_angle_deg"];
             items.emplace_back(concat("departure ", m["model"].get<std::string>()),
-                               d.is_null() ? std::string("none (follows the data)")
-                                           : concat(format_result(d.get<double>(), "departure"),
-                                                    " deg"));
+                               d.is_null()
+                                   ? std::string("none (follows the data)")
+                                   : concat(format_result(d.get<double>(), "departure"), " deg"));
         }
     }
     if (const auto& sph = doc["sphere"]; !sph.is_null()) {
         items.emplace_back("sphere table rows", std::to_string(sph["rows"].get<std::size_t>()));
         const auto& winner = sph["comparison"]["winner"];
-        items.emplace_back("best model", winner.is_null() ? std::string("-")
-                                                          : winner.get<std::string>());
+        items.emplace_back("best model",
+                           winner.is_null() ? std::string("-") : winner.get<std::string>());
     }
     if (const auto& map = doc["map"]; !map.is_null()) {
-        items.emplace_back("map", concat(std::to_string(map["width"].get<std::size_t>()), " x ",
-                                         std::to_string(map["height"].get<std::size_t>()),
-                                         " (window ", std::to_string(map["window_px"].get<std::size_t>()),
-                                         " px), ", std::to_string(map["valid"].get<std::size_t>()),
-                                         " valid"));
+        items.emplace_back("map",
+                           concat(std::to_string(map["width"].get<std::size_t>()), " x ",
+                                  std::to_string(map["height"].get<std::size_t>()), " (window ",
+                                  std::to_string(map["window_px"].get<std::size_t>()), " px), ",
+                                  std::to_string(map["valid"].get<std::size_t>()), " valid"));
         for (const auto& c : map["classes"])
             items.emplace_back(concat("map ", c["roughness_class"].get<std::string>()),
                                concat(format_fixed(100.0 * c["fraction"].get<double>(), 1), " %"));
         for (const auto& r : map["regions"])
-            items.emplace_back(concat("region ", r["name"].get<std::string>()),
-                               concat("sigma/T (G) ", value_with_error(r, "sigma_over_T_gaussian")));
+            items.emplace_back(
+                concat("region ", r["name"].get<std::string>()),
+                concat("sigma/T (G) ", value_with_error(r, "sigma_over_T_gaussian")));
     }
     std::ostringstream out;
     print_key_values(out, items);
@@ -123,10 +124,10 @@ std::vector<std::string> write_map_files(const image::RoughnessMap& map, const f
         files.emplace_back(layer.name + ".npy",
                            image::encode_npy(*layer.values, map.width, map.height));
         if (layer.name.find("stderr") == std::string::npos && layer.name != "E1_over_E2")
-            files.emplace_back(layer.name + ".png",
-                               image::encode_map_png(*layer.values, map.width, map.height,
-                                                     image::finite_range(*layer.values),
-                                                     layer.name));
+            files.emplace_back(
+                layer.name + ".png",
+                image::encode_map_png(*layer.values, map.width, map.height,
+                                      image::finite_range(*layer.values), layer.name));
     }
     for (const auto& layer : serialize::map_class_layers(map)) {
         files.emplace_back(layer.name + ".png",

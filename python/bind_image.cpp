@@ -204,8 +204,7 @@ void bind_image(py::module_& m) {
                 const std::vector<py::ssize_t> shape{static_cast<py::ssize_t>(map->height),
                                                      static_cast<py::ssize_t>(map->width)};
                 for (const auto& layer : serialize::map_float_layers(*map))
-                    arrays[py::str(layer.name)] =
-                        py::array_t<float>(shape, layer.values->data());
+                    arrays[py::str(layer.name)] = py::array_t<float>(shape, layer.values->data());
                 for (const auto& layer : serialize::map_class_layers(*map))
                     arrays[py::str(layer.name)] =
                         py::array_t<std::uint8_t>(shape, layer.values->data());

@@ -69,14 +69,14 @@ def profile_figure_png(cylinder, title=None):
     data = [r["brightness"] for r in rows]
     err = [2 * r["stderr"] for r in rows]
     fig, ax = plt.subplots(figsize=(5.2, 3.6), dpi=90)
-    ax.errorbar(theta, data, yerr=err, color="black", linewidth=1.6, elinewidth=0.8,
-                label="data (±2 s.e.)")
+    ax.errorbar(theta, data, yerr=err, color="black", fmt="o", markersize=3, elinewidth=0.8,
+                label="data (±2 s.e.)", zorder=1)
     for m in cylinder["models"]:
         style = _MODEL_STYLE.get(m["model"], {})
         label = m["display_name"]
         if m["sigma_over_T"] is not None:
             label += f", σ/T = {m['sigma_over_T']:.3g}"
-        ax.plot(theta, m["prediction"], label=label, **style)
+        ax.plot(theta, m["prediction"], label=label, zorder=2, **style)
         if m["departure_angle_deg"] is not None:
             ax.axvline(m["departure_angle_deg"], ymax=0.08, color=style.get("color", "grey"),
                        linewidth=2.5)

@@ -115,8 +115,9 @@ Region parse_region(const Context& ctx, const Json& j, const std::string& key,
                     std::initializer_list<std::string_view> allowed = {"rect", "circle", "polygon",
                                                                        "mask"}) {
     ctx.only(j, key, allowed);
-    const int shapes = static_cast<int>(j.contains("rect")) + static_cast<int>(j.contains("circle")) +
-                       static_cast<int>(j.contains("polygon")) + static_cast<int>(j.contains("mask"));
+    const int shapes =
+        static_cast<int>(j.contains("rect")) + static_cast<int>(j.contains("circle")) +
+        static_cast<int>(j.contains("polygon")) + static_cast<int>(j.contains("mask"));
     if (shapes != 1) ctx.fail(key, "must have exactly one of rect, circle, polygon, mask");
     if (j.contains("rect")) {
         const auto r = ctx.numbers(j["rect"], concat(key, ".rect"), 4);
@@ -131,8 +132,7 @@ Region parse_region(const Context& ctx, const Json& j, const std::string& key,
         if (!p.is_array()) ctx.fail(concat(key, ".polygon"), "must be an array of [x, y] points");
         std::vector<std::array<double, 2>> points;
         for (std::size_t k = 0; k < p.size(); ++k) {
-            const auto xy =
-                ctx.numbers(p[k], concat(key, ".polygon[", std::to_string(k), "]"), 2);
+            const auto xy = ctx.numbers(p[k], concat(key, ".polygon[", std::to_string(k), "]"), 2);
             points.push_back({xy[0], xy[1]});
         }
         return PolygonRegion{points};
@@ -228,16 +228,15 @@ ObjectSpec parse_object(const Context& ctx, const Json& j) {
             if (j.contains("axis")) {
                 const Json& a = j["axis"];
                 ctx.only(a, "object.axis", {"point_px", "direction", "radius_px"});
-                if (!a.contains("point_px") || !a.contains("direction") ||
-                    !a.contains("radius_px"))
-                    ctx.fail("object.axis", "needs point_px [x, y], direction [dx, dy] and "
-                                            "radius_px");
+                if (!a.contains("point_px") || !a.contains("direction") || !a.contains("radius_px"))
+                    ctx.fail("object.axis",
+                             "needs point_px [x, y], direction [dx, dy] and "
+                             "radius_px");
                 const auto p = ctx.numbers(a["point_px"], "object.axis.point_px", 2);
                 const auto d = ctx.numbers(a["direction"], "object.axis.direction", 2);
                 const double r = ctx.positive(a["radius_px"], "object.axis.radius_px");
-                checked(ctx, "object.axis", [&] {
-                    o.axis = cylinder_axis_from_line(p[0], p[1], d[0], d[1], r);
-                });
+                checked(ctx, "object.axis",
+                        [&] { o.axis = cylinder_axis_from_line(p[0], p[1], d[0], d[1], r); });
             }
             if (j.contains("edges")) {
                 const Json& e = j["edges"];
@@ -253,7 +252,8 @@ ObjectSpec parse_object(const Context& ctx, const Json& j) {
                 checked(ctx, "object.edges",
                         [&] { o.axis = cylinder_axis_from_edges(a0, a1, b0, b1); });
             }
-            if (j.contains("half")) o.half = ctx.named(j["half"], "object.half", parse_cylinder_half);
+            if (j.contains("half"))
+                o.half = ctx.named(j["half"], "object.half", parse_cylinder_half);
             if (j.contains("bin_width_deg"))
                 o.bin_width_deg = ctx.number(j["bin_width_deg"], "object.bin_width_deg");
             if (j.contains("min_pixels_per_bin"))
@@ -289,7 +289,8 @@ MapRequest parse_maps(const Context& ctx, const Json& j) {
               "slightly_rough_max_sigma_over_T", "very_rough_min_sigma_over_T", "regions"});
     MapRequest maps;
     MapOptions& o = maps.options;
-    if (j.contains("window_px")) o.window_px = whole(ctx, j["window_px"], "maps.window_px", 1, 4096);
+    if (j.contains("window_px"))
+        o.window_px = whole(ctx, j["window_px"], "maps.window_px", 1, 4096);
     if (j.contains("min_used_fraction"))
         o.min_used_fraction = ctx.positive(j["min_used_fraction"], "maps.min_used_fraction");
     if (j.contains("max_shift_px")) {
@@ -324,8 +325,8 @@ MapRequest parse_maps(const Context& ctx, const Json& j) {
 // The capture's geometry: theta_i_deg, theta_s_deg, phi_s_deg (paper frame) or light and view
 // vectors (the sample's normal +z; for a curved object the camera frame, view +z by default, and
 // neither given: L = V = +z, the retro-reflection of §5.2).
-void parse_capture_geometry(const Context& ctx, const Json& c, const std::string& key,
-                            bool curved, CaptureSpec& spec) {
+void parse_capture_geometry(const Context& ctx, const Json& c, const std::string& key, bool curved,
+                            CaptureSpec& spec) {
     const bool angles =
         c.contains("theta_i_deg") || c.contains("theta_s_deg") || c.contains("phi_s_deg");
     const bool vectors = c.contains("light") || c.contains("view");
@@ -337,7 +338,8 @@ void parse_capture_geometry(const Context& ctx, const Json& c, const std::string
                                          : Eigen::Vector3d::UnitZ();
         spec.view = c.contains("view") ? unit_vector(ctx, c["view"], concat(key, ".view"))
                                        : Eigen::Vector3d::UnitZ();
-        for (const auto& [name, v] : {std::pair{"light", *spec.light}, std::pair{"view", *spec.view}})
+        for (const auto& [name, v] :
+             {std::pair{"light", *spec.light}, std::pair{"view", *spec.view}})
             if (!(v.z() > 0.0))
                 ctx.fail(concat(key, ".", name),
                          "must point toward the camera side (z > 0; camera frame: x image right, "
@@ -547,8 +549,9 @@ MeasureRequest parse_checked(std::string_view text, const std::string& path) {
     if (doc.contains("roi"))
         request.roi = parse_region(ctx, doc["roi"], "roi");
     else if (!curved && !request.maps)
-        ctx.fail("roi", "missing: the region to measure is required (for a flat sample without "
-                        "\"maps\")");
+        ctx.fail("roi",
+                 "missing: the region to measure is required (for a flat sample without "
+                 "\"maps\")");
     if (!doc.contains("captures") || !doc["captures"].is_array() || doc["captures"].empty())
         ctx.fail("captures", "must be a non-empty array of captures");
     const Json& captures = doc["captures"];

@@ -149,6 +149,9 @@ void check_cylinder_options(const CylinderOptions& options) {
     }
 }
 
+// The dark-limb warning's factor (measure_cylinder_profile).
+constexpr double kDarkLimbFactor = 10.0;
+
 CylinderProfile measure_cylinder_profile(const LinearImage& image,
                                          const std::vector<std::uint8_t>* region_mask,
                                          const CylinderOptions& options) {
@@ -169,6 +172,7 @@ CylinderProfile measure_cylinder_profile(const LinearImage& image,
 
     // The axis, and the object mask when it comes from the silhouette.
     std::vector<std::uint8_t> object;
+    double silhouette_level = 0.0;
     if (options.axis) {
         out.axis = cylinder_axis_from_line(options.axis->point_x_px, options.axis->point_y_px,
                                            options.axis->direction_x, options.axis->direction_y,
@@ -176,6 +180,7 @@ CylinderProfile measure_cylinder_profile(const LinearImage& image,
     } else {
         Silhouette s = detail::find_silhouette_of_checked_image(image, options.silhouette);
         out.axis = fit_cylinder_axis(s, options.axis_fit);
+        silhouette_level = s.threshold;
         object = std::move(s.mask);
     }
     const CylinderAxis& axis = out.axis;
@@ -474,6 +479,33 @@ CylinderProfile measure_cylinder_profile(const LinearImage& image,
     }
     if (const auto& s = out.curve(ProfileModel::VhGaussian).sigma_over_T)
         out.theta_K_rad = caron_theta_K_rad(*s);
+    // A detected axis takes the silhouette's edge for the limb. On an object whose brightness
+    // fades smoothly to the silhouette's level (a narrow very-rough lobe lit from near the
+    // camera) the edge lies inside the true limb, and the radius, hence every angle, is off; a
+    // limb that stays bright to the edge (Lambert: cos 80° = 0.17) is found where it is. The
+    // sign: the profile 10° inside the detected limb is within a few times the silhouette's
+    // level.
+    if (axis.detected && out.maximum > 0.0 && !out.bins.empty()) {
+        // The bin nearest 80° (or the outermost one, when the profile stops short of 80°).
+        const double level = silhouette_level / out.maximum;
+        const double target = deg_to_rad(80.0);
+        const auto distance = [&](const ProfileBin& b) {
+            return std::abs(std::min(std::abs(b.alpha_rad), target) - target) -
+                   1e-3 * std::abs(b.alpha_rad);
+        };
+        const ProfileBin* near = &out.bins.front();
+        for (const ProfileBin& b : out.bins)
+            if (distance(b) < distance(*near)) near = &b;
+        if (std::abs(near->alpha_rad) >= deg_to_rad(60.0) &&
+            near->brightness < kDarkLimbFactor * level)
+            out.warnings.push_back(concat(
+                "the profile at ", check::format_number(rad_to_deg(std::abs(near->alpha_rad))),
+                "° from the axis (", check::format_number(near->brightness),
+                " of the maximum) is within ", check::format_number(kDarkLimbFactor),
+                "x the silhouette's level (", check::format_number(level),
+                "): the limb is dark, the detected edge is likely inside the true limb, so the "
+                "radius and the angles are biased; give the axis (or edges) of the cylinder"));
+    }
     return out;
 }
 

@@ -86,19 +86,22 @@ void check_request(const MeasureRequest& request) {
                                          std::to_string(request.captures.size()), " captures (",
                                          std::to_string(specular), " specular)"));
         if (request.maps)
-            throw InvalidArgument(concat(src, ": maps are made of a flat sample or an object with "
-                                              "a normal map (object.shape plane or normal_map), "
-                                              "not of a ",
+            throw InvalidArgument(concat(src,
+                                         ": maps are made of a flat sample or an object with "
+                                         "a normal map (object.shape plane or normal_map), "
+                                         "not of a ",
                                          to_string(shape)));
         return;
     }
     if (request.maps && diffuse < 2)
-        throw InvalidArgument(concat(src, ": a roughness map needs two diffuse captures (lit from "
-                                          "two directions); got ",
+        throw InvalidArgument(concat(src,
+                                     ": a roughness map needs two diffuse captures (lit from "
+                                     "two directions); got ",
                                      std::to_string(diffuse)));
     if (shape == ObjectShape::NormalMap && !request.maps)
-        throw InvalidArgument(concat(src, ": object.shape normal_map is measured as a map: give "
-                                          "\"maps\""));
+        throw InvalidArgument(concat(src,
+                                     ": object.shape normal_map is measured as a map: give "
+                                     "\"maps\""));
     if (!request.roi && !request.maps)
         throw InvalidArgument(concat(src, ": no roi: give the region to measure"));
     if (diffuse == 1 && specular == 0)
@@ -223,7 +226,8 @@ void check_same_size_pixels(const LinearImage& image, const LinearImage& first,
         throw DataError(concat(src, ": ", image.info.source, " is ", std::to_string(image.width),
                                " x ", std::to_string(image.height), " but ", first.info.source,
                                " is ", std::to_string(first.width), " x ",
-                               std::to_string(first.height), ": the normal map must have the "
+                               std::to_string(first.height),
+                               ": the normal map must have the "
                                "captures' size"));
 }
 
@@ -431,8 +435,8 @@ std::vector<float> decode_normal_map(const LinearImage& image, const std::string
         const double norm = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
         const bool on = norm >= 0.5 && (image.flags.empty() || image.flags[k] == 0);
         for (std::size_t c = 0; c < 3; ++c)
-            normals[3 * k + c] = on ? static_cast<float>(v[c] / norm)
-                                    : std::numeric_limits<float>::quiet_NaN();
+            normals[3 * k + c] =
+                on ? static_cast<float>(v[c] / norm) : std::numeric_limits<float>::quiet_NaN();
     }
     return normals;
 }

@@ -144,8 +144,8 @@ Json to_json(const image::CylinderProfile& p) {
             : std::nullopt);
     put(out, "sigma_over_T_exponential",
         p.exponential_fit.sigma_over_T
-            ? std::optional<Estimate>(Estimate{*p.exponential_fit.sigma_over_T,
-                                               p.exponential_fit.sigma_over_T_stderr})
+            ? std::optional<Estimate>(
+                  Estimate{*p.exponential_fit.sigma_over_T, p.exponential_fit.sigma_over_T_stderr})
             : std::nullopt);
     out["preferred_correlation"] = std::string(to_string(p.preferred));
     out["fit"] = Json{{"gaussian", profile_fit_json(p.gaussian_fit)},
@@ -306,9 +306,9 @@ Json to_json(const image::MeasureResult& r, const image::MeasureRequest& request
             slope(r.slope_gaussian, r.fit ? &r.fit->gaussian : nullptr));
         put(out, "sigma_over_T_exponential",
             slope(r.slope_exponential, r.fit ? &r.fit->exponential : nullptr));
-        out["sigma_over_T_source"] = r.fit                                        ? "fit"
+        out["sigma_over_T_source"] = r.fit                                     ? "fit"
                                      : r.slope_gaussian || r.slope_exponential ? "pair"
-                                                                                 : Json();
+                                                                               : Json();
     }
     std::optional<Estimate> sigma;
     if (request.sigma_um)

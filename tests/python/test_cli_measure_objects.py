@@ -122,6 +122,8 @@ def test_cylinder_given_axis_agrees_with_the_detected_one(cylinder):
     # The axis line itself is found to a fraction of a pixel (the radius is short: a dark limb).
     assert axis2["point_px"][0] == pytest.approx(100, abs=0.5)
     assert abs(axis2["direction"][0]) < 0.01 and axis2["radius_px"] < 64
+    assert any("inside the true limb" in w for w in doc2["warnings"]), doc2["warnings"]
+    assert not any("inside the true limb" in w for w in doc["warnings"])
 
 
 @pytest.mark.parametrize("change,words", [

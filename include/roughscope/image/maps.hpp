@@ -184,8 +184,8 @@ struct RegionMapStatistics {
     // inverse curved). A normal map: the mean of the cells' σ/T, error sd / √count.
     std::optional<Estimate> mean_sigma_over_T_gaussian;
     std::optional<Estimate> mean_sigma_over_T_exponential;
-    std::optional<Estimate> mean_T_um;                      // σ known
-    std::array<std::size_t, 3> class_counts{};              // by σ/T (RoughnessClass order)
+    std::optional<Estimate> mean_T_um;          // σ known
+    std::array<std::size_t, 3> class_counts{};  // by σ/T (RoughnessClass order)
 };
 
 struct RoughnessMap {

@@ -242,6 +242,27 @@ TEST(CylinderProfile, DetectedAxisOnALambertCylinderGivesCosine) {
     for (std::size_t i = 0; i < 40 * kSize; ++i) mask[i] = 1;
     const CylinderProfile pm = measure_cylinder_profile(img, &mask, CylinderOptions{});
     EXPECT_LT(pm.pixels_used, p.pixels_used / 3);
+    for (const auto& w : p.warnings)
+        EXPECT_EQ(w.find("inside the true limb"), std::string::npos) << w;
+}
+
+// A very rough cylinder lit from the camera has a dark limb: the detected radius is short and a
+// warning says so (the given axis has no such warning).
+TEST(CylinderProfile, DetectedAxisOnADarkLimbWarns) {
+    const LinearImage img = noisy_capture(cylinder_scene(Eigen::Vector3d(0, 0, 1)),
+                                          very_rough_truth(0.5, Correlation::Gaussian), 14, 11);
+    const CylinderProfile p = measure_cylinder_profile(img, nullptr, CylinderOptions{});
+    EXPECT_TRUE(p.axis.detected);
+    EXPECT_LT(p.axis.radius_px, 63.0);
+    const auto warned = [](const CylinderProfile& q) {
+        return std::any_of(q.warnings.begin(), q.warnings.end(), [](const std::string& w) {
+            return w.find("inside the true limb") != std::string::npos;
+        });
+    };
+    EXPECT_TRUE(warned(p));
+    CylinderOptions given;
+    given.axis = true_axis();
+    EXPECT_FALSE(warned(measure_cylinder_profile(img, nullptr, given)));
 }
 
 TEST(CylinderProfile, BadInputIsAnError) {

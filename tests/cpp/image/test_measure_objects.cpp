@@ -261,8 +261,8 @@ TEST(MeasureObjects, NormalMapOfASphereRecoversSigmaOverT) {
         const sim::CameraModel cam = camera(peak_radiance(scene, truths, {}), 40 + files.size());
         exposures.push_back(cam.exposure_s);
         const sim::Capture c = sim::render_capture(scene, truths, {}, cam);
-        files.push_back(write_tiff(dir, concat("c", std::to_string(files.size()), ".tiff"), c)
-                            .string());
+        files.push_back(
+            write_tiff(dir, concat("c", std::to_string(files.size()), ".tiff"), c).string());
         if (files.size() == 1) first = c;
     }
     // Normals (camera frame) as a 3-sample float TIFF; off the sphere (0, 0, 0).
@@ -273,9 +273,9 @@ TEST(MeasureObjects, NormalMapOfASphereRecoversSigmaOverT) {
             for (std::size_t c = 0; c < 3; ++c) normals[3 * k + c] = first.normal[3 * k + c];
     const fs::path normal_tiff = dir / "normals.tiff";
     {
-        const auto bytes = roughscope::testing::tiff_image(static_cast<std::uint32_t>(scene.width),
-                                      static_cast<std::uint32_t>(scene.height), 3, 32, 3,
-                                      roughscope::testing::raw_bytes(normals));
+        const auto bytes = roughscope::testing::tiff_image(
+            static_cast<std::uint32_t>(scene.width), static_cast<std::uint32_t>(scene.height), 3,
+            32, 3, roughscope::testing::raw_bytes(normals));
         io::write_file_atomic(normal_tiff, std::string(bytes.begin(), bytes.end()));
     }
     auto vec = [](const Eigen::Vector3d& v) {
@@ -284,12 +284,12 @@ TEST(MeasureObjects, NormalMapOfASphereRecoversSigmaOverT) {
     };
     const std::string text =
         concat(R"({"black_level_dn": 64, "object": {"shape": "normal_map", "file": ")",
-               normal_tiff.string(), R"("}, "maps": {"window_px": 4, "max_shift_px": 3, "regions": [{"name":
+               normal_tiff.string(),
+               R"("}, "maps": {"window_px": 4, "max_shift_px": 3, "regions": [{"name":
                "centre", "circle": [128, 128, 60]}]}, "captures": [{"image": ")",
                files[0], R"(", "light": )", vec(lights[0]), R"(, "exposure_s": )",
-               check::format_number(exposures[0]), R"(}, {"image": ")", files[1],
-               R"(", "light": )", vec(lights[1]), R"(, "exposure_s": )",
-               check::format_number(exposures[1]), "}]}");
+               check::format_number(exposures[0]), R"(}, {"image": ")", files[1], R"(", "light": )",
+               vec(lights[1]), R"(, "exposure_s": )", check::format_number(exposures[1]), "}]}");
     const MeasureResult result = measure(parse(text));
     ASSERT_TRUE(result.map);
     ASSERT_EQ(result.map->regions.size(), 1u);
