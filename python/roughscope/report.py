@@ -6,7 +6,8 @@ linked relatively) — with:
 * a header (library version, date);
 * first, the main job — :mod:`roughscope.report_measure`: synthetic photographs of samples of known
   roughness written, measured (``roughscope measure``) and the recovered values set against the
-  truth;
+  truth; then :mod:`roughscope.report_objects`: a cylinder (Fig. 8), a sphere and a roughness map
+  of synthetic photographs;
 * "Models": the paper's Figs. 3 and 4 (retro-scattering, B–K and V–H) and a table checking the
   closed forms Eq. 7–11 against the library's general forms at the retro geometry;
 * the sections of :mod:`roughscope.report_estimation`, :mod:`roughscope.report_curet`,

@@ -213,7 +213,7 @@ def measurement_html(doc, capture_file=None, truth=None, title=None):
     objects = objects_html(doc)
     if objects:
         parts.append(objects)
-    if doc.get("region", {}).get("description"):
+    if (doc.get("region") or {}).get("description"):
         parts.append(captures_table(doc))
     parts.append("<h4>Checks</h4>" + checks_html(doc))
     return "\n".join(parts)

@@ -261,3 +261,18 @@ def test_bad_map_requests_fail_naming_the_key(flat_map, change, words):
     message = fails(code, edited(flat_map, name, change))
     for w in words:
         assert w in message, message
+
+
+# --------------------------------------------------------------------------------------------
+# Report
+
+def test_report_of_a_cylinder_and_of_a_map_shows_their_figures(cylinder, flat_map, tmp_path):
+    run(cylinder, "--report", tmp_path / "cyl")
+    page = (tmp_path / "cyl" / "index.html").read_text()
+    assert "Cylinder profile (§5.2)" in page and "data:image/png;base64," in page
+    assert "leaves the data at θi" in page
+    run(flat_map, "--maps", tmp_path / "maps", "--report", tmp_path / "map")
+    page = (tmp_path / "map" / "index.html").read_text()
+    assert "Roughness map (§5.1)" in page
+    assert page.count("data:image/png;base64,") >= 2  # the σ/T map and the class map
+    assert "nan" not in page.lower().replace("nanometre", "")
