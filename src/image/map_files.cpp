@@ -19,6 +19,7 @@
 #include <png.h>
 #include <tiffio.h>
 
+#include "io/memory_image_writers.hpp"
 #include "roughscope/core/errors.hpp"
 #include "roughscope/core/text.hpp"
 #include "roughscope/image/maps.hpp"
@@ -43,27 +44,8 @@ constexpr std::size_t kMaxPngSide = 65535;
 
 // ---- PNG ------------------------------------------------------------------------------------
 
-struct PngError {
-    char message[256] = {};
-};
-
-void png_append(png_structp png, png_bytep data, png_size_t length) {
-    auto* out = static_cast<std::string*>(png_get_io_ptr(png));
-    out->append(reinterpret_cast<const char*>(data), length);
-}
-void png_flush_nothing(png_structp) {}
-[[noreturn]] void png_fail(png_structp png, png_const_charp message) {
-    auto* e = static_cast<PngError*>(png_get_error_ptr(png));
-    std::snprintf(e->message, sizeof e->message, "%s", message);
-    png_longjmp(png, 1);
-}
-void png_ignore_warning(png_structp, png_const_charp) {}
-
-struct PngWriteHandle {
-    png_structp png = nullptr;
-    png_infop info = nullptr;
-    ~PngWriteHandle() { png_destroy_write_struct(&png, &info); }
-};
+using io::detail::PngMemoryWriter;
+using io::detail::TiffMemoryWriter;
 
 // An 8-bit RGB cv::Mat (CV_8UC3, R G B order) as PNG.
 std::string encode_rgb_png(const cv::Mat& rgb) {
@@ -71,74 +53,16 @@ std::string encode_rgb_png(const cv::Mat& rgb) {
     for (int r = 0; r < rgb.rows; ++r)
         rows[static_cast<std::size_t>(r)] = const_cast<png_bytep>(rgb.ptr<png_byte>(r));
     std::string out;
-    PngError error;
-    PngWriteHandle h;
-    h.png = png_create_write_struct(PNG_LIBPNG_VER_STRING, &error, png_fail, png_ignore_warning);
-    if (h.png == nullptr) throw Error("png: libpng could not start");
-    h.info = png_create_info_struct(h.png);
-    if (h.info == nullptr) throw Error("png: libpng could not start");
-    if (setjmp(png_jmpbuf(h.png)) != 0) throw Error(concat("png: libpng: ", error.message));
-    png_set_write_fn(h.png, &out, png_append, png_flush_nothing);
-    png_set_IHDR(h.png, h.info, static_cast<png_uint_32>(rgb.cols),
+    PngMemoryWriter w(out);
+    if (setjmp(png_jmpbuf(w.png())) != 0) throw Error(w.message());
+    png_set_IHDR(w.png(), w.info(), static_cast<png_uint_32>(rgb.cols),
                  static_cast<png_uint_32>(rgb.rows), 8, PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE,
                  PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
-    png_write_info(h.png, h.info);
-    png_write_image(h.png, rows.data());
-    png_write_end(h.png, nullptr);
+    png_write_info(w.png(), w.info());
+    png_write_image(w.png(), rows.data());
+    png_write_end(w.png(), nullptr);
     return out;
 }
-
-// ---- TIFF -----------------------------------------------------------------------------------
-
-struct TiffSink {
-    std::string* out = nullptr;
-    std::uint64_t pos = 0;
-};
-struct TiffError {
-    std::string message;
-};
-tmsize_t tiff_read(thandle_t handle, void* buffer, tmsize_t length) {
-    auto* f = static_cast<TiffSink*>(handle);
-    const std::uint64_t size = f->out->size();
-    if (length <= 0 || f->pos >= size) return 0;
-    const auto n = static_cast<std::size_t>(
-        std::min<std::uint64_t>(static_cast<std::uint64_t>(length), size - f->pos));
-    std::memcpy(buffer, f->out->data() + f->pos, n);
-    f->pos += n;
-    return static_cast<tmsize_t>(n);
-}
-tmsize_t tiff_write(thandle_t handle, void* buffer, tmsize_t length) {
-    auto* f = static_cast<TiffSink*>(handle);
-    if (length < 0) return -1;
-    const auto n = static_cast<std::size_t>(length);
-    if (f->out->size() < f->pos + n) f->out->resize(static_cast<std::size_t>(f->pos + n));
-    std::memcpy(f->out->data() + f->pos, buffer, n);
-    f->pos += n;
-    return length;
-}
-toff_t tiff_seek(thandle_t handle, toff_t offset, int whence) {
-    auto* f = static_cast<TiffSink*>(handle);
-    std::uint64_t base = 0;
-    if (whence == SEEK_CUR) base = f->pos;
-    if (whence == SEEK_END) base = f->out->size();
-    f->pos = base + offset;
-    return f->pos;
-}
-int tiff_close(thandle_t) { return 0; }
-toff_t tiff_size(thandle_t handle) { return static_cast<TiffSink*>(handle)->out->size(); }
-int tiff_map(thandle_t, void**, toff_t*) { return 0; }
-void tiff_unmap(thandle_t, void*, toff_t) {}
-int tiff_on_error(TIFF*, void* user, const char* module, const char* format, va_list args) {
-    auto* e = static_cast<TiffError*>(user);
-    if (e->message.empty()) {
-        char text[256];
-        std::vsnprintf(text, sizeof text, format, args);
-        if (module != nullptr && *module != '\0') e->message.append(module).append(": ");
-        e->message.append(text);
-    }
-    return 1;
-}
-int tiff_on_warning(TIFF*, void*, const char*, const char*, va_list) { return 1; }
 
 // ---- colours --------------------------------------------------------------------------------
 
@@ -212,20 +136,8 @@ std::string encode_map_tiff_float(std::span<const float> layer, std::size_t widt
                                   std::size_t height) {
     check_layer(layer.size(), width, height, kMaxTiffSide - 1, "map tiff");
     std::string out;
-    TiffSink sink{&out, 0};
-    TiffError error;
-    TIFFOpenOptions* options = TIFFOpenOptionsAlloc();
-    TIFFOpenOptionsSetErrorHandlerExtR(options, tiff_on_error, &error);
-    TIFFOpenOptionsSetWarningHandlerExtR(options, tiff_on_warning, nullptr);
-    TIFF* tif = TIFFClientOpenExt("map", "wl", &sink, tiff_read, tiff_write, tiff_seek, tiff_close,
-                                  tiff_size, tiff_map, tiff_unmap, options);
-    TIFFOpenOptionsFree(options);
-    auto fail = [&](std::string_view what) {
-        if (tif != nullptr) TIFFClose(tif);
-        throw Error(concat("map tiff: libtiff ", what, ": ",
-                           error.message.empty() ? std::string("no detail") : error.message));
-    };
-    if (tif == nullptr) fail("could not start");
+    TiffMemoryWriter writer(out, "wl", "map tiff");
+    TIFF* tif = writer.get();
     TIFFSetField(tif, TIFFTAG_IMAGEWIDTH, static_cast<std::uint32_t>(width));
     TIFFSetField(tif, TIFFTAG_IMAGELENGTH, static_cast<std::uint32_t>(height));
     TIFFSetField(tif, TIFFTAG_BITSPERSAMPLE, 32);
@@ -237,14 +149,10 @@ std::string encode_map_tiff_float(std::span<const float> layer, std::size_t widt
     TIFFSetField(tif, TIFFTAG_ORIENTATION, ORIENTATION_TOPLEFT);
     TIFFSetField(tif, TIFFTAG_ROWSPERSTRIP, TIFFDefaultStripSize(tif, 0));
     TIFFSetField(tif, TIFFTAG_SOFTWARE, "roughscope map");
-    std::vector<float> row(width);
-    for (std::size_t r = 0; r < height; ++r) {
-        std::copy_n(layer.data() + r * width, width, row.data());
-        if (TIFFWriteScanline(tif, row.data(), static_cast<std::uint32_t>(r), 0) < 0)
-            fail(concat("could not write row ", std::to_string(r)));
-    }
-    if (TIFFFlush(tif) != 1) fail("could not finish");
-    TIFFClose(tif);
+    // The layer's rows as scanlines (libtiff does not modify an uncompressed buffer).
+    writer.write_rows(reinterpret_cast<const unsigned char*>(layer.data()), width * sizeof(float),
+                      height);
+    writer.finish();
     return out;
 }
 

@@ -17,6 +17,7 @@
 #include <png.h>
 #include <tiffio.h>
 
+#include "io/memory_image_writers.hpp"
 #include "roughscope/core/errors.hpp"
 #include "roughscope/core/names.hpp"
 #include "roughscope/core/text.hpp"
@@ -34,130 +35,8 @@ constexpr std::array<NameEntry<CaptureFormat>, 5> kFormatNames{{
     {"tif", CaptureFormat::Tiff},
 }};
 
-// ---- PNG ------------------------------------------------------------------------------------
-
-struct PngError {
-    char message[256] = {};
-};
-
-void png_append(png_structp png, png_bytep data, png_size_t length) {
-    auto* out = static_cast<std::string*>(png_get_io_ptr(png));
-    out->append(reinterpret_cast<const char*>(data), length);
-}
-
-void png_flush_nothing(png_structp) {}
-
-[[noreturn]] void png_fail(png_structp png, png_const_charp message) {
-    auto* e = static_cast<PngError*>(png_get_error_ptr(png));
-    std::snprintf(e->message, sizeof e->message, "%s", message);
-    png_longjmp(png, 1);
-}
-
-void png_ignore_warning(png_structp, png_const_charp) {}
-
-struct PngWriteHandle {
-    png_structp png = nullptr;
-    png_infop info = nullptr;
-    ~PngWriteHandle() { png_destroy_write_struct(&png, &info); }
-};
-
-// ---- TIFF -----------------------------------------------------------------------------------
-
-struct TiffSink {
-    std::string* out = nullptr;
-    std::uint64_t pos = 0;
-};
-
-struct TiffError {
-    std::string message;
-};
-
-tmsize_t tiff_read(thandle_t handle, void* buffer, tmsize_t length) {
-    auto* f = static_cast<TiffSink*>(handle);
-    const std::uint64_t size = f->out->size();
-    if (length <= 0 || f->pos >= size) return 0;
-    const auto n = static_cast<std::size_t>(
-        std::min<std::uint64_t>(static_cast<std::uint64_t>(length), size - f->pos));
-    std::memcpy(buffer, f->out->data() + f->pos, n);
-    f->pos += n;
-    return static_cast<tmsize_t>(n);
-}
-
-tmsize_t tiff_write(thandle_t handle, void* buffer, tmsize_t length) {
-    auto* f = static_cast<TiffSink*>(handle);
-    if (length < 0) return -1;
-    const auto n = static_cast<std::size_t>(length);
-    if (f->out->size() < f->pos + n) f->out->resize(static_cast<std::size_t>(f->pos + n));
-    std::memcpy(f->out->data() + f->pos, buffer, n);
-    f->pos += n;
-    return length;
-}
-
-toff_t tiff_seek(thandle_t handle, toff_t offset, int whence) {
-    auto* f = static_cast<TiffSink*>(handle);
-    std::uint64_t base = 0;
-    if (whence == SEEK_CUR) base = f->pos;
-    if (whence == SEEK_END) base = f->out->size();
-    f->pos = base + offset;
-    return f->pos;
-}
-
-int tiff_close(thandle_t) { return 0; }
-toff_t tiff_size(thandle_t handle) { return static_cast<TiffSink*>(handle)->out->size(); }
-int tiff_map(thandle_t, void**, toff_t*) { return 0; }
-void tiff_unmap(thandle_t, void*, toff_t) {}
-
-int tiff_on_error(TIFF*, void* user, const char* module, const char* format, va_list args) {
-    auto* e = static_cast<TiffError*>(user);
-    if (e->message.empty()) {
-        char text[256];
-        std::vsnprintf(text, sizeof text, format, args);
-        if (module != nullptr && *module != '\0') e->message.append(module).append(": ");
-        e->message.append(text);
-    }
-    return 1;
-}
-
-int tiff_on_warning(TIFF*, void*, const char*, const char*, va_list) { return 1; }
-
-class TiffWriter {
-  public:
-    explicit TiffWriter(std::string& out) : sink_{&out, 0} {
-        TIFFOpenOptions* options = TIFFOpenOptionsAlloc();
-        TIFFOpenOptionsSetErrorHandlerExtR(options, tiff_on_error, &error_);
-        TIFFOpenOptionsSetWarningHandlerExtR(options, tiff_on_warning, nullptr);
-        tiff_ = TIFFClientOpenExt("capture", "w", &sink_, tiff_read, tiff_write, tiff_seek,
-                                  tiff_close, tiff_size, tiff_map, tiff_unmap, options);
-        TIFFOpenOptionsFree(options);
-        if (tiff_ == nullptr) fail("could not start");
-    }
-    ~TiffWriter() {
-        if (tiff_ != nullptr) TIFFClose(tiff_);
-    }
-    TiffWriter(const TiffWriter&) = delete;
-    TiffWriter& operator=(const TiffWriter&) = delete;
-    TIFF* get() const { return tiff_; }
-    [[noreturn]] void fail(std::string_view what) const {
-        throw Error(concat("tiff: libtiff ", what, ": ",
-                           error_.message.empty() ? std::string("no detail") : error_.message));
-    }
-    void write_rows(const unsigned char* data, std::size_t row_bytes, std::size_t rows) {
-        for (std::size_t r = 0; r < rows; ++r) {
-            // libtiff takes a non-const buffer but does not modify it when writing uncompressed.
-            auto* row = const_cast<unsigned char*>(data + r * row_bytes);
-            if (TIFFWriteScanline(tiff_, row, static_cast<std::uint32_t>(r), 0) < 0)
-                fail(concat("could not write row ", std::to_string(r)));
-        }
-    }
-    void finish() {
-        if (TIFFFlush(tiff_) != 1) fail("could not finish");
-    }
-
-  private:
-    TiffSink sink_;
-    TiffError error_;
-    TIFF* tiff_ = nullptr;
-};
+using io::detail::PngMemoryWriter;
+using TiffWriter = io::detail::TiffMemoryWriter;
 
 void set_common_tags(TIFF* tif, const Capture& c, int bits, int samples, int sample_format,
                      int photometric) {
@@ -218,26 +97,20 @@ std::string encode_capture_png(const Capture& capture) {
     for (std::size_t r = 0; r < capture.height; ++r) rows[r] = pixels.data() + r * row_bytes;
     std::string out;
     out.reserve(pixels.size() + pixels.size() / 8 + 1024);
-    PngError error;
-    PngWriteHandle h;
-    h.png = png_create_write_struct(PNG_LIBPNG_VER_STRING, &error, png_fail, png_ignore_warning);
-    if (h.png == nullptr) throw Error("png: libpng could not start");
-    h.info = png_create_info_struct(h.png);
-    if (h.info == nullptr) throw Error("png: libpng could not start");
-    if (setjmp(png_jmpbuf(h.png)) != 0) throw Error(concat("png: libpng: ", error.message));
-    png_set_write_fn(h.png, &out, png_append, png_flush_nothing);
+    PngMemoryWriter w(out);
+    if (setjmp(png_jmpbuf(w.png())) != 0) throw Error(w.message());
     // Fast settings: the images are noise, which deflate barely shrinks.
-    png_set_compression_level(h.png, 1);
-    png_set_filter(h.png, PNG_FILTER_TYPE_BASE, PNG_FILTER_NONE);
-    png_set_IHDR(h.png, h.info, static_cast<png_uint_32>(capture.width),
+    png_set_compression_level(w.png(), 1);
+    png_set_filter(w.png(), PNG_FILTER_TYPE_BASE, PNG_FILTER_NONE);
+    png_set_IHDR(w.png(), w.info(), static_cast<png_uint_32>(capture.width),
                  static_cast<png_uint_32>(capture.height), eight ? 8 : 16, PNG_COLOR_TYPE_GRAY,
                  PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
     png_color_8 significant{};
     significant.gray = static_cast<png_byte>(capture.bit_depth);
-    png_set_sBIT(h.png, h.info, &significant);
-    png_write_info(h.png, h.info);
-    png_write_image(h.png, rows.data());
-    png_write_end(h.png, nullptr);
+    png_set_sBIT(w.png(), w.info(), &significant);
+    png_write_info(w.png(), w.info());
+    png_write_image(w.png(), rows.data());
+    png_write_end(w.png(), nullptr);
     return out;
 }
 
@@ -246,7 +119,7 @@ std::string encode_capture_tiff(const Capture& capture) {
     std::string out;
     out.reserve(capture.dn.size() * 2 + 4096);
     {
-        TiffWriter writer(out);
+        TiffWriter writer(out, "w", "tiff");
         set_common_tags(writer.get(), capture, 16, 1, SAMPLEFORMAT_UINT, PHOTOMETRIC_MINISBLACK);
         writer.write_rows(reinterpret_cast<const unsigned char*>(capture.dn.data()),
                           capture.width * 2, capture.height);
@@ -260,7 +133,7 @@ std::string encode_capture_tiff_float(const Capture& capture) {
     std::string out;
     out.reserve(capture.expected_dn.size() * 4 + 4096);
     {
-        TiffWriter writer(out);
+        TiffWriter writer(out, "w", "tiff");
         set_common_tags(writer.get(), capture, 32, 1, SAMPLEFORMAT_IEEEFP, PHOTOMETRIC_MINISBLACK);
         writer.write_rows(reinterpret_cast<const unsigned char*>(capture.expected_dn.data()),
                           capture.width * 4, capture.height);
@@ -285,7 +158,7 @@ std::string encode_capture_dng(const Capture& capture, const CameraModel& camera
     std::string out;
     out.reserve(rgb.size() * 2 + 4096);
     {
-        TiffWriter writer(out);
+        TiffWriter writer(out, "w", "tiff");
         TIFF* tif = writer.get();
         set_common_tags(tif, capture, 16, 3, SAMPLEFORMAT_UINT, 34892 /* LinearRaw */);
         TIFFSetField(tif, TIFFTAG_MAKE, "roughscope");
