@@ -11,8 +11,6 @@
   and set against the truth.
 """
 
-import base64
-import html
 import io
 import json
 import math
@@ -21,24 +19,7 @@ import pathlib
 import subprocess
 
 from . import _core
-
-
-def _e(text):
-    return html.escape(str(text))
-
-
-def _fmt(value, err=None, digits=4):
-    if value is None:
-        return "–"
-    text = f"{value:.{digits}g}"
-    if err is not None and err > 0:
-        text += f" ± {err:.2g}"
-    return text
-
-
-def _img_tag(png, alt):
-    data = base64.b64encode(png).decode("ascii")
-    return f'<img src="data:image/png;base64,{data}" alt="{_e(alt)}">'
+from .report_measure import _e, _fmt, _img_tag
 
 
 def _pass(good):
