@@ -630,6 +630,19 @@ class Evaluator {
     Counts counts_;
 };
 
+// A cell without an estimate has no class (its float layers stay NaN).
+void mark_no_class(RoughnessMap& map, std::size_t index) {
+    map.roughness_class[index] = kClassNone;
+    if (!map.roughness_class_g.empty()) map.roughness_class_g[index] = kClassNone;
+}
+
+// A cell whose ratio no model produces (both correlations).
+void mark_no_solution(Evaluator& ev, RoughnessMap& map, std::size_t index) {
+    ++ev.counts().no_solution;
+    ++ev.counts().no_solution_exponential;
+    mark_no_class(map, index);
+}
+
 bool pixel_used(const MapCapture& c1, const MapCapture& c2, const MapOptions& o, std::size_t p) {
     if ((c1.image->flags[p] | c2.image->flags[p]) != 0) return false;
     if (!o.normal_map.empty()) {
@@ -687,15 +700,11 @@ void tile_map(const std::vector<MapCapture>& captures, const MapOptions& o, Eval
             double m1 = 0, m2 = 0, var = 0;
             if (s.n < std::max(2.0, o.min_used_fraction * area)) {
                 ++ev.counts().missing;
-                map.roughness_class[index] = kClassNone;
-                if (!map.roughness_class_g.empty()) map.roughness_class_g[index] = kClassNone;
+                mark_no_class(map, index);
                 continue;
             }
             if (!s.pixel_log_variance(m1, m2, var)) {
-                ++ev.counts().no_solution;
-                ++ev.counts().no_solution_exponential;
-                map.roughness_class[index] = kClassNone;
-                if (!map.roughness_class_g.empty()) map.roughness_class_g[index] = kClassNone;
+                mark_no_solution(ev, map, index);
                 continue;
             }
             Cell cell;
@@ -769,16 +778,12 @@ void pixel_map(const std::vector<MapCapture>& captures, const MapOptions& o, Eva
             // Running sums of ±1 stay exact integers in n.
             if (!used[k][x] || window.n < 3.0) {
                 ++ev.counts().missing;
-                map.roughness_class[index] = kClassNone;
-                if (!map.roughness_class_g.empty()) map.roughness_class_g[index] = kClassNone;
+                mark_no_class(map, index);
                 continue;
             }
             const double a = x1[k][x], b = x2[k][x];
             if (!(a > 0.0) || !(b > 0.0) || !window.pixel_log_variance(m1, m2, var)) {
-                ++ev.counts().no_solution;
-                ++ev.counts().no_solution_exponential;
-                map.roughness_class[index] = kClassNone;
-                if (!map.roughness_class_g.empty()) map.roughness_class_g[index] = kClassNone;
+                mark_no_solution(ev, map, index);
                 continue;
             }
             Cell cell;
