@@ -273,7 +273,7 @@ void run(Args& a) {
         const std::vector<Comparison> all = compare_curet_all(db, o, a.threads);
         switch (a.format) {
             case Format::Json:
-                text = serialize::dump(serialize::to_json(all, a.series));
+                text = serialize::dump(serialize::versioned(serialize::to_json(all, a.series)));
                 break;
             case Format::Csv:
                 text = serialize::to_csv(all);
@@ -301,7 +301,7 @@ void run(Args& a) {
         require_identified_model(c);
         switch (a.format) {
             case Format::Json:
-                text = serialize::dump(serialize::to_json(c, a.series));
+                text = serialize::dump(serialize::versioned(serialize::to_json(c, a.series)));
                 break;
             case Format::Csv:
                 text = serialize::to_csv({c});

@@ -150,7 +150,7 @@ CLI::Option* add_pair_radiometry_option(CLI::App& cmd, Radiometry& radiometry) {
 void emit(const OutputArgs& o, const json& record) {
     std::string text;
     if (o.json_output) {
-        text = serialize::dump(record);
+        text = serialize::dump(serialize::versioned(record));
     } else {
         std::vector<std::pair<std::string, std::string>> items;
         for (const auto& [key, value] : record.items()) {

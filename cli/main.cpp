@@ -29,6 +29,8 @@ int main(int argc, char** argv) {
     roughscope::cli::register_surface(app);
     roughscope::cli::register_simulate(app);
     roughscope::cli::register_measure(app);
+    // Last: the completion script describes every subcommand registered before it.
+    roughscope::cli::register_completion(app);
 
     return roughscope::cli::run_app(app, argc, argv);
 }

@@ -171,7 +171,8 @@ void run_measure(const MeasureCommand& c) {
                           {"--out", fs::absolute(c.report_dir).string()}, serialize::dump(doc),
                           "measure --report");
     }
-    const std::string text = c.json_output ? serialize::dump(doc) : text_report(doc);
+    const std::string text =
+        c.json_output ? serialize::dump(serialize::versioned(doc)) : text_report(doc);
     write_output(given(c.o_output) ? std::optional<fs::path>(c.output_path) : std::nullopt, text);
 }
 

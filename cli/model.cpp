@@ -30,6 +30,7 @@
 #include "roughscope/scattering/reflectance_models.hpp"
 #include "roughscope/scattering/validity.hpp"
 #include "roughscope/serialize/json.hpp"
+#include "roughscope/version.hpp"
 
 namespace roughscope::cli {
 namespace {
@@ -658,7 +659,7 @@ class RecordWriter {
                 // Nested values (Lafortune lobes): the element as the whole array's dump indents
                 // it: "[\n" + element + "\n]\n".
                 json one = json::array();
-                one.push_back(record.to_json());
+                one.push_back(serialize::versioned(record.to_json()));
                 const std::string text = serialize::dump(one);
                 chunk_.append(text, 2, text.size() - 5);
             }
@@ -696,12 +697,11 @@ class RecordWriter {
     // false (chunk_ unchanged) when a value is nested or needs escaping.
     bool append_json_element(const Record& record) {
         const std::size_t mark = chunk_.size();
-        if (record.items().empty()) {
-            chunk_ += "  {}";
-            return true;
-        }
-        chunk_ += "  {\n";
-        bool first = true;
+        // serialize::versioned: the version first in every element.
+        chunk_ += "  {\n    \"";
+        chunk_ += serialize::kVersionKey;
+        chunk_ += "\": \"" ROUGHSCOPE_VERSION_STRING "\"";
+        bool first = false;
         for (const Record::Item& item : record.items()) {
             if (!first) chunk_ += ",\n";
             first = false;
@@ -790,7 +790,7 @@ void run_model(const Args& a) {
         const json record = result.to_json();
         std::string text;
         if (a.json_output) {
-            text = serialize::dump(record);
+            text = serialize::dump(serialize::versioned(record));
         } else if (output) {
             text = csv_text(record);
         } else {

@@ -145,7 +145,7 @@ void run_tables(const Args& a) {
             "rounding of the printed inputs;  DIFFERS otherwise.\n";
 
     write_output(given(a.o_output) ? std::optional<fs::path>(a.output_path) : std::nullopt,
-                 a.json_output ? serialize::dump(out) : text.str());
+                 a.json_output ? serialize::dump(serialize::versioned(out)) : text.str());
 }
 
 }  // namespace

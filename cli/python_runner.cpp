@@ -27,7 +27,9 @@ std::optional<fs::path> package_dir_beside_executable() {
     if (ec) return std::nullopt;
     for (const fs::path& candidate :
          {exe.parent_path().parent_path() / "python",
-          exe.parent_path().parent_path() / "lib" / "roughscope" / "python"}) {
+          exe.parent_path().parent_path() / "lib" / "roughscope" / "python",
+          // <prefix>/bin/roughscope of the .deb (or a copy of its files in a scratch root)
+          exe.parent_path().parent_path() / "lib" / "python3" / "dist-packages"}) {
         if (fs::exists(candidate / "roughscope" / "plot.py", ec)) return candidate;
     }
     return std::nullopt;

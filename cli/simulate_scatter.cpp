@@ -101,7 +101,7 @@ void run_scatter(const ScatterCommand& c) {
         [&progress](std::size_t done, std::size_t total) { progress(done, total); });
     std::string text;
     if (c.json_output) {
-        text = serialize::dump(serialize::to_json(results, c.options));
+        text = serialize::dump(serialize::versioned(serialize::to_json(results, c.options)));
     } else if (given(c.o_output)) {
         text = serialize::scatter_csv(results);
     } else {

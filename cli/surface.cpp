@@ -216,8 +216,9 @@ void run_stats(const StatsCommand& c) {
         // The map is not needed afterwards: levelled in place (one copy less at the peak).
         stats = surface::surface_statistics(std::move(map), so);
     }
-    emit(c.out, c.out.json_output ? serialize::dump(serialize::to_json(input, stats))
-                                  : serialize::to_text(input, stats));
+    emit(c.out, c.out.json_output
+                    ? serialize::dump(serialize::versioned(serialize::to_json(input, stats)))
+                    : serialize::to_text(input, stats));
 }
 
 // ---- generate -----------------------------------------------------------------------------
@@ -273,7 +274,8 @@ void run_generate(GenerateCommand& c) {
     surface::write_height_map(map, c.out_path,
                               write_options(c.out_format, c.o_z, c.z_scale_um, c.sdf_ascii));
     if (c.json_output && c.out_path != "-")
-        write_output(std::nullopt, serialize::dump(serialize::summary_json(map)));
+        write_output(std::nullopt,
+                     serialize::dump(serialize::versioned(serialize::summary_json(map))));
 }
 
 // ---- convert ------------------------------------------------------------------------------
@@ -331,9 +333,9 @@ void run_predict(const PredictCommand& c) {
             surface::predict_brightness(Surface{c.sigma_um, c.T_um, c.correlation}, geoms, c.model);
     }
     const std::string source = from_file ? c.file : std::string("given");
-    emit(c.out, c.out.json_output
-                    ? serialize::dump(serialize::to_json(prediction, c.model, source, T_source))
-                    : serialize::to_text(prediction, c.model, source));
+    emit(c.out, c.out.json_output ? serialize::dump(serialize::versioned(
+                                        serialize::to_json(prediction, c.model, source, T_source)))
+                                  : serialize::to_text(prediction, c.model, source));
 }
 
 }  // namespace

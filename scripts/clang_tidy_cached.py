@@ -8,7 +8,7 @@ clang-tidy is deterministic: for the same configuration, the same clang-tidy and
 text it gives the same diagnostics. The key of a unit is the SHA-256 of
   - `clang-tidy --version` and the extra arguments,
   - the .clang-tidy file,
-  - the unit's compile command without its paths (compiler flags and defines),
+  - the unit's compile command without its paths and without -Werror (flags and defines),
   - the unit's preprocessed text *with comments kept* (`-E -P -C`): every header it includes (the
     project's headers, which clang-tidy also checks, and the libraries'), and every NOLINT comment.
 A unit is checked unless its key is in the cache; a unit found clean adds its key. A unit with a
@@ -55,8 +55,12 @@ def preprocess_command(entry: dict) -> list[str]:
 
 
 def flags_without_paths(entry: dict) -> str:
+    """The compile flags that can change clang-tidy's findings. -Werror is left out: it turns a
+    warning into an error, and a unit with either is never cached, so a unit found clean without it
+    (make lint) is clean with it (CI, ROUGHSCOPE_WERROR=ON) and shares the key."""
     args = entry.get("arguments") or shlex.split(entry["command"])
-    return " ".join(a for a in args[1:] if not a.startswith(("-I", "/", "-o")) and "/" not in a)
+    return " ".join(a for a in args[1:]
+                    if not a.startswith(("-I", "/", "-o")) and "/" not in a and a != "-Werror")
 
 
 def unit_key(entry: dict, common: bytes) -> str | None:

@@ -12,6 +12,7 @@
 #include "roughscope/core/text.hpp"
 #include "roughscope/io/output_file.hpp"
 #include "roughscope/scattering/factors.hpp"
+#include "roughscope/version.hpp"
 
 namespace roughscope::serialize {
 
@@ -84,6 +85,7 @@ Json capture_sidecar(const simulation::Capture& capture, const CaptureRecord& re
     const simulation::Scene& s = record.scene;
     const simulation::CameraModel& cam = record.camera;
     Json doc;
+    doc[kVersionKey] = ROUGHSCOPE_VERSION_STRING;
     doc["format"] = "roughscope-capture";
     doc["version"] = 1;
     Json files;

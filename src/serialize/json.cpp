@@ -9,6 +9,7 @@
 
 #include "roughscope/core/numbers.hpp"
 #include "roughscope/scattering/geometry.hpp"
+#include "roughscope/version.hpp"
 
 namespace roughscope::serialize {
 
@@ -41,6 +42,19 @@ Json numbers(const std::vector<double>& values) {
 }
 
 Json text_or_null(const std::string& text) { return text.empty() ? Json(nullptr) : Json(text); }
+
+Json versioned(Json document) {
+    if (document.is_array()) {
+        for (Json& element : document) element = versioned(std::move(element));
+        return document;
+    }
+    if (!document.is_object()) return document;
+    Json out = Json::object();
+    out[kVersionKey] = ROUGHSCOPE_VERSION_STRING;
+    for (auto& [key, value] : document.items())
+        if (key != kVersionKey) out[key] = std::move(value);
+    return out;
+}
 
 std::string dump(const Json& value, int indent) {
     // error_handler::replace: invalid UTF-8 in a name read from a file cannot abort the output.

@@ -33,6 +33,14 @@ Json numbers(const std::vector<double>& values);
 // An empty string as null (an absent reason or name), else the string.
 Json text_or_null(const std::string& text);
 
+// The key that names the roughscope version which produced a document ("0.2.0", the project's
+// one version number, CMakeLists.txt).
+inline constexpr const char* kVersionKey = "roughscope_version";
+
+// A document as the command line writes it: an object gets kVersionKey as its first key (an array
+// gets it in each object element); any other value is returned unchanged.
+Json versioned(Json document);
+
 // The document as text: 2-space indentation and a trailing newline (indent < 0: one line).
 std::string dump(const Json& value, int indent = 2);
 
