@@ -106,7 +106,7 @@ def test_generate_needs_out_and_a_known_extension(tmp_path):
 
 def test_stats_json_keys_and_round_trip_recovers_sigma_and_T(gaussian_x3p):
     doc = json.loads(run("surface", "stats", gaussian_x3p, "--json").stdout)
-    assert list(doc) == STATS_KEYS
+    assert list(doc) == ["roughscope_version", *STATS_KEYS]
     assert doc["format"] == "x3p" and doc["nx"] == 256 and doc["points"] == 256 * 256
     # Truth σ = 0.5 µm, T = 8 µm (L/T = 32: the 1/e T is biased low by a few per cent).
     assert abs(doc["sigma_um"] - 0.5) < 0.05

@@ -53,7 +53,7 @@ def fails(code, *args, mentions=()):
 def test_json_has_the_documented_keys_and_agrees_with_the_series():
     doc = json.loads(run(*BASE, "--theta-i", "30,45", "--theta-s", "0,20", "--phi-s", "0,90",
                          "--realisations", "80", "--json").stdout)
-    assert list(doc) == ["options", "results"]
+    assert list(doc) == ["roughscope_version", "options", "results"]
     assert doc["options"]["realisations"] == 80 and doc["options"]["n"] is None
     assert len(doc["results"]) == 2
     for r in doc["results"]:
@@ -119,6 +119,7 @@ def test_cli_and_python_give_the_same_numbers():
                          "--correlation", "exponential", "--theta-i", "20,50",
                          "--theta-s", "10", "--phi-s", "0,120", "--json").stdout)
     py = rs.simulate_scatter([20, 50], 10, [0, 120], **args)
+    assert doc.pop("roughscope_version") == rs.__version__  # the CLI's documents carry it
     assert py == doc
 
 

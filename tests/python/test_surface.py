@@ -76,6 +76,7 @@ def test_statistics_dict_equals_the_cli_json(tmp_path):
         cli = json.loads(subprocess.run([cli_path(), "surface", "stats", str(path), "--json",
                                          *flags], capture_output=True, text=True,
                                         check=True).stdout)
+        assert cli.pop("roughscope_version") == rs.__version__  # the CLI's documents carry it
         py = rs.surface_statistics(rs.read_height_map(str(path))["heights_um"], 0.5, 0.5,
                                    **options)
         assert list(py) == list(cli)
