@@ -33,8 +33,13 @@ if(TARGET _core)
   # The folder is chosen at install time: cmake --install --prefix P and CPack (prefix /usr)
   # give different prefixes to the same build. The Debian package always carries the package:
   # cpack sets ROUGHSCOPE_CPACK (cmake/CPackProject.cmake).
+  # The install script can also be told at install time:
+  #   cmake -DROUGHSCOPE_INSTALL_PYTHON=ON -DCMAKE_INSTALL_PREFIX=P -P BUILD/cmake_install.cmake
   install(CODE "
-    if(${ROUGHSCOPE_INSTALL_PYTHON} OR \"\$ENV{ROUGHSCOPE_CPACK}\" STREQUAL \"1\")
+    if(NOT DEFINED ROUGHSCOPE_INSTALL_PYTHON)
+      set(ROUGHSCOPE_INSTALL_PYTHON ${ROUGHSCOPE_INSTALL_PYTHON})
+    endif()
+    if(ROUGHSCOPE_INSTALL_PYTHON OR \"\$ENV{ROUGHSCOPE_CPACK}\" STREQUAL \"1\")
       set(_dir \"${ROUGHSCOPE_PYTHON_INSTALL_DIR}\")
       if(NOT _dir)
         if(CMAKE_INSTALL_PREFIX STREQUAL \"/usr\" OR \"\$ENV{ROUGHSCOPE_CPACK}\" STREQUAL \"1\")

@@ -127,6 +127,30 @@ def test_wheel_builds_and_installs_into_a_fresh_venv(tmp_path):
     assert values and min(abs(v - 0.3) for v in values) < 1e-6, doc
 
 
+# ---- cmake --install with the Python package ------------------------------------------------
+
+def test_cmake_install_puts_the_python_package_in_the_prefix_site_packages(tmp_path):
+    build = build_dir()
+    prefix = tmp_path / "prefix"
+    # ROUGHSCOPE_INSTALL_PYTHON=ON given to the install script (the build was configured OFF).
+    sh(["cmake", "-DROUGHSCOPE_INSTALL_PYTHON=ON", f"-DCMAKE_INSTALL_PREFIX={prefix}",
+        "-DCMAKE_INSTALL_COMPONENT=runtime", "-P", build / "cmake_install.cmake"], timeout=600)
+    pyver = f"{sys.version_info.major}.{sys.version_info.minor}"
+    site = prefix / "lib" / f"python{pyver}" / "site-packages"
+    assert list((site / "roughscope").glob("_core*.so")), sorted(prefix.rglob("*"))[:20]
+    assert (prefix / "bin" / "roughscope").is_file()
+    assert (prefix / "share" / "man" / "man1" / "roughscope.1.gz").is_file()
+    # Without the option the same install leaves the package out.
+    bare = tmp_path / "bare"
+    sh(["cmake", f"-DCMAKE_INSTALL_PREFIX={bare}", "-DCMAKE_INSTALL_COMPONENT=runtime", "-P",
+        build / "cmake_install.cmake"], timeout=600)
+    assert (bare / "bin" / "roughscope").is_file() and not list(bare.rglob("_core*.so"))
+    env = dict(os.environ, PYTHONPATH=str(site))
+    got = smoke(DEBIAN_PYTHON, env, tmp_path)
+    assert got["version"] == cmake_version()
+    assert pathlib.Path(got["file"]).is_relative_to(site), got["file"]
+
+
 # ---- the Debian packages -----------------------------------------------------------------------
 
 def deb_field(deb, field):
