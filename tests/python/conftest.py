@@ -8,6 +8,7 @@ reason, instead of skipping anything.
 import json
 import os
 import pathlib
+import re
 import subprocess
 import sys
 
@@ -62,6 +63,12 @@ def curet_dir():
 
 # For tests that read CURET_DIR directly: the same skip-or-fail rule as the fixture.
 needs_curet = pytest.mark.usefixtures("curet_dir")
+
+
+def project_version():
+    """The one version of the project: project(roughscope VERSION x.y.z) in CMakeLists.txt."""
+    text = (REPO_ROOT / "CMakeLists.txt").read_text(encoding="utf-8")
+    return re.search(r"project\(\s*roughscope\s+VERSION\s+(\d+\.\d+\.\d+)", text).group(1)
 
 
 # ---------------------------------------------------------------------------------------------

@@ -16,15 +16,11 @@ import pytest
 
 import roughscope as rs
 
-from conftest import cli_path
+from conftest import cli_path, project_version
 
 REPO = pathlib.Path(__file__).resolve().parents[2]
 EXAMPLES = REPO / "docs" / "examples" / "measure"
 
-
-def cmake_version():
-    text = (REPO / "CMakeLists.txt").read_text(encoding="utf-8")
-    return re.search(r"project\(\s*roughscope\s+VERSION\s+(\d+\.\d+\.\d+)", text).group(1)
 
 
 def run(*args, check=True, cwd=None):
@@ -36,7 +32,7 @@ def run(*args, check=True, cwd=None):
 
 
 def test_versions_agree():
-    version = cmake_version()
+    version = project_version()
     assert run("--version").stdout.strip() == f"roughscope {version}"
     assert rs.__version__ == version
     changelog = (REPO / "CHANGELOG.md").read_text(encoding="utf-8")
@@ -80,7 +76,7 @@ def _documents(tmp_path):
 
 
 def test_every_json_document_starts_with_the_version(tmp_path):
-    version = cmake_version()
+    version = project_version()
     seen = 0
     for args, doc in _documents(tmp_path):
         records = doc if isinstance(doc, list) else [doc]
@@ -97,7 +93,7 @@ def test_capture_sidecar_carries_the_version(tmp_path):
     run("simulate", "capture", "--width", 32, "--height", 24, "--out", tmp_path / "c")
     sidecar = next((tmp_path / "c").glob("*.json"))
     doc = json.loads(sidecar.read_text())
-    assert next(iter(doc)) == "roughscope_version" and doc["roughscope_version"] == cmake_version()
+    assert next(iter(doc)) == "roughscope_version" and doc["roughscope_version"] == project_version()
 
 
 # ---- bash completion -----------------------------------------------------------------------------

@@ -22,13 +22,11 @@ import pytest
 
 import roughscope as rs
 
+from conftest import project_version
+
 REPO = pathlib.Path(__file__).resolve().parents[2]
 DEBIAN_PYTHON = "/usr/bin/python3"
 
-
-def cmake_version():
-    text = (REPO / "CMakeLists.txt").read_text(encoding="utf-8")
-    return re.search(r"project\(\s*roughscope\s+VERSION\s+(\d+\.\d+\.\d+)", text).group(1)
 
 
 def sh(args, **kwargs):
@@ -88,7 +86,7 @@ def expected_smoke():
 
 
 def test_wheel_builds_and_installs_into_a_fresh_venv(tmp_path):
-    version = cmake_version()
+    version = project_version()
     src = tracked_copy(tmp_path / "src")
     env = dict(os.environ)
     env.pop("PYTHONPATH", None)
@@ -147,7 +145,7 @@ def test_cmake_install_puts_the_python_package_in_the_prefix_site_packages(tmp_p
     assert (bare / "bin" / "roughscope").is_file() and not list(bare.rglob("_core*.so"))
     env = dict(os.environ, PYTHONPATH=str(site))
     got = smoke(DEBIAN_PYTHON, env, tmp_path)
-    assert got["version"] == cmake_version()
+    assert got["version"] == project_version()
     assert pathlib.Path(got["file"]).is_relative_to(site), got["file"]
 
 
@@ -173,7 +171,7 @@ def debs(tmp_path_factory):
 
 def test_deb_fields(debs):
     found, _ = debs
-    version = cmake_version()
+    version = project_version()
     for deb in found.values():
         assert deb_field(deb, "Version") == version
         assert deb.name.endswith(f"_{version}_{sh(['dpkg', '--print-architecture']).strip()}.deb")
@@ -187,14 +185,14 @@ def test_deb_fields(debs):
 def test_deb_cli_runs_from_a_scratch_root(debs, tmp_path):
     _, root = debs
     cli = root / "usr" / "bin" / "roughscope"
-    assert sh([cli, "--version"]).strip() == f"roughscope {cmake_version()}"
+    assert sh([cli, "--version"]).strip() == f"roughscope {project_version()}"
     # A short measurement: the capture file of the installed documentation.
     example = root / "usr" / "share" / "doc" / "roughscope" / "docs" / "examples" / "measure"
     doc = sh([cli, "measure", example / "capture-file.json", "--json"], cwd=tmp_path)
     reference = sh([os.environ.get("ROUGHSCOPE_CLI") or REPO / "build" / "bin" / "roughscope",
                     "measure", REPO / "docs" / "examples" / "measure" / "capture-file.json",
                     "--json"], cwd=tmp_path)
-    assert json.loads(doc)["roughscope_version"] == cmake_version()
+    assert json.loads(doc)["roughscope_version"] == project_version()
     assert json.loads(doc)["sigma_over_T_gaussian"] is not None
     # The same numbers as the build tree's CLI (paths of the example files aside).
     assert doc.replace(str(example), "EXAMPLE") == reference.replace(
@@ -206,7 +204,7 @@ def test_deb_python_package_imports_from_the_root(debs, tmp_path):
     site = root / "usr" / "lib" / "python3" / "dist-packages"
     env = dict(os.environ, PYTHONPATH=str(site))
     got = smoke(DEBIAN_PYTHON, env, tmp_path)
-    assert got["version"] == cmake_version()
+    assert got["version"] == project_version()
     assert pathlib.Path(got["file"]).is_relative_to(site), got["file"]
     assert got["brightness"] == pytest.approx(expected_smoke(), rel=1e-14)
 
@@ -220,7 +218,7 @@ def test_deb_man_page_and_completion(debs, tmp_path):
         assert found.is_relative_to(man_dir), found
     text = sh(["man", "-P", "cat", "roughscope"], env=env)
     assert "measure" in text and "roughscope-measure(1)" in re.sub(r".\x08", "", text)
-    assert cmake_version() in text
+    assert project_version() in text
     measure = re.sub(r".\x08", "", sh(["man", "-P", "cat", "roughscope-measure"], env=env))
     assert "--maps" in measure and "capture" in measure
     completion = root / "usr" / "share" / "bash-completion" / "completions" / "roughscope"
@@ -234,10 +232,10 @@ def test_deb_cmake_package_version(debs):
     config = root / "usr" / "lib" / "cmake" / "roughscope" / "roughscopeConfigVersion.cmake"
     if not config.exists():
         config = next(root.glob("usr/lib/*/cmake/roughscope/roughscopeConfigVersion.cmake"))
-    assert f'set(PACKAGE_VERSION "{cmake_version()}")' in config.read_text()
+    assert f'set(PACKAGE_VERSION "{project_version()}")' in config.read_text()
     archives = list(root.glob("usr/lib*/**/libroughscope_core.a"))
     assert archives, "libroughscope-dev holds no static library"
     # Not stripped of its symbols (CPACK_STRIP_FILES must leave archives linkable).
     assert " T " in sh(["nm", "--defined-only", archives[0]])
     assert (root / "usr" / "include" / "roughscope" / "version.hpp").read_text().count(
-        f'"{cmake_version()}"') == 1
+        f'"{project_version()}"') == 1
