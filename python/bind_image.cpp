@@ -149,7 +149,7 @@ void bind_image(py::module_& m) {
         "Reads a photograph (PNG, TIFF, JPEG, camera RAW) on a linear scale (response None: what "
         "the file says; 'linear', 'srgb' or 'gamma' with gamma): a dict with values "
         "(channels, height, width) float32, flags (height, width) uint8 (1 saturated, 2 clipped "
-        "low) and info (docs/image.md).");
+        "low, 4 no flat field, 8 missing: NaN in a float file) and info (docs/image.md).");
     m.def(
         "region_mask",
         [](const py::dict& roi, py::handle width_in, py::handle height_in) {

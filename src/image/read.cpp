@@ -330,10 +330,19 @@ void Linearizer::put(const T* samples, std::size_t row, std::size_t stride, std:
         const double inverse_range = 1.0 / (white_ - black);
         for (std::size_t x = 0; x < width; ++x) {
             const float q = in[x * stride];
+            if (std::isnan(q)) {
+                // A missing value (NaN: the usual marker of float rasters, roughscope's maps
+                // too): flagged, stored as 0, never averaged.
+                out[x] = 0.0F;
+                flags[x] |= kPixelMissing;
+                continue;
+            }
             if (!std::isfinite(q))
                 throw DataError(concat(image_.info.source, ": sample ", number(q), " at row ",
                                        std::to_string(row), ", column ", std::to_string(x),
-                                       " of plane ", std::to_string(plane), " is not finite"));
+                                       " of plane ", std::to_string(plane),
+                                       " is infinite; valid: a finite value, or NaN for a "
+                                       "missing one"));
             const double s = response_ == Response::Linear ? q : linear_code(q);
             const double value = (s - black) * inverse_range;
             if (!(std::abs(value) <= std::numeric_limits<float>::max()))

@@ -218,6 +218,15 @@ def test_map_regions_recover_the_truth_and_files_are_written(flat_map, tmp_path)
     classes_npy = np.load(out / "roughness_class.npy")
     np.testing.assert_array_equal(np.nan_to_num(classes_npy, nan=255).astype(np.uint8),
                                   py["map"]["layers"]["roughness_class"])
+    # The float TIFF read back by the project's own reader: the same values, and a NaN cell (no
+    # estimate; none here, MapFiles.FloatTiffReadsBackBitExactly has them) flagged missing (8).
+    back = roughscope.read_image(str(out / "sigma_over_T_gaussian.tiff"), response="linear")
+    missing = np.isnan(layer)
+    # (bit 1, "saturated", marks values >= 1: a float file's white level is 1)
+    np.testing.assert_array_equal(back["flags"] & 8, np.where(missing, 8, 0).astype(np.uint8))
+    np.testing.assert_array_equal(back["flags"] & 1, (layer >= 1).astype(np.uint8))
+    np.testing.assert_array_equal(back["values"][0][~missing], layer[~missing])
+    assert (back["values"][0][missing] == 0).all()
 
 
 def test_a_shifted_pair_is_refused_with_the_shift(flat_map, tmp_path):

@@ -171,7 +171,9 @@ def test_two_geometry_solver_inverts_the_forward_model(correlation):
 
 
 def test_two_geometry_solver_bad_input():
-    with pytest.raises(rs.NoSolution, match="must be in"):
+    # Eq. 16's range at normal view: E1/E2 > C (ratio_range_gaussian)
+    C = rs.ratio_range_gaussian(30, 45)[0]
+    with pytest.raises(rs.NoSolution, match=f"must be > {C:.7g}"):
         rs.sigma_over_T_two_geometries(0.5, 30, 0, 0, 45, 0, 0)
     with pytest.raises(rs.InvalidArgument, match="same v_xy"):
         rs.sigma_over_T_two_geometries(1.1, 30, 0, 0, 30, 0, 0)

@@ -114,6 +114,13 @@ struct TwoGeometryOptions {
     double upper = 1e4;
     double relative_tolerance = 1e-13;  // on the unknown
     int max_iterations = 200;
+    // For correlation_length_two_geometries in the Series and Auto regimes only (the exact
+    // series' ratio need not be monotonic in T): when E1/E2 has several solutions, one T is kept
+    // only if, at T, the diffuse brightness of each geometry is at least this fraction of the
+    // diffuse brightness in the specular direction of the same incidence (fainter than that, no
+    // camera sees the sample beside its own highlight). Several kept solutions are an error
+    // (NoSolution) listing them; a single solution is returned whatever its brightness.
+    double min_observable_fraction = 1e-12;
 };
 
 // σ/T for a very-rough surface (Eq. 4 Gaussian / Eq. 5 exponential, as published) from

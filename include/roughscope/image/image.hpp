@@ -31,6 +31,9 @@ inline constexpr std::uint8_t kPixelClippedLow = 2;   // a channel at or below t
 inline constexpr std::uint8_t kPixelNoFlatField = 4;  // no usable flat-field value (the flat is
                                                       // ≤ 0 or flagged there): not corrected
                                                       // (image/radiometry.hpp)
+inline constexpr std::uint8_t kPixelMissing = 8;      // no value: a NaN sample of a float file
+                                                      // (e.g. a roughscope map's cells without
+                                                      // an estimate); the value is stored as 0
 
 // What the file said about itself and what reading it did.
 struct ImageInfo {

@@ -18,7 +18,8 @@
 //                           decode; gamma γ: s = F · (q/F)^γ),
 // then value = (s − black) / (white − black), with black and white levels in the units of s
 // (linear DN). Flags (per pixel): kPixelSaturated when a channel has s ≥ white, kPixelClippedLow
-// when a channel has s ≤ black (RAW: per sensor site, against its own black level).
+// when a channel has s ≤ black (RAW: per sensor site, against its own black level), kPixelMissing
+// when a sample of a float file is NaN (value 0); an infinite float sample is a DataError.
 #pragma once
 
 #include <cstddef>

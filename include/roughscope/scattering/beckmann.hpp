@@ -178,6 +178,21 @@ inline double very_rough_shape_exponential(double F2, const ScatteringDirection&
            (q.qz2() * std::pow(1.0 + very_rough_argument(q.qxy2(), q.qz2(), sigma_over_T), 1.5));
 }
 
+// Natural logarithms of the two shapes, finite where the shapes underflow (ratios of very-rough
+// brightnesses at two geometries are formed from these):
+//   Gaussian:    ln F² − ln q_z² − q_xy²/(4 (σ/T)² q_z²)
+//   Exponential: ln F² − ln q_z² − (3/2) ln(1 + q_xy²/((σ/T)² q_z²))
+inline double log_very_rough_shape_gaussian(double F2, const ScatteringDirection& q,
+                                            double sigma_over_T) {
+    return std::log(F2) - std::log(q.qz2()) -
+           0.25 * very_rough_argument(q.qxy2(), q.qz2(), sigma_over_T);
+}
+inline double log_very_rough_shape_exponential(double F2, const ScatteringDirection& q,
+                                               double sigma_over_T) {
+    return std::log(F2) - std::log(q.qz2()) -
+           1.5 * std::log1p(very_rough_argument(q.qxy2(), q.qz2(), sigma_over_T));
+}
+
 // ---------------------------------------------------------------------------------------------
 // Validated, user-facing evaluation.
 

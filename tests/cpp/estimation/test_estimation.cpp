@@ -380,6 +380,87 @@ TEST(TwoGeometrySolver, RecoversCorrelationLengthWithTheExactSeries) {
         }
 }
 
+TEST(TwoGeometrySolver, RecoversSlopeWhereTheBracketReachesUnderflow) {
+    // Far from both specular directions, the brightness of one geometry underflows at small σ/T
+    // (exp(−q_xy²/(4(σ/T)²q_z²))), where the bracket search passes on its way to the root; the
+    // solver works with ln B and the roots are found. Truth from the forward model (Eq. 4/5).
+    const rs::Geometry g1 = rs::make_geometry(deg_to_rad(5), deg_to_rad(80), deg_to_rad(120));
+    const rs::Geometry g2 = rs::make_geometry(deg_to_rad(60), deg_to_rad(80), deg_to_rad(170));
+    for (auto c : {rs::Correlation::Gaussian, rs::Correlation::Exponential})
+        for (double s : {0.1, 0.3, 1.0}) {
+            const double r = very_rough_E(g1, s, c) / very_rough_E(g2, s, c);
+            ASSERT_TRUE(std::isfinite(r) && r > 0.0);
+            EXPECT_NEAR(rs::sigma_over_T_two_geometries(r, g1, g2, c), s, 1e-9 * s)
+                << rs::to_string(c) << " s = " << s << " E1/E2 = " << r;
+        }
+}
+
+TEST(TwoGeometrySolver, RecoversCorrelationLengthNearTheEdgeOfTheFiniteRange) {
+    // Eq. 3 at 30°/32° (viewer on the normal), σ = 0.02 µm: each brightness underflows above
+    // T ≈ 9 µm; the root T = 8 µm lies between two steps of the bracket search, the second of
+    // which is beyond that edge. Truth: Eq. 15 in closed form.
+    const double t1 = deg_to_rad(30), t2 = deg_to_rad(32), sigma = 0.02;
+    const double r = std::exp(63.22684089540162);
+    const double closed = rs::correlation_length_from_ratio(r, sigma, t1, t2, kLambda);
+    ASSERT_NEAR(closed, 8.0, 1e-9);
+    rs::TwoGeometryOptions o;
+    o.wavelength_um = kLambda;
+    EXPECT_NEAR(rs::correlation_length_two_geometries(r, rs::normal_view_geometry(t1),
+                                                      rs::normal_view_geometry(t2), sigma,
+                                                      rs::Correlation::Gaussian, o),
+                closed, 1e-9 * closed);
+}
+
+TEST(TwoGeometrySolver, SeveralSolutionsForTAreAnErrorThatListsThem) {
+    // The exact series' ratio is not monotonic in T when the two geometries' g differ
+    // (here g ≈ 11 and 3.6): E1/E2 of T = 3 µm is also that of T ≈ 1.95 µm. Each listed value
+    // reproduces the ratio (forward model), and a bracket around one returns it.
+    rs::TwoGeometryOptions o;
+    o.regime = rs::Regime::Series;
+    o.wavelength_um = kLambda;
+    const rs::Geometry g1 = rs::make_geometry(deg_to_rad(10), deg_to_rad(60), 0.0);
+    const rs::Geometry g2 = rs::make_geometry(deg_to_rad(70), deg_to_rad(60), deg_to_rad(30));
+    const double sigma = 0.2;
+    const auto c = rs::Correlation::Gaussian;
+    const double r = rs::model_ratio_diffuse(g1, g2, sigma, 3.0, c, o);
+    try {
+        rs::correlation_length_two_geometries(r, g1, g2, sigma, c, o);
+        FAIL() << "expected NoSolution";
+    } catch (const rs::NoSolution& e) {
+        const std::string m = e.what();
+        EXPECT_NE(m.find("not monotonic in T"), std::string::npos) << m;
+        EXPECT_NE(m.find("T = 1.95"), std::string::npos) << m;
+        EXPECT_NE(m.find(" and 3 um"), std::string::npos) << m;
+    }
+    rs::TwoGeometryOptions narrow = o;
+    narrow.lower = 2.5;
+    narrow.upper = 10.0;
+    EXPECT_NEAR(rs::correlation_length_two_geometries(r, g1, g2, sigma, c, narrow), 3.0, 1e-9);
+    narrow.lower = 1.0;
+    narrow.upper = 2.5;
+    const double other = rs::correlation_length_two_geometries(r, g1, g2, sigma, c, narrow);
+    EXPECT_NEAR(other, 1.95, 0.01);
+    EXPECT_NEAR(rs::model_ratio_diffuse(g1, g2, sigma, other, c, o), r, 1e-9 * r);
+}
+
+TEST(TwoGeometrySolver, AnUnobservableSecondSolutionIsDropped) {
+    // σ = 1 µm (g ≈ 280 and 91): E1/E2 of T = 3 µm is also reached at T ≈ 109 µm, where the
+    // surface is a near-mirror (σ/T ≈ 0.01) and the 10°/60° brightness is ~1e-130 of the
+    // specular direction's: that solution is dropped. With the floor at 0 both are listed.
+    rs::TwoGeometryOptions o;
+    o.regime = rs::Regime::Series;
+    o.wavelength_um = kLambda;
+    const rs::Geometry g1 = rs::make_geometry(deg_to_rad(10), deg_to_rad(60), 0.0);
+    const rs::Geometry g2 = rs::make_geometry(deg_to_rad(70), deg_to_rad(60), deg_to_rad(30));
+    const auto c = rs::Correlation::Gaussian;
+    const double r = rs::model_ratio_diffuse(g1, g2, 1.0, 3.0, c, o);
+    EXPECT_NEAR(rs::correlation_length_two_geometries(r, g1, g2, 1.0, c, o), 3.0, 1e-9);
+    o.min_observable_fraction = 0.0;
+    EXPECT_THROW(rs::correlation_length_two_geometries(r, g1, g2, 1.0, c, o), rs::NoSolution);
+    o.min_observable_fraction = 1.5;
+    EXPECT_THROW(rs::correlation_length_two_geometries(r, g1, g2, 1.0, c, o), rs::InvalidArgument);
+}
+
 TEST(TwoGeometrySolver, NoSolutionGivesTheRangeAndSameGeometryIsInvalid) {
     rs::TwoGeometryOptions o;
     const auto g1 = rs::normal_view_geometry(deg_to_rad(30));
@@ -388,7 +469,12 @@ TEST(TwoGeometrySolver, NoSolutionGivesTheRangeAndSameGeometryIsInvalid) {
         rs::sigma_over_T_two_geometries(0.9, g1, g2, rs::Correlation::Gaussian, o);
         FAIL() << "expected NoSolution";
     } catch (const rs::NoSolution& e) {
-        EXPECT_NE(std::string(e.what()).find("must be in ("), std::string::npos) << e.what();
+        // Eq. 16's range at normal view: E1/E2 > C (ratio_range_gaussian), C = 1.025019.
+        EXPECT_NE(std::string(e.what()).find("must be > 1.025019"), std::string::npos) << e.what();
+        EXPECT_NEAR(rs::ratio_range_gaussian(g1.theta_i_rad, g2.theta_i_rad,
+                                             rs::GeometricFactor::VernoldHarvey)
+                        .lower,
+                    1.025019, 1e-6);
     }
     EXPECT_THROW(rs::sigma_over_T_two_geometries(1.1, g1, g1, rs::Correlation::Gaussian, o),
                  rs::InvalidArgument);

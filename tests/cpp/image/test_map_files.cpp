@@ -74,16 +74,38 @@ TEST(MapFiles, FloatTiffReadsBackBitExactly) {
         EXPECT_TRUE(same_bits(direct[i], layer[i])) << i;
         EXPECT_TRUE(same_bits(image.values[i], layer[i])) << i;
     }
-    // Missing values stay NaN in the file (libtiff); the photograph reader refuses non-finite
-    // samples (a map is not a photograph).
+    // Missing values stay NaN in the file (libtiff); the photograph reader flags them missing
+    // (value 0) and reads every other cell bit for bit.
     std::vector<float> holes = layer;
     holes[5] = std::numeric_limits<float>::quiet_NaN();
+    holes[W * 3 + 7] = std::numeric_limits<float>::quiet_NaN();
     const fs::path hpath = dir / "holes.tiff";
     io::write_file_atomic(hpath, encode_map_tiff_float(holes, W, H));
     const std::vector<float> back = read_tiff_with_libtiff(hpath, w, h);
     EXPECT_TRUE(std::isnan(back[5]));
     EXPECT_TRUE(same_bits(back[6], holes[6]));
-    EXPECT_THROW((void)read_image(hpath.string()), DataError);
+    const LinearImage with_holes = read_image(hpath.string());
+    EXPECT_EQ(count_flagged(with_holes, kPixelMissing), 2u);
+    for (std::size_t i = 0; i < holes.size(); ++i) {
+        if (std::isnan(holes[i])) {
+            EXPECT_EQ(with_holes.flags[i], kPixelMissing) << i;
+            EXPECT_EQ(with_holes.values[i], 0.0F) << i;
+        } else {
+            EXPECT_EQ(with_holes.flags[i] & kPixelMissing, 0) << i;
+            EXPECT_TRUE(same_bits(with_holes.values[i], holes[i])) << i;
+        }
+    }
+    // An infinite sample is not a missing value: refused, naming it.
+    std::vector<float> inf = layer;
+    inf[9] = std::numeric_limits<float>::infinity();
+    const fs::path ipath = dir / "inf.tiff";
+    io::write_file_atomic(ipath, encode_map_tiff_float(inf, W, H));
+    try {
+        (void)read_image(ipath.string());
+        FAIL() << "expected DataError";
+    } catch (const DataError& e) {
+        EXPECT_NE(std::string(e.what()).find("is infinite"), std::string::npos) << e.what();
+    }
 }
 
 TEST(MapFiles, NpyFollowsTheFormatSpecification) {

@@ -738,11 +738,24 @@ TEST(ReadImage, UnsupportedDepthsLayoutsAndHugeImagesAreDataErrors) {
                             {"huge.png", "20001 x 20000", "400000000"});
 }
 
-TEST(ReadImage, NonFiniteFloatSamplesAreDataErrors) {
-    const std::vector<float> samples = {0.5F, std::numeric_limits<float>::quiet_NaN()};
-    const ByteVector file = testing::tiff_image(2, 1, 1, 32, 3, testing::raw_bytes(samples));
-    expect_error<DataError>([&] { decode(file, {}, "nan.tif"); },
-                            {"nan.tif", "column 1", "not finite"});
+TEST(ReadImage, NaNFloatSamplesAreMissingAndInfiniteOnesDataErrors) {
+    // NaN marks a missing value in float rasters: the pixel is flagged kPixelMissing, value 0.
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    const std::vector<float> grey = {0.5F, nan, 0.25F};
+    const LinearImage g =
+        decode(testing::tiff_image(3, 1, 1, 32, 3, testing::raw_bytes(grey)), {}, "nan.tif");
+    EXPECT_EQ(g.flags, (std::vector<std::uint8_t>{0, kPixelMissing, 0}));
+    EXPECT_EQ(g.values, (std::vector<float>{0.5F, 0.0F, 0.25F}));
+    // RGB (interleaved): one NaN channel flags the pixel; its other channels are kept.
+    const std::vector<float> rgb = {0.1F, 0.2F, 0.3F, 0.4F, nan, 0.6F};
+    const LinearImage c =
+        decode(testing::tiff_image(2, 1, 3, 32, 3, testing::raw_bytes(rgb)), {}, "nan3.tif");
+    EXPECT_EQ(c.flags, (std::vector<std::uint8_t>{0, kPixelMissing}));
+    EXPECT_EQ(c.values, (std::vector<float>{0.1F, 0.4F, 0.2F, 0.0F, 0.3F, 0.6F}));  // planar
+    const std::vector<float> inf = {0.5F, -std::numeric_limits<float>::infinity()};
+    const ByteVector file = testing::tiff_image(2, 1, 1, 32, 3, testing::raw_bytes(inf));
+    expect_error<DataError>([&] { decode(file, {}, "inf.tif"); },
+                            {"inf.tif", "column 1", "is infinite", "NaN for a missing one"});
 }
 
 TEST(ReadImage, ValuesBeyondTheFloatRangeAreRefused) {
