@@ -499,7 +499,7 @@ RootResult solve_log_ratio(
 
 // Every solution of ln M(x) = target in [lower, upper] for a model ratio that need not be
 // monotonic in x (the exact series in T: the two geometries' diffuse powers change regime at
-// different T). ln M is sampled on a grid of 8 points per decade of x; the edges of the finite
+// different T). ln M is sampled on a grid of 4 points per decade of x; the edges of the finite
 // part are located by bisection; a sign change between neighbours is a root (TOMS 748); an
 // interior extremum of the samples is refined (Brent) and, when it crosses the target, gives two
 // roots. The range reported for "no solution" is the one M spans over the samples and extrema.
@@ -513,15 +513,16 @@ template <class F>
 ScanResult scan_log_ratio(F&& log_ratio, double target, const TwoGeometryOptions& o) {
     auto g = [&](double y) { return log_ratio(std::exp(y)) - target; };
     const double ylo = std::log(o.lower), yhi = std::log(o.upper);
-    constexpr double kPointsPerDecade = 8.0;
+    constexpr double kPointsPerDecade = 4.0;
     const auto n =
         static_cast<std::size_t>(std::ceil((yhi - ylo) / std::log(10.0) * kPointsPerDecade)) + 1;
     std::vector<double> ys, fs;
     ys.reserve(n + 4);
     fs.reserve(n + 4);
-    // Bisection toward the edge of the finite part between a finite and a non-finite sample.
+    // Bisection toward the edge of the finite part between a finite and a non-finite sample, to
+    // 1e-4 in ln x (a root closer than that to where the brightness underflows is not looked for).
     auto edge = [&](double y_good, double y_bad) {
-        for (int i = 0; i < 60 && std::abs(y_bad - y_good) > 1e-9; ++i) {
+        for (int i = 0; i < 60 && std::abs(y_bad - y_good) > 1e-4; ++i) {
             const double m = 0.5 * (y_good + y_bad);
             if (std::isfinite(g(m)))
                 y_good = m;
@@ -566,7 +567,7 @@ ScanResult scan_log_ratio(F&& log_ratio, double target, const TwoGeometryOptions
     auto add_root = [&](double ya, double yb, double fa, double fb) {
         out.roots.push_back(fa == 0.0 ? std::exp(ya) : polish_root(g, ya, yb, fa, fb, o));
     };
-    const int kBits = 40;
+    const int kBits = 24;
     for (std::size_t j = 0; j + 1 < ys.size(); ++j) {
         const double fa = fs[j], fb = fs[j + 1];
         if (!std::isfinite(fa) || !std::isfinite(fb)) continue;
