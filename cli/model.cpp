@@ -10,6 +10,8 @@
 #include <array>
 #include <charconv>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <filesystem>
 #include <iostream>
 #include <memory>
@@ -294,6 +296,26 @@ class Record {
         double number = 0.0;
         std::string text;
         json nested;
+        // The writer's last formatted number and its text: a record is reused row after row and
+        // most of its numbers (the options echoed) repeat, so each is formatted once.
+        enum class Style : std::uint8_t { None, Csv, Json };
+        mutable Style formatted_style = Style::None;
+        mutable std::uint8_t formatted_size = 0;
+        mutable double formatted_number = 0.0;
+        mutable std::array<char, 64> formatted{};
+
+        // The text of `number` in `style`, by `format(buffer) -> end` when not the cached one.
+        template <class Format>
+        std::string_view number_text(Style style, Format&& format) const {
+            if (formatted_style != style ||
+                std::memcmp(&formatted_number, &number, sizeof number) != 0) {
+                const char* end = format(formatted.data());
+                formatted_size = static_cast<std::uint8_t>(end - formatted.data());
+                formatted_number = number;
+                formatted_style = style;
+            }
+            return {formatted.data(), formatted_size};
+        }
 
         Value& operator=(std::nullptr_t) {
             kind = Kind::Null;
@@ -603,10 +625,9 @@ bool append_json_scalar(std::string& out, const Record::Value& v) {
                 return true;
             }
             // nlohmann's own shortest round-trip formatter, as its serializer calls it.
-            std::array<char, 64> buf{};
-            const char* end =
-                nlohmann::detail::to_chars(buf.data(), buf.data() + buf.size(), v.number);
-            out.append(buf.data(), static_cast<std::size_t>(end - buf.data()));
+            out += v.number_text(Record::Value::Style::Json, [&](char* buf) {
+                return nlohmann::detail::to_chars(buf, buf + 64, v.number);
+            });
             return true;
         }
         case Kind::Text:
@@ -626,10 +647,11 @@ void append_csv_cell(std::string& out, const Record::Value& v) {
     using Kind = Record::Value::Kind;
     if (v.kind == Kind::Number && std::isfinite(v.number)) {
         // format_result's "%.10g" (no "-0"), without a temporary string.
-        std::array<char, roughscope::kSignificantBufferSize> buf{};
-        const char* end = roughscope::write_significant(
-            buf.data(), v.number == 0.0 ? 0.0 : v.number, kPrintDigits);
-        out.append(buf.data(), static_cast<std::size_t>(end - buf.data()));
+        static_assert(roughscope::kSignificantBufferSize <= 64);
+        out += v.number_text(Record::Value::Style::Csv, [&](char* buf) {
+            return roughscope::write_significant(buf, v.number == 0.0 ? 0.0 : v.number,
+                                                 kPrintDigits);
+        });
         return;
     }
     if (v.kind == Kind::Null) return;  // cell_text: ""

@@ -158,37 +158,45 @@ std::string format_roundtrip(double value, std::string_view name) {
     return std::string(buf, res.ptr);
 }
 
-char* write_significant(char* out, double value, int digits) {
-    // Shortest round-trip digits S of a normal double v are within half an ulp (relative
-    // 2^-53) of v, far less than half a unit of the 15th significant digit (relative ≥ 5e-16):
-    // with k ≤ digits ≤ 15 digits, S is the correctly rounded value, and with more, S rounds to
-    // the same `digits` digits as v unless a rounding boundary lies between them, which the
-    // shortest (and, among the shortest, closest) digits exclude; S ending on an exact tie
-    // ("…5" right after the kept digits) goes to the exact path.
+// Shortest round-trip digits S of a normal double v are within half an ulp (relative 2^-53) of
+// v, far less than half a unit of the 15th significant digit (relative ≥ 5e-16): with
+// k ≤ digits ≤ 15 digits, S is the correctly rounded value, and with more, S rounds to the same
+// `digits` digits as v unless a rounding boundary lies between them, which the shortest (and,
+// among the shortest, closest) digits exclude; S ending on an exact tie ("…5" right after the
+// kept digits) goes to the exact path.
+SignificantDigits::SignificantDigits(double value) : value_(value) {
     const double magnitude = std::abs(value);
-    if (digits < 1 || digits > 15 || !(magnitude >= std::numeric_limits<double>::min()) ||
-        !std::isfinite(value))
-        return write_significant_exact(out, value, digits);
+    if (!(magnitude >= std::numeric_limits<double>::min()) || !std::isfinite(value)) return;
     char sci[kSignificantBufferSize];
     const auto printed = std::to_chars(sci, sci + sizeof sci, value, std::chars_format::scientific);
-    if (printed.ec != std::errc()) return write_significant_exact(out, value, digits);
+    if (printed.ec != std::errc()) return;
     const char* p = sci;
-    const bool negative = *p == '-';
-    if (negative) ++p;
-    char dig[24];
+    negative_ = *p == '-';
+    if (negative_) ++p;
     int k = 0;
     for (; p < printed.ptr && *p != 'e'; ++p)
-        if (*p != '.') dig[k++] = *p;
-    if (p == printed.ptr) return write_significant_exact(out, value, digits);
+        if (*p != '.') digits_[k++] = *p;
+    if (p == printed.ptr) return;
     ++p;  // 'e'
     const bool negative_exponent = *p == '-';
     if (*p == '-' || *p == '+') ++p;
     int exponent = 0;
     for (; p < printed.ptr; ++p) exponent = exponent * 10 + (*p - '0');
-    if (negative_exponent) exponent = -exponent;
+    count_ = k;
+    exponent_ = negative_exponent ? -exponent : exponent;
+    decomposed_ = true;
+}
+
+char* SignificantDigits::write(char* out, int digits) const {
+    if (digits < 1 || digits > 15 || !decomposed_)
+        return write_significant_exact(out, value_, digits);
+    char dig[24];
+    int k = count_;
+    int exponent = exponent_;
+    std::copy(digits_, digits_ + k, dig);
     if (k > digits) {
         if (k == digits + 1 && dig[digits] == '5')
-            return write_significant_exact(out, value, digits);
+            return write_significant_exact(out, value_, digits);
         const bool up = dig[digits] >= '5';
         k = digits;
         if (up) {
@@ -204,7 +212,7 @@ char* write_significant(char* out, double value, int digits) {
     }
     while (k > 1 && dig[k - 1] == '0') --k;  // %g drops trailing zeros
     char* o = out;
-    if (negative) *o++ = '-';
+    if (negative_) *o++ = '-';
     if (exponent < -4 || exponent >= digits) {  // style e
         *o++ = dig[0];
         if (k > 1) {
@@ -229,6 +237,11 @@ char* write_significant(char* out, double value, int digits) {
         for (int i = 0; i < k; ++i) *o++ = dig[i];
     }
     return o;
+}
+
+char* write_significant(char* out, double value, int digits) {
+    if (digits < 1 || digits > 15) return write_significant_exact(out, value, digits);
+    return SignificantDigits(value).write(out, digits);
 }
 
 std::string format_significant(double value, int digits, std::string_view name) {

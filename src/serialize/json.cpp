@@ -21,10 +21,11 @@ Json degrees(double radians) {
     const double deg = rad_to_deg(radians);
     if (!std::isfinite(deg)) return nullptr;
     char buf[kSignificantBufferSize + 1];
+    const SignificantDigits significant(deg);  // the shortest digits found once
     for (int digits = 1; digits <= 17; ++digits) {
-        // "%.*g" and strtod, without printf's format parsing (write_significant gives printf's
+        // "%.*g" and strtod, without printf's format parsing (SignificantDigits gives printf's
         // characters; from_chars rounds as strtod).
-        char* const end = write_significant(buf, deg, digits);
+        char* const end = significant.write(buf, digits);
         double candidate = deg;
         if (std::from_chars(buf, end, candidate).ec != std::errc()) {
             *end = '\0';

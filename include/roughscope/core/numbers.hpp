@@ -72,6 +72,22 @@ std::string format_significant(double value, int digits, std::string_view name =
 inline constexpr std::size_t kSignificantBufferSize = 32;
 char* write_significant(char* out, double value, int digits);
 
+// write_significant at several precisions of one value: the shortest round-trip digits are
+// found once (the costly step), and each write() rounds them (same bytes as write_significant).
+class SignificantDigits {
+  public:
+    explicit SignificantDigits(double value);
+    char* write(char* out, int digits) const;
+
+  private:
+    double value_;
+    bool decomposed_ = false;  // false: every precision through the exact path
+    bool negative_ = false;
+    int count_ = 0;  // digits in digits_
+    int exponent_ = 0;
+    char digits_[24] = {};
+};
+
 // For error messages only: the shortest round-trip form, or `digits` significant digits when
 // digits > 0 — unless the rounded text has fewer significant digits than `digits` and differs
 // from the value by more than floating-point noise (relative 1e-14): 1.00000001 at 7 digits is

@@ -131,6 +131,25 @@ TEST(WriteSignificant, MatchesPrintfOnRandomDecimalsAndSubnormals) {
     }
 }
 
+TEST(WriteSignificant, OneDecompositionWritesEveryPrecisionAsPrintf) {
+    // SignificantDigits finds the shortest digits once and rounds them for each precision (the
+    // degrees echo of serialize::degrees tries 1, 2, ... digits): printf's bytes at each.
+    std::mt19937_64 rng(31);
+    std::vector<double> values = edge_values();
+    for (int i = 0; i < 20000; ++i) {
+        const double v = from_bits(rng());
+        if (std::isfinite(v)) values.push_back(v);
+    }
+    for (const double v : values) {
+        const SignificantDigits sd(v);
+        for (int digits = 1; digits <= 17; ++digits) {
+            char buf[kSignificantBufferSize];
+            const std::string text(buf, sd.write(buf, digits));
+            ASSERT_EQ(text, via_snprintf(v, digits)) << v << " digits " << digits;
+        }
+    }
+}
+
 TEST(WriteSignificant, FormatSignificantUsesItAndStillRefusesNonFinite) {
     EXPECT_EQ(format_significant(2.45598509e-08, 10), "2.45598509e-08");
     EXPECT_EQ(format_significant(-0.0, 10), "0");
