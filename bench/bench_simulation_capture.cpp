@@ -59,7 +59,9 @@ void write_only(const Capture& c, const CameraModel& camera, CaptureFormat forma
 }
 
 void render_write(const Setup& s, CaptureFormat format, const std::filesystem::path& path) {
-    const Capture c = render_capture(s.scene, {s.truth}, {}, s.camera, {.keep_geometry = false});
+    // As roughscope simulate capture renders for a file (capture_options_for_file).
+    const Capture c =
+        render_capture(s.scene, {s.truth}, {}, s.camera, capture_options_for_file(format, false));
     write_only(c, s.camera, format, path);
 }
 

@@ -76,8 +76,9 @@ void run_capture(CaptureCommand& c) {
     const fs::path dir(c.out_dir);
     if (fs::exists(dir) && !fs::is_directory(dir))
         throw DataError(concat("--out ", c.out_dir, " exists and is not a directory"));
-    const simulation::Capture capture =
-        simulation::render_capture(record.scene, record.truths, record.labels, record.camera);
+    const simulation::Capture capture = simulation::render_capture(
+        record.scene, record.truths, record.labels, record.camera,
+        simulation::capture_options_for_file(c.format, !record.labels.empty()));
     // The image is encoded (and DNG's response checked) before anything is created on disk.
     fs::create_directories(dir);
     const serialize::CaptureFiles files =

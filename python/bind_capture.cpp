@@ -289,11 +289,15 @@ void bind_capture(py::module_& m) {
            const py::kwargs& kw) {
             Request r = request_from(kw);
             const CaptureFormat f = simulation::parse_capture_format(format);
+            // Only what the file and the sidecar need (the same bytes as a full render).
+            simulation::CaptureOptions options =
+                simulation::capture_options_for_file(f, !r.record.labels.empty());
+            options.threads = r.options.threads;
             simulation::Capture c;
             {
                 py::gil_scoped_release release;
                 c = simulation::render_capture(r.record.scene, r.record.truths, r.record.labels,
-                                               r.record.camera, r.options);
+                                               r.record.camera, options);
             }
             const serialize::CaptureFiles files = serialize::write_capture_files(
                 c, r.record, f, std::filesystem::path(out_dir), stem);

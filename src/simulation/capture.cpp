@@ -393,8 +393,8 @@ Capture render_capture(const Scene& scene, const std::vector<SurfaceTruth>& trut
     out.width = W;
     out.height = H;
     out.bit_depth = camera.bit_depth;
-    out.radiance.resize(N);
-    out.expected_dn.resize(N);
+    if (options.keep_radiance) out.radiance.resize(N);
+    if (options.keep_expected_dn) out.expected_dn.resize(N);
     out.dn.resize(N);
     out.saturated.resize(N);
     if (options.keep_geometry) {
@@ -509,9 +509,10 @@ Capture render_capture(const Scene& scene, const std::vector<SurfaceTruth>& trut
                 out.dn[i] = static_cast<std::uint16_t>(std::floor(encoded + 0.5));
                 out.saturated[i] = saturated ? 1 : 0;
                 counts.saturated += saturated ? 1 : 0;
-                out.radiance[i] = static_cast<float>(radiance);
-                out.expected_dn[i] =
-                    static_cast<float>(camera.gain_dn_per_e * mu_e + camera.black_level_dn);
+                if (options.keep_radiance) out.radiance[i] = static_cast<float>(radiance);
+                if (options.keep_expected_dn)
+                    out.expected_dn[i] =
+                        static_cast<float>(camera.gain_dn_per_e * mu_e + camera.black_level_dn);
                 if (options.keep_geometry) {
                     out.label[i] = label;
                     out.theta_i_rad[i] =

@@ -55,8 +55,7 @@ void set_common_tags(TIFF* tif, const Capture& c, int bits, int samples, int sam
 }
 
 void check_capture(const Capture& c) {
-    if (c.width == 0 || c.height == 0 || c.dn.size() != c.width * c.height ||
-        c.expected_dn.size() != c.width * c.height)
+    if (c.width == 0 || c.height == 0 || c.dn.size() != c.width * c.height)
         throw InvalidArgument("capture: empty, or its images do not match width x height");
 }
 
@@ -66,6 +65,14 @@ std::string_view to_string(CaptureFormat format) { return name_of(kFormatNames, 
 CaptureFormat parse_capture_format(std::string_view name) {
     return parse_name(kFormatNames, "capture format", name);
 }
+CaptureOptions capture_options_for_file(CaptureFormat format, bool several_regions) {
+    CaptureOptions o;
+    o.keep_geometry = several_regions;
+    o.keep_radiance = false;
+    o.keep_expected_dn = format == CaptureFormat::TiffFloat;
+    return o;
+}
+
 std::string_view file_extension(CaptureFormat format) {
     switch (format) {
         case CaptureFormat::Png:
@@ -130,6 +137,10 @@ std::string encode_capture_tiff(const Capture& capture) {
 
 std::string encode_capture_tiff_float(const Capture& capture) {
     check_capture(capture);
+    if (capture.expected_dn.size() != capture.width * capture.height)
+        throw InvalidArgument(
+            "capture: a float TIFF holds expected_dn, which this capture did not keep "
+            "(CaptureOptions::keep_expected_dn)");
     std::string out;
     out.reserve(capture.expected_dn.size() * 4 + 4096);
     {

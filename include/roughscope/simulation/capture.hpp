@@ -169,6 +169,10 @@ struct CaptureOptions {
     // Keep the per-pixel label, (θi, θs, φs) and normal (4 + 12 + 12 bytes a pixel); off for
     // very large images when only the pixels are needed.
     bool keep_geometry = true;
+    // Keep radiance and expected_dn (4 bytes a pixel each; empty otherwise). Writing a file needs
+    // neither, except expected_dn for the float TIFF (encode_capture_tiff_float).
+    bool keep_radiance = true;
+    bool keep_expected_dn = true;
     // Worker threads over blocks of rows (0 = all cores; images below 65536 pixels use one). The
     // result does not depend on it.
     std::size_t threads = 0;
@@ -205,11 +209,17 @@ std::string_view to_string(CaptureFormat format);  // "png", "tiff", "tiff_float
 CaptureFormat parse_capture_format(std::string_view name);
 std::string_view file_extension(CaptureFormat format);  // "png", "tiff", "tiff", "dng"
 
+// The options of a render whose only use is writing `format` and its sidecar (roughscope
+// simulate capture, Python write_capture): no radiance, expected_dn only for the float TIFF, the
+// geometry only with several regions (its label layer gives the sidecar's per-region counts).
+CaptureOptions capture_options_for_file(CaptureFormat format, bool several_regions);
+
 // PNG: 8-bit grey when bit_depth = 8, else 16-bit grey holding the DN unscaled (sBIT = bit depth).
 std::string encode_capture_png(const Capture& capture);
 // TIFF: 16-bit unsigned grey, the DN unscaled.
 std::string encode_capture_tiff(const Capture& capture);
-// TIFF: 32-bit float grey, expected_dn (the noise-free linear signal in DN, not clipped).
+// TIFF: 32-bit float grey, expected_dn (the noise-free linear signal in DN, not clipped);
+// InvalidArgument when the capture was rendered without it.
 std::string encode_capture_tiff_float(const Capture& capture);
 // DNG 1.4: one IFD, LinearRaw (34892), 3 samples of 16 bits (the DN repeated), BlackLevel,
 // WhiteLevel, identity ColorMatrix1, AsShotNeutral 1 1 1. Linear response only (InvalidArgument

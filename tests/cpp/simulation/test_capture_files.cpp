@@ -150,6 +150,49 @@ TEST(CaptureFiles, LibRawDecodesTheDngToTheWrittenLinearDn) {
     }
 }
 
+TEST(CaptureFiles, ARenderForAFileWritesTheBytesOfAFullRender) {
+    // capture_options_for_file keeps only what the file needs (no radiance; expected_dn for the
+    // float TIFF; geometry with several regions): every format's bytes equal a full render's.
+    Scene scene;
+    scene.shape = SceneShape::Cylinder;
+    scene.width = 41;
+    scene.height = 29;
+    SurfaceTruth a, b;
+    b.sigma_um = 2.0 * a.sigma_um;
+    std::vector<std::int32_t> labels(scene.width * scene.height);
+    for (std::size_t i = 0; i < labels.size(); ++i)
+        labels[i] = static_cast<std::int32_t>((i % scene.width) * 2 / scene.width);
+    CameraModel camera;
+    camera.bit_depth = 12;
+    camera.gain_dn_per_e = 0.25;
+    camera.read_noise_e = 2.0;
+    camera.seed = 11;
+    for (const bool several : {false, true}) {
+        const std::vector<SurfaceTruth> truths =
+            several ? std::vector<SurfaceTruth>{a, b} : std::vector<SurfaceTruth>{a};
+        const std::vector<std::int32_t> l = several ? labels : std::vector<std::int32_t>{};
+        const Capture full = render_capture(scene, truths, l, camera);
+        for (const CaptureFormat f : {CaptureFormat::Png, CaptureFormat::Tiff,
+                                      CaptureFormat::TiffFloat, CaptureFormat::Dng}) {
+            const CaptureOptions o = capture_options_for_file(f, several);
+            EXPECT_FALSE(o.keep_radiance);
+            EXPECT_EQ(o.keep_geometry, several);
+            const Capture lean = render_capture(scene, truths, l, camera, o);
+            EXPECT_TRUE(lean.radiance.empty());
+            EXPECT_EQ(lean.expected_dn.empty(), f != CaptureFormat::TiffFloat);
+            EXPECT_EQ(lean.label, several ? full.label : std::vector<std::int32_t>{});
+            EXPECT_EQ(lean.saturated_count, full.saturated_count);
+            EXPECT_EQ(lean.object_count, full.object_count);
+            EXPECT_EQ(encode_capture(lean, camera, f), encode_capture(full, camera, f))
+                << to_string(f) << (several ? ", two regions" : "");
+        }
+    }
+    // Without expected_dn there is no float TIFF: an error, not an empty image.
+    const Capture lean = render_capture(scene, {a}, {}, camera,
+                                        capture_options_for_file(CaptureFormat::Tiff, false));
+    EXPECT_THROW(encode_capture_tiff_float(lean), InvalidArgument);
+}
+
 TEST(CaptureFiles, DngRefusesANonLinearResponse) {
     Capture c = noisy_sphere(12);
     CameraModel camera;
