@@ -8,7 +8,10 @@
 //        maps/map_pixels/<rows>      read_image of both + roughness_map, per pixel
 // <rows> = 4096 is the 24-MP pair (5859 x 4096 = 24.0 MP, the size of the other image benchmarks;
 // 6000 x 4000 has the same pixel count); 256 a small one (the smoke run skips /4096).
-// Counters: time_vs_decode = (decode + map) / decode of the two files; peak_vs_image = the peak
+// Counters: time_vs_decode = (decode + map) / decode of the two files by read_image;
+// time_vs_opencv_decode = the same over OpenCV's imread of the two files (IMREAD_UNCHANGED: the
+// decoding baseline of bench_measure.cpp, a decoder this project does not tune — read_image
+// itself is 3-7x faster than it since its buffers ask for huge pages); peak_vs_image = the peak
 // resident memory of decode + map above the resident memory before it, divided by that of
 // decoding one image. The peak is Linux's VmHWM of /proc/self/status, reset before each
 // measurement by writing 5 to /proc/self/clear_refs (0 when the kernel does not allow it).
@@ -20,6 +23,7 @@
 #include <vector>
 
 #include <benchmark/benchmark.h>
+#include <opencv2/imgcodecs.hpp>
 #include <unistd.h>
 
 #include "bench_timing.hpp"
@@ -79,6 +83,13 @@ void decode_pair(const PairFiles& p) {
     }
 }
 
+void opencv_decode_pair(const PairFiles& p) {
+    for (const auto& f : p.files) {
+        const cv::Mat m = cv::imread(f.string(), cv::IMREAD_UNCHANGED);
+        benchmark::DoNotOptimize(m.data);
+    }
+}
+
 img::RoughnessMap decode_and_map(const PairFiles& p, std::size_t window) {
     const img::LinearImage a = img::read_image(p.files[0].string(), read_options());
     const img::LinearImage b = img::read_image(p.files[1].string(), read_options());
@@ -124,8 +135,10 @@ void BM_maps_map(benchmark::State& state, std::size_t window) {
     make_pair(p, static_cast<std::size_t>(state.range(0)));
     for (auto _ : state) benchmark::DoNotOptimize(decode_and_map(p, window).valid);
     const double t_decode = seconds_of([&] { decode_pair(p); }, 3);
+    const double t_opencv = seconds_of([&] { opencv_decode_pair(p); }, 3);
     const double t_map = seconds_of([&] { (void)decode_and_map(p, window); }, 2);
     state.counters["time_vs_decode"] = t_map / t_decode;
+    state.counters["time_vs_opencv_decode"] = t_map / t_opencv;
     const long one = peak_above_now_kb([&] {
         const img::LinearImage im = img::read_image(p.files[0].string(), read_options());
         benchmark::DoNotOptimize(im.values.data());

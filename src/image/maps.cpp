@@ -10,11 +10,8 @@
 #include <thread>
 #include <utility>
 
-#if defined(__linux__)
-#include <sys/mman.h>
-#endif
-
 #include "roughscope/core/errors.hpp"
+#include "roughscope/core/memory.hpp"
 #include "roughscope/core/text.hpp"
 
 namespace roughscope::image {
@@ -799,27 +796,6 @@ void pixel_map(const std::vector<MapCapture>& captures, const MapOptions& o, Eva
     }
 }
 
-// A layer of n cells set to `fill`. Large layers ask the kernel for transparent huge pages
-// first (Linux; a hint, ignored elsewhere): filling 100 MB of 4 kB pages costs more in page
-// faults than the map's arithmetic.
-template <class T>
-void allocate_layer(std::vector<T>& layer, std::size_t n, T fill) {
-    layer.clear();
-    layer.reserve(n);
-#if defined(__linux__) && defined(MADV_HUGEPAGE)
-    constexpr std::size_t kHugePage = std::size_t{2} << 20;
-    const std::size_t bytes = n * sizeof(T);
-    if (bytes >= 4 * kHugePage) {
-        auto* base = reinterpret_cast<char*>(layer.data());
-        const std::size_t misalign = reinterpret_cast<std::uintptr_t>(base) % kHugePage;
-        const std::size_t skip = misalign == 0 ? 0 : kHugePage - misalign;
-        if (bytes > skip + kHugePage)
-            (void)madvise(base + skip, (bytes - skip) / kHugePage * kHugePage, MADV_HUGEPAGE);
-    }
-#endif
-    layer.assign(n, fill);
-}
-
 // σ/T of a region of a flat sample: the inverse at the mean of its cells' ln(E1/E2), with the
 // standard error of that mean through the inverse's slope. Averaging the cells' σ/T instead is
 // biased where the inverse is curved and the cells are noisy (large σ/T, where E1/E2 hardly
@@ -944,12 +920,12 @@ RoughnessMap roughness_map(const std::vector<MapCapture>& captures, const MapOpt
     for (auto* layer :
          {&map.E1_over_E2, &map.sigma_over_T_gaussian, &map.sigma_over_T_gaussian_stderr,
           &map.sigma_over_T_exponential, &map.sigma_over_T_exponential_stderr})
-        allocate_layer(*layer, cells, kNaN);
-    allocate_layer(map.roughness_class, cells, kClassNone);
+        assign_large(*layer, cells, kNaN);
+    assign_large(map.roughness_class, cells, kClassNone);
     if (o.sigma_um) {
-        allocate_layer(map.T_um, cells, kNaN);
-        allocate_layer(map.T_um_stderr, cells, kNaN);
-        allocate_layer(map.roughness_class_g, cells, kClassNone);
+        assign_large(map.T_um, cells, kNaN);
+        assign_large(map.T_um_stderr, cells, kNaN);
+        assign_large(map.roughness_class_g, cells, kClassNone);
     }
     std::vector<std::int32_t> cell_region;
     if (!o.region_labels.empty()) cell_region.assign(cells, -1);

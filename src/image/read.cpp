@@ -22,6 +22,7 @@
 
 #include "decode.hpp"
 #include "roughscope/core/errors.hpp"
+#include "roughscope/core/memory.hpp"
 #include "roughscope/core/text.hpp"
 
 namespace roughscope::image {
@@ -278,8 +279,8 @@ Linearizer::Linearizer(LinearImage& image, const Layout& layout, const Evidence&
     image.width = layout.width;
     image.height = layout.height;
     image.channels = planes;
-    image.values.assign(planes * layout.width * layout.height, 0.0F);
-    image.flags.assign(layout.width * layout.height, 0);
+    assign_large(image.values, planes * layout.width * layout.height, 0.0F);
+    assign_large(image.flags, layout.width * layout.height, std::uint8_t{0});
     bits_ = layout.bits;
 }
 

@@ -5,6 +5,7 @@
 #include <type_traits>
 
 #include "roughscope/core/errors.hpp"
+#include "roughscope/core/memory.hpp"
 #include "roughscope/core/text.hpp"
 
 namespace roughscope::image {
@@ -193,7 +194,8 @@ std::vector<std::uint8_t> rasterize(const Region& region, std::size_t width, std
                    size_text(width, height), " pixels (valid coordinates: x in [0, ",
                    std::to_string(width), "], y in [0, ", std::to_string(height), "])"));
     };
-    std::vector<std::uint8_t> mask(width * height, 0);
+    std::vector<std::uint8_t> mask;
+    assign_large(mask, width * height, std::uint8_t{0});
     std::visit(
         [&](const auto& r) {
             using T = std::decay_t<decltype(r)>;
@@ -236,7 +238,7 @@ MaskRegion mask_region_from_image(const LinearImage& mask_image) {
     MaskRegion mask;
     mask.width = mask_image.width;
     mask.height = mask_image.height;
-    mask.inside.resize(mask_image.pixel_count());
+    assign_large(mask.inside, mask_image.pixel_count(), std::uint8_t{0});
     const float* values = mask_image.plane(0);
     for (std::size_t k = 0; k < mask.inside.size(); ++k) mask.inside[k] = values[k] > 0.5F ? 1 : 0;
     return mask;

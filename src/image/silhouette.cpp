@@ -15,6 +15,7 @@
 
 #include "object_profile.hpp"
 #include "roughscope/core/errors.hpp"
+#include "roughscope/core/memory.hpp"
 #include "roughscope/core/text.hpp"
 #include "roughscope/scattering/geometry.hpp"
 
@@ -32,7 +33,7 @@ std::string image_name(const LinearImage& image) {
 std::span<const float> channel_average(const LinearImage& image, std::vector<float>& storage) {
     const std::size_t n = image.pixel_count();
     if (image.channels == 1) return {image.plane(0), n};
-    storage.resize(n);
+    assign_large(storage, n, 0.0F);
     const float* r = image.plane(0);
     const float* g = image.plane(1);
     const float* b = image.plane(2);
@@ -180,7 +181,7 @@ Silhouette detail::find_silhouette_of_checked_image(const LinearImage& image,
         }
     }
     const auto* lab = labels.ptr<std::int32_t>(0);
-    s.mask.assign(n, 0);
+    assign_large(s.mask, n, std::uint8_t{0});
     std::size_t object_pixels = 0;
     double sx = 0, sy = 0;
     s.col_min = w;

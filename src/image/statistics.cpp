@@ -11,6 +11,7 @@
 
 #include "robust_location.hpp"
 #include "roughscope/core/errors.hpp"
+#include "roughscope/core/memory.hpp"
 #include "roughscope/core/text.hpp"
 
 namespace roughscope::image {
@@ -306,7 +307,8 @@ RegionStatistics region_statistics(const LinearImage& image, const std::vector<s
         ChannelStatistics& a = out.average;
         a.count = out.pixels_used;
         a.mean = average_sum / static_cast<double>(a.count);
-        std::vector<float> series(out.pixels_used);
+        std::vector<float> series;
+        assign_large(series, out.pixels_used, 0.0F);
         std::size_t i = 0;
         double ss = 0.0;
         for (const ValueRun& r : runs)

@@ -22,6 +22,7 @@
 #include <boost/random/poisson_distribution.hpp>
 
 #include "roughscope/core/errors.hpp"
+#include "roughscope/core/memory.hpp"
 #include "roughscope/core/names.hpp"
 #include "roughscope/core/numbers.hpp"
 #include "roughscope/core/text.hpp"
@@ -393,10 +394,10 @@ Capture render_capture(const Scene& scene, const std::vector<SurfaceTruth>& trut
     out.width = W;
     out.height = H;
     out.bit_depth = camera.bit_depth;
-    if (options.keep_radiance) out.radiance.resize(N);
-    if (options.keep_expected_dn) out.expected_dn.resize(N);
-    out.dn.resize(N);
-    out.saturated.resize(N);
+    if (options.keep_radiance) assign_large(out.radiance, N, 0.0F);
+    if (options.keep_expected_dn) assign_large(out.expected_dn, N, 0.0F);
+    assign_large(out.dn, N, std::uint16_t{0});
+    assign_large(out.saturated, N, std::uint8_t{0});
     if (options.keep_geometry) {
         out.label.resize(N);
         out.theta_i_rad.resize(N);

@@ -8,6 +8,8 @@
 
 #include <fftw3.h>
 
+#include "roughscope/core/memory.hpp"
+
 namespace roughscope::surface::fft {
 
 namespace {
@@ -44,6 +46,7 @@ RealToComplex::RealToComplex(std::size_t rows, std::size_t cols, Layout layout)
     if (data_ == nullptr) {
         throw std::bad_alloc();
     }
+    advise_huge_pages(data_, doubles * sizeof(double));  // before FFTW's planner touches it
     plan(layout);
 }
 

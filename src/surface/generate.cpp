@@ -16,6 +16,7 @@
 
 #include "fft.hpp"
 #include "roughscope/core/errors.hpp"
+#include "roughscope/core/memory.hpp"
 #include "roughscope/core/numbers.hpp"
 
 namespace roughscope::surface {
@@ -113,7 +114,7 @@ HeightMap empty_map(const GenerationOptions& o) {
     map.ny = o.ny;
     map.dx_um = o.dx_um;
     map.dy_um = o.dy_um;
-    map.heights_um.resize(o.nx * o.ny);
+    assign_large(map.heights_um, o.nx * o.ny, 0.0);
     return map;
 }
 
@@ -239,30 +240,29 @@ HeightMap filter_noise(const GenerationOptions& o, const std::vector<double>& ga
 
 }  // namespace
 
-SurfaceGenerator::SurfaceGenerator(const GenerationOptions& options) : options_(options) {
-    check_options(options);
-    const GenerationOptions& o = options_;
-    fft::RealToComplex f(o.ny, o.nx, fft::Layout::plane);
-    // S = DFT(C_p) is real (C_p is even) and ≥ 0 up to rounding (C_p is positive definite), so the
-    // gain σ√S/(nx ny) gives the periodic surface the ensemble ACF σ² C_p on the lattice.
+namespace {
+
+// The half-spectrum gain of the options' surface, computed in `f`'s buffer (left holding the
+// ACF's spectrum). S = DFT(C_p) is real (C_p is even) and ≥ 0 up to rounding (C_p is positive
+// definite), so the gain σ√S/(nx ny) gives the periodic surface the ensemble ACF σ² C_p on the
+// lattice.
+std::vector<double> generation_gain(const GenerationOptions& o, fft::RealToComplex& f) {
     fill_periodised_acf(o, f);
     f.forward();
     const std::size_t cols = f.spectrum_cols();
     const double points = static_cast<double>(o.nx) * static_cast<double>(o.ny);
-    gain_.resize(o.ny * cols);
+    std::vector<double> gain;
+    assign_large(gain, o.ny * cols, 0.0);
     for (std::size_t r = 0; r < o.ny; ++r) {
         const std::complex<double>* row = f.spectrum_row(r);
         for (std::size_t k = 0; k < cols; ++k) {
-            gain_[r * cols + k] = o.sigma_um * std::sqrt(std::max(row[k].real(), 0.0)) / points;
+            gain[r * cols + k] = o.sigma_um * std::sqrt(std::max(row[k].real(), 0.0)) / points;
         }
     }
+    return gain;
 }
 
-HeightMap SurfaceGenerator::generate(std::uint64_t seed) const {
-    GenerationOptions o = options_;
-    o.seed = seed;
-    fft::RealToComplex f(o.ny, o.nx, fft::Layout::plane);
-    HeightMap map = filter_noise(o, gain_, f);
+HeightMap titled(HeightMap map, const GenerationOptions& o) {
     map.title = "roughscope generated surface (";
     map.title.append(to_string(o.correlation))
         .append(" correlation, sigma_um = ")
@@ -275,8 +275,28 @@ HeightMap SurfaceGenerator::generate(std::uint64_t seed) const {
     return map;
 }
 
+}  // namespace
+
+SurfaceGenerator::SurfaceGenerator(const GenerationOptions& options) : options_(options) {
+    check_options(options);
+    fft::RealToComplex f(options_.ny, options_.nx, fft::Layout::plane);
+    gain_ = generation_gain(options_, f);
+}
+
+HeightMap SurfaceGenerator::generate(std::uint64_t seed) const {
+    GenerationOptions o = options_;
+    o.seed = seed;
+    fft::RealToComplex f(o.ny, o.nx, fft::Layout::plane);
+    return titled(filter_noise(o, gain_, f), o);
+}
+
 HeightMap generate_surface(const GenerationOptions& options) {
-    return SurfaceGenerator(options).generate(options.seed);
+    // One surface: the buffer that computed the gain filters the noise too (the same numbers as
+    // SurfaceGenerator(options).generate(options.seed), one FFT buffer fewer).
+    check_options(options);
+    fft::RealToComplex f(options.ny, options.nx, fft::Layout::plane);
+    const std::vector<double> gain = generation_gain(options, f);
+    return titled(filter_noise(options, gain, f), options);
 }
 
 HeightMap generate_surface_from_psd(const std::function<double(double k_rad_per_um)>& psd,
