@@ -8,7 +8,9 @@
 #include <complex>
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <boost/random/mersenne_twister.hpp>
@@ -108,16 +110,6 @@ void check_options(const GenerationOptions& o) {
     }
 }
 
-HeightMap empty_map(const GenerationOptions& o) {
-    HeightMap map;
-    map.nx = o.nx;
-    map.ny = o.ny;
-    map.dx_um = o.dx_um;
-    map.dy_um = o.dy_um;
-    assign_large(map.heights_um, o.nx * o.ny, 0.0);
-    return map;
-}
-
 // Signed frequency (or minimal-image lag) index of j on a circle of n points: j or j − n.
 double signed_index(std::size_t j, std::size_t n) {
     return j <= n / 2 ? static_cast<double>(j) : static_cast<double>(j) - static_cast<double>(n);
@@ -212,11 +204,41 @@ void fill_periodised_acf(const GenerationOptions& o, fft::RealToComplex& f) {
     }
 }
 
+// A height map of the options' grid whose heights_um is, for now, the padded in-place FFT array
+// (ny rows of 2·(nx/2 + 1) doubles at a 32-byte aligned offset, for FFTW's fastest codelets):
+// the transform works inside the result's own storage, and take_heights() packs the rows in place.
+struct MapBuffer {
+    HeightMap map;
+    std::size_t offset = 0;  // doubles before the aligned array
+    std::size_t stride = 0;  // doubles per row of the real array
+
+    explicit MapBuffer(const GenerationOptions& o) {
+        map.nx = o.nx;
+        map.ny = o.ny;
+        map.dx_um = o.dx_um;
+        map.dy_um = o.dy_um;
+        stride = 2 * (o.nx / 2 + 1);
+        assign_large(map.heights_um, o.ny * stride + 4, 0.0);
+        const auto misalignment = reinterpret_cast<std::uintptr_t>(map.heights_um.data()) % 32;
+        offset = misalignment == 0 ? 0 : (32 - misalignment) / sizeof(double);
+    }
+    double* array() { return map.heights_um.data() + offset; }
+    // Rows of nx heights packed to the front (row r moves from offset + r·stride to r·nx, never
+    // forward of itself: memmove in increasing r is safe), the padding dropped.
+    HeightMap take_heights() {
+        double* const data = map.heights_um.data();
+        for (std::size_t r = 0; r < map.ny; ++r)
+            std::memmove(data + r * map.nx, data + offset + r * stride, map.nx * sizeof(double));
+        map.heights_um.resize(map.nx * map.ny);
+        return std::move(map);
+    }
+};
+
 // Filters white noise with the half-spectrum `gain` (ny × (nx/2 + 1), the DFT gain including
-// the 1/(nx ny) of the inverse transform): z = IDFT(gain · DFT(w)), w i.i.d. N(0, 1) drawn in
-// row-major order from the seed.
-HeightMap filter_noise(const GenerationOptions& o, const std::vector<double>& gain,
-                       fft::RealToComplex& f) {
+// the 1/(nx ny) of the inverse transform) in `f`: z = IDFT(gain · DFT(w)), w i.i.d. N(0, 1) drawn
+// in row-major order from the seed; z is left in f's real rows.
+void filter_noise(const GenerationOptions& o, const std::vector<double>& gain,
+                  fft::RealToComplex& f) {
     NormalStream normal(o.seed);
     for (std::size_t iy = 0; iy < o.ny; ++iy) {
         normal.fill(f.real_row(iy), o.nx);
@@ -231,11 +253,16 @@ HeightMap filter_noise(const GenerationOptions& o, const std::vector<double>& ga
         }
     }
     f.backward();
-    HeightMap map = empty_map(o);
-    for (std::size_t iy = 0; iy < o.ny; ++iy) {
-        std::copy_n(f.real_row(iy), o.nx, map.heights_um.data() + iy * o.nx);
+}
+
+// The filtered noise as a height map, transformed inside the map's own storage.
+HeightMap filtered_map(const GenerationOptions& o, const std::vector<double>& gain) {
+    MapBuffer out(o);
+    {
+        fft::RealToComplex f(o.ny, o.nx, fft::Layout::plane, out.array());
+        filter_noise(o, gain, f);
     }
-    return map;
+    return out.take_heights();
 }
 
 }  // namespace
@@ -286,17 +313,20 @@ SurfaceGenerator::SurfaceGenerator(const GenerationOptions& options) : options_(
 HeightMap SurfaceGenerator::generate(std::uint64_t seed) const {
     GenerationOptions o = options_;
     o.seed = seed;
-    fft::RealToComplex f(o.ny, o.nx, fft::Layout::plane);
-    return titled(filter_noise(o, gain_, f), o);
+    return titled(filtered_map(o, gain_), o);
 }
 
 HeightMap generate_surface(const GenerationOptions& options) {
     // One surface: the buffer that computed the gain filters the noise too (the same numbers as
     // SurfaceGenerator(options).generate(options.seed), one FFT buffer fewer).
     check_options(options);
-    fft::RealToComplex f(options.ny, options.nx, fft::Layout::plane);
-    const std::vector<double> gain = generation_gain(options, f);
-    return titled(filter_noise(options, gain, f), options);
+    MapBuffer out(options);
+    {
+        fft::RealToComplex f(options.ny, options.nx, fft::Layout::plane, out.array());
+        const std::vector<double> gain = generation_gain(options, f);
+        filter_noise(options, gain, f);
+    }
+    return titled(out.take_heights(), options);
 }
 
 HeightMap generate_surface_from_psd(const std::function<double(double k_rad_per_um)>& psd,
@@ -306,8 +336,7 @@ HeightMap generate_surface_from_psd(const std::function<double(double k_rad_per_
     }
     check_grid_options(options);
     const GenerationOptions& o = options;
-    fft::RealToComplex f(o.ny, o.nx, fft::Layout::plane);
-    const std::size_t cols = f.spectrum_cols();
+    const std::size_t cols = o.nx / 2 + 1;  // the half spectrum's columns
     const double dkx = 2 * kPi / (static_cast<double>(o.nx) * o.dx_um);
     const double dky = 2 * kPi / (static_cast<double>(o.ny) * o.dy_um);
     // W at the lattice frequencies of the half spectrum; the total Σ W over the full spectrum
@@ -343,7 +372,7 @@ HeightMap generate_surface_from_psd(const std::function<double(double k_rad_per_
     for (double& g : gain) {
         g = o.sigma_um * std::sqrt(g / total) / std::sqrt(points);
     }
-    HeightMap map = filter_noise(o, gain, f);
+    HeightMap map = filtered_map(o, gain);
     map.title = "roughscope generated surface (given PSD, sigma_um = ";
     map.title.append(format_message(o.sigma_um))
         .append(", seed = ")

@@ -15,6 +15,7 @@
 
 #include "fft.hpp"
 #include "roughscope/core/errors.hpp"
+#include "roughscope/core/memory.hpp"
 #include "roughscope/core/numbers.hpp"
 
 namespace roughscope::surface {
@@ -154,7 +155,7 @@ Acf2d acf_2d(const HeightMap& levelled, AcfEstimator estimator) {
     // so the peak memory is one padded array (~4 maps), not the array and the grid side by side.
     const std::size_t stride = 2 * (px / 2 + 1);  // doubles per row of the real array
     std::vector<double>& buffer = acf.values;
-    buffer.resize(py * stride + 4);
+    assign_large(buffer, py * stride + 4, 0.0);
     const auto misalignment = reinterpret_cast<std::uintptr_t>(buffer.data()) % 32;
     const std::size_t offset = misalignment == 0 ? 0 : (32 - misalignment) / sizeof(double);
     {
