@@ -22,6 +22,7 @@
 #include <zip.h>
 
 #include "roughscope/core/errors.hpp"
+#include "roughscope/core/memory.hpp"
 #include "roughscope/core/text.hpp"
 #include "roughscope/surface/formats.hpp"
 
@@ -491,7 +492,7 @@ void read_binary_heights(const ZipArchive& zip, const std::string& name, const s
             .append(" bytes");
         fail(name, what);
     }
-    heights.resize(points);
+    assign_large(heights, points, 0.0);
     ZipFilePtr file = zip.open(entry);
     Md5 md5;
     constexpr std::size_t kChunkPoints = 1 << 16;
@@ -563,7 +564,7 @@ void read_data_list(const tinyxml2::XMLElement* list, const std::string& name, c
     // An absolute integer-coded X or Y column must step by one count per column or row.
     std::optional<double> y_first;
     std::optional<double> x_first;
-    map.heights_um.assign(nx * ny, std::numeric_limits<double>::quiet_NaN());
+    assign_large(map.heights_um, nx * ny, std::numeric_limits<double>::quiet_NaN());
     std::size_t k = 0;
     for (const auto* d = list->FirstChildElement("Datum"); d;
          d = d->NextSiblingElement("Datum"), ++k) {

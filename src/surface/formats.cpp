@@ -11,6 +11,7 @@
 #include <system_error>
 
 #include "roughscope/core/errors.hpp"
+#include "roughscope/core/memory.hpp"
 #include "roughscope/core/names.hpp"
 #include "roughscope/core/text.hpp"
 #include "roughscope/io/output_file.hpp"
@@ -91,7 +92,21 @@ std::string read_whole_file(const std::filesystem::path& path) {
         message.append(": ").append(std::strerror(errno));
         throw DataError(message);
     }
-    std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    // A regular file: read in one call into storage of its size (huge pages asked for when it is
+    // large); then whatever else the stream holds (a file that grew, or no known size: a pipe).
+    std::string bytes;
+    const bool regular = std::filesystem::is_regular_file(status);
+    const std::uintmax_t size = regular ? std::filesystem::file_size(path, ec) : 0;
+    if (regular && !ec && size > 0 && size <= bytes.max_size()) {
+        bytes.reserve(static_cast<std::size_t>(size));
+        advise_huge_pages(bytes.data(), static_cast<std::size_t>(size));
+        bytes.resize(static_cast<std::size_t>(size));
+        in.read(bytes.data(), static_cast<std::streamsize>(size));
+        bytes.resize(static_cast<std::size_t>(in.gcount()));
+        if (in.bad()) throw DataError("cannot read " + quote_input(path.string()) + ": read error");
+        in.clear(in.rdstate() & ~std::ios::failbit & ~std::ios::eofbit);
+    }
+    bytes.append(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
     if (in.bad()) throw DataError("cannot read " + quote_input(path.string()) + ": read error");
     return bytes;
 }
