@@ -411,15 +411,28 @@ TEST(TwoGeometrySolver, RecoversCorrelationLengthNearTheEdgeOfTheFiniteRange) {
                 closed, 1e-9 * closed);
 }
 
+namespace {
+// Two geometries whose g differ (10°/60°/0° and 70°/60°/30°): the exact series' E1/E2 is not
+// monotonic in T there.
+struct SeriesPair {
+    rs::TwoGeometryOptions options = [] {
+        rs::TwoGeometryOptions o;
+        o.regime = rs::Regime::Series;
+        o.wavelength_um = kLambda;
+        return o;
+    }();
+    rs::Geometry g1 = rs::make_geometry(deg_to_rad(10), deg_to_rad(60), 0.0);
+    rs::Geometry g2 = rs::make_geometry(deg_to_rad(70), deg_to_rad(60), deg_to_rad(30));
+};
+}  // namespace
+
 TEST(TwoGeometrySolver, SeveralSolutionsForTAreAnErrorThatListsThem) {
     // The exact series' ratio is not monotonic in T when the two geometries' g differ
     // (here g ≈ 11 and 3.6): E1/E2 of T = 3 µm is also that of T ≈ 1.95 µm. Each listed value
     // reproduces the ratio (forward model), and a bracket around one returns it.
-    rs::TwoGeometryOptions o;
-    o.regime = rs::Regime::Series;
-    o.wavelength_um = kLambda;
-    const rs::Geometry g1 = rs::make_geometry(deg_to_rad(10), deg_to_rad(60), 0.0);
-    const rs::Geometry g2 = rs::make_geometry(deg_to_rad(70), deg_to_rad(60), deg_to_rad(30));
+    const SeriesPair p;
+    rs::TwoGeometryOptions o = p.options;
+    const rs::Geometry &g1 = p.g1, &g2 = p.g2;
     const double sigma = 0.2;
     const auto c = rs::Correlation::Gaussian;
     const double r = rs::model_ratio_diffuse(g1, g2, sigma, 3.0, c, o);
@@ -447,11 +460,9 @@ TEST(TwoGeometrySolver, AnUnobservableSecondSolutionIsDropped) {
     // σ = 1 µm (g ≈ 280 and 91): E1/E2 of T = 3 µm is also reached at T ≈ 109 µm, where the
     // surface is a near-mirror (σ/T ≈ 0.01) and the 10°/60° brightness is ~1e-130 of the
     // specular direction's: that solution is dropped. With the floor at 0 both are listed.
-    rs::TwoGeometryOptions o;
-    o.regime = rs::Regime::Series;
-    o.wavelength_um = kLambda;
-    const rs::Geometry g1 = rs::make_geometry(deg_to_rad(10), deg_to_rad(60), 0.0);
-    const rs::Geometry g2 = rs::make_geometry(deg_to_rad(70), deg_to_rad(60), deg_to_rad(30));
+    const SeriesPair p;
+    rs::TwoGeometryOptions o = p.options;
+    const rs::Geometry &g1 = p.g1, &g2 = p.g2;
     const auto c = rs::Correlation::Gaussian;
     const double r = rs::model_ratio_diffuse(g1, g2, 1.0, 3.0, c, o);
     EXPECT_NEAR(rs::correlation_length_two_geometries(r, g1, g2, 1.0, c, o), 3.0, 1e-9);
