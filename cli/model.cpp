@@ -8,10 +8,10 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <charconv>
 #include <cmath>
 #include <cstdint>
-#include <cstring>
 #include <filesystem>
 #include <iostream>
 #include <memory>
@@ -301,17 +301,17 @@ class Record {
         enum class Style : std::uint8_t { None, Csv, Json };
         mutable Style formatted_style = Style::None;
         mutable std::uint8_t formatted_size = 0;
-        mutable double formatted_number = 0.0;
+        mutable std::uint64_t formatted_bits = 0;  // of the number formatted
         mutable std::array<char, 64> formatted{};
 
         // The text of `number` in `style`, by `format(buffer) -> end` when not the cached one.
         template <class Format>
         std::string_view number_text(Style style, Format&& format) const {
-            if (formatted_style != style ||
-                std::memcmp(&formatted_number, &number, sizeof number) != 0) {
+            const auto bits = std::bit_cast<std::uint64_t>(number);
+            if (formatted_style != style || formatted_bits != bits) {
                 const char* end = format(formatted.data());
                 formatted_size = static_cast<std::uint8_t>(end - formatted.data());
-                formatted_number = number;
+                formatted_bits = bits;
                 formatted_style = style;
             }
             return {formatted.data(), formatted_size};

@@ -544,12 +544,11 @@ ScanResult scan_log_ratio(F&& log_ratio, double target, const TwoGeometryOptions
                 fs.push_back(g(ye));
             }
         }
-        if (std::isfinite(f)) {
+        // Finite samples, and the first non-finite one after finite ones (it marks a gap in
+        // the finite part).
+        if (std::isfinite(f) || (!ys.empty() && std::isfinite(fs.back()))) {
             ys.push_back(y);
             fs.push_back(f);
-        } else if (!ys.empty() && std::isfinite(fs.back())) {
-            ys.push_back(y);
-            fs.push_back(f);  // marks a gap in the finite part
         }
         y_prev = y;
         f_prev = f;
