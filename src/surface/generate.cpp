@@ -110,11 +110,6 @@ void check_options(const GenerationOptions& o) {
     }
 }
 
-// Signed frequency (or minimal-image lag) index of j on a circle of n points: j or j − n.
-double signed_index(std::size_t j, std::size_t n) {
-    return j <= n / 2 ? static_cast<double>(j) : static_cast<double>(j) - static_cast<double>(n);
-}
-
 // Offsets u + m·period (m integer) within r_max of 0: the periodic images of lag u that matter.
 std::vector<double> images_within(double u, double period, double r_max, bool periodic) {
     std::vector<double> out;
@@ -234,9 +229,15 @@ struct MapBuffer {
     }
 };
 
-// Filters white noise with the half-spectrum `gain` (ny × (nx/2 + 1), the DFT gain including
-// the 1/(nx ny) of the inverse transform) in `f`: z = IDFT(gain · DFT(w)), w i.i.d. N(0, 1) drawn
-// in row-major order from the seed; z is left in f's real rows.
+// The gain's rows: the DFT gain is even in ky (C_p(x, −y) = C_p(x, y), a PSD of |k|), so only the
+// rows ky ≥ 0 of the half spectrum are kept, ny/2 + 1 of them; spectrum row r (ky = r for
+// r ≤ ny/2, r − ny above) uses gain row min(r, ny − r).
+std::size_t gain_rows(std::size_t ny) { return ny / 2 + 1; }
+std::size_t gain_row(std::size_t r, std::size_t ny) { return r <= ny / 2 ? r : ny - r; }
+
+// Filters white noise with the half-spectrum `gain` (gain_rows(ny) × (nx/2 + 1), the DFT gain
+// including the 1/(nx ny) of the inverse transform) in `f`: z = IDFT(gain · DFT(w)), w i.i.d.
+// N(0, 1) drawn in row-major order from the seed; z is left in f's real rows.
 void filter_noise(const GenerationOptions& o, const std::vector<double>& gain,
                   fft::RealToComplex& f) {
     NormalStream normal(o.seed);
@@ -247,7 +248,7 @@ void filter_noise(const GenerationOptions& o, const std::vector<double>& gain,
     const std::size_t cols = f.spectrum_cols();
     for (std::size_t r = 0; r < o.ny; ++r) {
         std::complex<double>* row = f.spectrum_row(r);
-        const double* g = gain.data() + r * cols;
+        const double* g = gain.data() + gain_row(r, o.ny) * cols;
         for (std::size_t k = 0; k < cols; ++k) {
             row[k] *= g[k];
         }
@@ -272,15 +273,15 @@ namespace {
 // The half-spectrum gain of the options' surface, computed in `f`'s buffer (left holding the
 // ACF's spectrum). S = DFT(C_p) is real (C_p is even) and ≥ 0 up to rounding (C_p is positive
 // definite), so the gain σ√S/(nx ny) gives the periodic surface the ensemble ACF σ² C_p on the
-// lattice.
+// lattice. S is even in ky: the rows ky ≥ 0 are kept (gain_row).
 std::vector<double> generation_gain(const GenerationOptions& o, fft::RealToComplex& f) {
     fill_periodised_acf(o, f);
     f.forward();
     const std::size_t cols = f.spectrum_cols();
     const double points = static_cast<double>(o.nx) * static_cast<double>(o.ny);
     std::vector<double> gain;
-    assign_large(gain, o.ny * cols, 0.0);
-    for (std::size_t r = 0; r < o.ny; ++r) {
+    assign_large(gain, gain_rows(o.ny) * cols, 0.0);
+    for (std::size_t r = 0; r < gain_rows(o.ny); ++r) {
         const std::complex<double>* row = f.spectrum_row(r);
         for (std::size_t k = 0; k < cols; ++k) {
             gain[r * cols + k] = o.sigma_um * std::sqrt(std::max(row[k].real(), 0.0)) / points;
@@ -339,12 +340,15 @@ HeightMap generate_surface_from_psd(const std::function<double(double k_rad_per_
     const std::size_t cols = o.nx / 2 + 1;  // the half spectrum's columns
     const double dkx = 2 * kPi / (static_cast<double>(o.nx) * o.dx_um);
     const double dky = 2 * kPi / (static_cast<double>(o.ny) * o.dy_um);
-    // W at the lattice frequencies of the half spectrum; the total Σ W over the full spectrum
-    // (the half counted twice except at kx = 0 and the Nyquist column).
-    std::vector<double> gain(o.ny * cols);
+    // W at the lattice frequencies of the half spectrum's rows ky ≥ 0 (gain_row: W depends on
+    // |k|); the total Σ W over the full spectrum (a half-spectrum column counted twice except at
+    // kx = 0 and the Nyquist column, a row ky > 0 twice except the Nyquist row).
+    std::vector<double> gain;
+    assign_large(gain, gain_rows(o.ny) * cols, 0.0);
     double total = 0;
-    for (std::size_t r = 0; r < o.ny; ++r) {
-        const double ky = signed_index(r, o.ny) * dky;
+    for (std::size_t r = 0; r < gain_rows(o.ny); ++r) {
+        const double ky = static_cast<double>(r) * dky;
+        const double row_weight = (r != 0 && 2 * r != o.ny) ? 2 : 1;
         for (std::size_t k = 0; k < cols; ++k) {
             const double kabs = std::hypot(static_cast<double>(k) * dkx, ky);
             const double w = psd(kabs);
@@ -359,7 +363,7 @@ HeightMap generate_surface_from_psd(const std::function<double(double k_rad_per_
                 throw InvalidArgument(message);
             }
             gain[r * cols + k] = w;
-            total += (k != 0 && 2 * k != o.nx) ? 2 * w : w;
+            total += row_weight * ((k != 0 && 2 * k != o.nx) ? 2 * w : w);
         }
     }
     if (!(total > 0) || !std::isfinite(total)) {

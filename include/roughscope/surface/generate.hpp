@@ -41,7 +41,7 @@ class SurfaceGenerator {
 
   private:
     GenerationOptions options_;
-    std::vector<double> gain_;  // the half-spectrum gain σ√S/(nx ny)
+    std::vector<double> gain_;  // the half-spectrum gain σ√S/(nx ny), its rows ky ≥ 0
 };
 
 // The same with the correlation replaced by an isotropic two-sided PSD W(k) of the spatial
