@@ -269,6 +269,8 @@ void expect_periodic_ensemble_acf(Correlation c, std::size_t nx, std::size_t ny,
 TEST(Generate, EnsembleAveragedPeriodicAcfIsThePeriodisedTargetOnTheLattice) {
     expect_periodic_ensemble_acf(Correlation::Exponential, 16, 12, 1.0, 1.5, 5.0);
     expect_periodic_ensemble_acf(Correlation::Gaussian, 16, 12, 1.0, 1.5, 8.0);
+    // An odd ny: the gain's rows ky >= 0 mirror onto ky < 0 without a Nyquist row.
+    expect_periodic_ensemble_acf(Correlation::Gaussian, 12, 11, 1.0, 1.5, 7.0);
     expect_periodic_ensemble_acf(Correlation::Exponential, 24, 1, 0.5, 1.0, 6.0);
 }
 
@@ -295,7 +297,7 @@ TEST(Generate, FromTheGaussianPsdGivesTheGaussianCorrelationSurface) {
     // periodic images are below 1e−15, so both routes filter the same noise by the same gain, up to
     // the ACF route's rounding: its DFT of C_p carries absolute errors of ~1e−16 Σ C_p, whose
     // square roots (~1e−8 of the peak gain) fill the frequencies where the gain should be ~0.
-    for (const std::size_t ny : {std::size_t{40}, std::size_t{1}}) {
+    for (const std::size_t ny : {std::size_t{40}, std::size_t{39}, std::size_t{1}}) {
         GenerationOptions o = options(Correlation::Gaussian, 64, ny, 6, 77);
         o.dx_um = 0.5;
         o.dy_um = 0.5;
