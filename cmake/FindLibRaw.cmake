@@ -2,13 +2,14 @@
 # package).
 #
 # Defines LibRaw_FOUND, LibRaw_VERSION and the imported target LibRaw::LibRaw (header
-# libraw/libraw.h, library raw).
+# libraw/libraw.h, library raw_r: the thread-safe build, as measure() decodes captures in
+# parallel; libraw_r.pc calls the plain libraw "non-thread-safe").
 find_package(PkgConfig QUIET)
 if(PkgConfig_FOUND)
-  pkg_check_modules(PC_LIBRAW QUIET libraw)
+  pkg_check_modules(PC_LIBRAW QUIET libraw_r)
 endif()
 find_path(LibRaw_INCLUDE_DIR libraw/libraw.h HINTS ${PC_LIBRAW_INCLUDEDIR} ${PC_LIBRAW_INCLUDE_DIRS})
-find_library(LibRaw_LIBRARY NAMES raw HINTS ${PC_LIBRAW_LIBDIR} ${PC_LIBRAW_LIBRARY_DIRS})
+find_library(LibRaw_LIBRARY NAMES raw_r HINTS ${PC_LIBRAW_LIBDIR} ${PC_LIBRAW_LIBRARY_DIRS})
 set(LibRaw_VERSION "${PC_LIBRAW_VERSION}")
 include(FindPackageHandleStandardArgs)
 find_package_handle_standard_args(LibRaw

@@ -37,6 +37,19 @@ std::vector<float>::const_iterator first_non_finite(const std::vector<float>& va
 }  // namespace
 
 void check_linear_image(const LinearImage& image) {
+    check_linear_image_layout(image);
+    const auto bad = first_non_finite(image.values);
+    if (bad != image.values.end())
+        throw_non_finite_value(image, static_cast<std::size_t>(bad - image.values.begin()));
+}
+
+void throw_non_finite_value(const LinearImage& image, std::size_t sample) {
+    const std::string name = image.info.source.empty() ? std::string("image") : image.info.source;
+    throw InvalidArgument(concat(name, ": value ", check::format_number(image.values[sample]),
+                                 " at sample ", std::to_string(sample), " is not finite"));
+}
+
+void check_linear_image_layout(const LinearImage& image) {
     const std::string name = image.info.source.empty() ? std::string("image") : image.info.source;
     if (image.width == 0 || image.height == 0)
         throw InvalidArgument(concat(name, ": image size ", std::to_string(image.width), " x ",
@@ -52,10 +65,6 @@ void check_linear_image(const LinearImage& image) {
     if (image.flags.size() != pixels)
         throw InvalidArgument(concat(name, ": ", std::to_string(image.flags.size()),
                                      " pixel flags for ", std::to_string(pixels), " pixels"));
-    const auto bad = first_non_finite(image.values);
-    if (bad != image.values.end())
-        throw InvalidArgument(concat(name, ": value ", check::format_number(*bad), " at sample ",
-                                     std::to_string(bad - image.values.begin()), " is not finite"));
 }
 
 std::size_t count_flagged(const LinearImage& image, std::uint8_t mask) {

@@ -3,9 +3,13 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cmath>
 #include <cstdint>
+#include <exception>
+#include <future>
 #include <limits>
+#include <thread>
 #include <utility>
 
 #include "roughscope/core/errors.hpp"
@@ -453,6 +457,159 @@ std::vector<std::int32_t> region_labels(const MapRequest& maps, std::size_t widt
     return labels;
 }
 
+// Captures in flight by default (threads = 0): each holds its decoded image.
+constexpr std::size_t kMaxDefaultThreads = 4;
+
+// What one capture gives: its measurement, its warnings (in order), the curved object's profile,
+// the image itself when a map divides it, or the error that stopped it.
+struct CaptureOutcome {
+    CaptureMeasurement capture;
+    std::vector<std::string> warnings;
+    std::optional<CylinderProfile> cylinder;
+    std::optional<SphereResult> sphere;
+    std::optional<LinearImage> map_image;
+    std::exception_ptr error;
+};
+
+// The first capture's size (a LinearImage without values) and the region's mask, which every
+// capture is measured with.
+struct FirstCapture {
+    LinearImage header;
+    std::vector<std::uint8_t> mask;
+    std::size_t region_pixels = 0;
+};
+
+// The captures measured by up to `threads` workers, each taking the next capture in order (so
+// capture 0, which gives the size and the mask, is always taken first and never waits). Every
+// capture's result is what a one-thread run gives; the first failing capture's error is thrown.
+class CaptureRun {
+  public:
+    CaptureRun(const MeasureRequest& request, const Loader& loader,
+               const std::optional<LinearImage>& dark, const std::optional<LinearImage>& flat)
+        : request_(request),
+          loader_(loader),
+          dark_(dark),
+          flat_(flat),
+          outcomes_(request.captures.size()),
+          first_ready_(first_.get_future().share()) {
+        // A map divides the first two diffuse captures.
+        if (request.maps)
+            for (std::size_t k = 0; k < request.captures.size() && map_keep_.size() < 2; ++k)
+                if (request.captures[k].role == CaptureRole::Diffuse) map_keep_.push_back(k);
+    }
+
+    void run(std::size_t threads) {
+        const std::size_t n = request_.captures.size();
+        threads = std::clamp<std::size_t>(threads, 1, n);
+        std::vector<std::thread> workers;
+        workers.reserve(threads - 1);
+        for (std::size_t t = 1; t < threads; ++t) workers.emplace_back([this] { work(); });
+        work();
+        for (std::thread& w : workers) w.join();
+        for (const CaptureOutcome& o : outcomes_)
+            if (o.error) std::rethrow_exception(o.error);
+    }
+
+    std::vector<CaptureOutcome>& outcomes() { return outcomes_; }
+    const FirstCapture& first() const { return first_ready_.get(); }
+
+  private:
+    void work() {
+        for (;;) {
+            const std::size_t k = next_.fetch_add(1);
+            if (k >= outcomes_.size()) return;
+            try {
+                measure_capture(k);
+            } catch (...) {
+                outcomes_[k].error = std::current_exception();
+                if (k == 0 && !first_published_) first_.set_exception(std::current_exception());
+            }
+        }
+    }
+
+    void measure_capture(std::size_t k) {
+        const CaptureSpec& spec = request_.captures[k];
+        const std::string src = where(request_);
+        CaptureOutcome& out = outcomes_[k];
+        CaptureMeasurement& capture = out.capture;
+        capture.spec = spec;
+        // A merged bracket is per second of exposure.
+        if (!spec.bracket.empty()) capture.spec.exposure_s = 1.0;
+        LinearImage image = loader_.capture(spec);
+        if (k == 0) {
+            FirstCapture first;
+            first.header.width = image.width;
+            first.header.height = image.height;
+            first.header.channels = image.channels;
+            first.header.info.source = image.info.source;
+            if (request_.roi) {
+                first.mask = rasterize(*request_.roi, image.width, image.height);
+                first.region_pixels = static_cast<std::size_t>(std::count_if(
+                    first.mask.begin(), first.mask.end(), [](std::uint8_t m) { return m != 0; }));
+            }
+            first_.set_value(std::move(first));
+            first_published_ = true;
+        }
+        // Capture 0's failure ends the others here (its error is the one thrown).
+        const FirstCapture& first = first_ready_.get();
+        check_same_size(image, first.header, src);
+        if (dark_) {
+            check_same_size(*dark_, first.header, src);
+            subtract_dark_frame(image, *dark_);
+        }
+        if (flat_) {
+            check_same_size(*flat_, first.header, src);
+            divide_flat_field(image, *flat_);
+        }
+        for (const auto& w : image.info.warnings)
+            out.warnings.push_back(concat(spec.image, ": ", w));
+        const std::vector<std::uint8_t>* roi_mask = request_.roi ? &first.mask : nullptr;
+        const ObjectShape shape = request_.object.shape;
+        if (shape == ObjectShape::Cylinder) {
+            CylinderOptions options = request_.object.cylinder;
+            options.light = spec.light.value_or(Eigen::Vector3d::UnitZ());
+            options.view = spec.view.value_or(Eigen::Vector3d::UnitZ());
+            out.cylinder = measure_cylinder_profile(image, roi_mask, options);
+            for (const auto& w : out.cylinder->warnings)
+                out.warnings.push_back(concat(spec.image, ": ", w));
+        } else if (shape == ObjectShape::Sphere) {
+            SphereOptions options = request_.object.sphere;
+            options.light = spec.light.value_or(Eigen::Vector3d::UnitZ());
+            options.view = spec.view.value_or(Eigen::Vector3d::UnitZ());
+            out.sphere = measure_sphere(image, roi_mask, options);
+            for (const auto& w : out.sphere->warnings)
+                out.warnings.push_back(concat(spec.image, ": ", w));
+        } else if (spec.role == CaptureRole::Specular) {
+            if (!request_.roi)
+                throw InvalidArgument(concat(src, ": ", spec.image,
+                                             ": a specular capture needs the roi that holds its "
+                                             "highlight"));
+            capture.highlight = measure_highlight(image, first.mask, request_.highlight);
+            capture.region = capture.highlight->core;
+            for (const auto& w : capture.highlight->warnings)
+                out.warnings.push_back(concat(spec.image, ": ", w));
+        } else if (request_.roi) {
+            capture.region = region_statistics(image, first.mask, request_.statistics);
+            for (const auto& w : capture.region.warnings)
+                out.warnings.push_back(concat(spec.image, ": ", w));
+        }
+        capture.info = image.info;
+        if (std::find(map_keep_.begin(), map_keep_.end(), k) != map_keep_.end())
+            out.map_image = std::move(image);
+    }
+
+    const MeasureRequest& request_;
+    const Loader& loader_;
+    const std::optional<LinearImage>& dark_;
+    const std::optional<LinearImage>& flat_;
+    std::vector<CaptureOutcome> outcomes_;
+    std::vector<std::size_t> map_keep_;
+    std::atomic<std::size_t> next_{0};
+    std::promise<FirstCapture> first_;
+    bool first_published_ = false;  // only the worker of capture 0 touches it
+    std::shared_future<FirstCapture> first_ready_;
+};
+
 }  // namespace
 
 MeasureResult measure(const MeasureRequest& request) {
@@ -466,75 +623,26 @@ MeasureResult measure(const MeasureRequest& request) {
     if (request.dark_frame) dark = loader.image(*request.dark_frame);
     if (request.flat_field) flat = loader.image(*request.flat_field);
 
-    std::vector<std::uint8_t> mask;
-    std::optional<LinearImage> first;
+    CaptureRun run(request, loader, dark, flat);
+    run.run(request.threads == 0
+                ? std::min<std::size_t>(kMaxDefaultThreads,
+                                        std::max(1U, std::thread::hardware_concurrency()))
+                : request.threads);
+    const FirstCapture& first_capture = run.first();
+    const LinearImage* first = &first_capture.header;
+    result.region_pixels = first_capture.region_pixels;
     // A map keeps the first two diffuse images (the pair it divides) and their captures' index.
     std::vector<LinearImage> map_images;
     std::vector<std::size_t> map_captures;
-    for (const CaptureSpec& spec : request.captures) {
-        CaptureMeasurement capture;
-        capture.spec = spec;
-        // A merged bracket is per second of exposure.
-        if (!spec.bracket.empty()) capture.spec.exposure_s = 1.0;
-        LinearImage image = loader.capture(spec);
-        if (!first) {
-            first = LinearImage{};
-            first->width = image.width;
-            first->height = image.height;
-            first->channels = image.channels;
-            first->info.source = image.info.source;
-            if (request.roi) {
-                mask = rasterize(*request.roi, image.width, image.height);
-                result.region_pixels = static_cast<std::size_t>(
-                    std::count_if(mask.begin(), mask.end(), [](std::uint8_t m) { return m != 0; }));
-            }
-        }
-        check_same_size(image, *first, src);
-        if (dark) {
-            check_same_size(*dark, *first, src);
-            subtract_dark_frame(image, *dark);
-        }
-        if (flat) {
-            check_same_size(*flat, *first, src);
-            divide_flat_field(image, *flat);
-        }
-        for (const auto& w : image.info.warnings)
-            result.warnings.push_back(concat(spec.image, ": ", w));
-        const std::vector<std::uint8_t>* roi_mask = request.roi ? &mask : nullptr;
-        if (shape == ObjectShape::Cylinder) {
-            CylinderOptions options = request.object.cylinder;
-            options.light = spec.light.value_or(Eigen::Vector3d::UnitZ());
-            options.view = spec.view.value_or(Eigen::Vector3d::UnitZ());
-            result.cylinder = measure_cylinder_profile(image, roi_mask, options);
-            for (const auto& w : result.cylinder->warnings)
-                result.warnings.push_back(concat(spec.image, ": ", w));
-        } else if (shape == ObjectShape::Sphere) {
-            SphereOptions options = request.object.sphere;
-            options.light = spec.light.value_or(Eigen::Vector3d::UnitZ());
-            options.view = spec.view.value_or(Eigen::Vector3d::UnitZ());
-            result.sphere = measure_sphere(image, roi_mask, options);
-            for (const auto& w : result.sphere->warnings)
-                result.warnings.push_back(concat(spec.image, ": ", w));
-        } else if (spec.role == CaptureRole::Specular) {
-            if (!request.roi)
-                throw InvalidArgument(concat(src, ": ", spec.image,
-                                             ": a specular capture needs the roi that holds its "
-                                             "highlight"));
-            capture.highlight = measure_highlight(image, mask, request.highlight);
-            capture.region = capture.highlight->core;
-            for (const auto& w : capture.highlight->warnings)
-                result.warnings.push_back(concat(spec.image, ": ", w));
-        } else if (request.roi) {
-            capture.region = region_statistics(image, mask, request.statistics);
-            for (const auto& w : capture.region.warnings)
-                result.warnings.push_back(concat(spec.image, ": ", w));
-        }
-        capture.info = image.info;
-        if (request.maps && spec.role == CaptureRole::Diffuse && map_images.size() < 2) {
-            map_images.push_back(std::move(image));
+    for (CaptureOutcome& o : run.outcomes()) {
+        for (auto& w : o.warnings) result.warnings.push_back(std::move(w));
+        if (o.cylinder) result.cylinder = std::move(o.cylinder);
+        if (o.sphere) result.sphere = std::move(o.sphere);
+        if (o.map_image) {
+            map_images.push_back(std::move(*o.map_image));
             map_captures.push_back(result.captures.size());
         }
-        result.captures.push_back(std::move(capture));
+        result.captures.push_back(std::move(o.capture));
     }
     assign_exposures(result.captures, result.warnings, src);
     if (is_profile(shape)) {

@@ -400,6 +400,27 @@ void put_linear_pixels(LinearImage& image, const T* samples, std::size_t row, st
     }
     const std::uint64_t high_q = static_cast<std::uint64_t>(std::min(std::ceil(white), 1e18));
     std::uint8_t* flags = image.flags.data() + row * width;
+    if constexpr (Planes == 1) {
+        if (stride == 1) {
+            // Contiguous grey samples (the usual 16-bit TIFF/PNG): a loop the compiler vectorises,
+            // with the thresholds as 32-bit integers (codes are at most 16 bits, so clamping them
+            // to [−1, 2¹⁷] changes no comparison).
+            const T* in = samples + offsets[0];
+            float* o = out[0];
+            const float b = black_f[0];
+            const float scale = scale_f[0];
+            constexpr std::uint64_t kClamp = std::uint64_t{1} << 17;
+            const auto high = static_cast<std::int32_t>(std::min(high_q, kClamp));
+            const auto low = static_cast<std::int32_t>(std::min(low_q[0], kClamp));
+            for (std::size_t x = 0; x < width; ++x) {
+                const std::int32_t q = in[x];
+                o[x] = (static_cast<float>(q) - b) * scale;
+                flags[x] |= static_cast<std::uint8_t>((q >= high ? kPixelSaturated : 0) |
+                                                      (q <= low ? kPixelClippedLow : 0));
+            }
+            return;
+        }
+    }
     for (std::size_t x = 0; x < width; ++x) {
         const T* pixel = samples + x * stride;
         std::uint8_t f = 0;

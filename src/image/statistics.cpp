@@ -5,6 +5,7 @@
 #include <cassert>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <limits>
 #include <span>
 #include <vector>
@@ -13,6 +14,14 @@
 #include "roughscope/core/errors.hpp"
 #include "roughscope/core/memory.hpp"
 #include "roughscope/core/text.hpp"
+
+// The sums below run twice as wide with AVX2 (one clone per instruction set, chosen when the
+// program loads). No FMA: the clones round exactly as the default code does.
+#if defined(__x86_64__) && defined(__linux__) && (defined(__GNUC__) || defined(__clang__))
+#define ROUGHSCOPE_VECTOR_CLONES __attribute__((target_clones("avx2", "default")))
+#else
+#define ROUGHSCOPE_VECTOR_CLONES
+#endif
 
 namespace roughscope::image {
 namespace {
@@ -30,30 +39,116 @@ std::string image_name(const LinearImage& image) {
 
 std::string fraction_text(double f) { return check::format_number(f); }
 
-// Σ p[0..n) in double, four partial sums (no chain of additions through one register).
-double sum_of(const float* p, std::size_t n) {
-    std::array<double, 4> acc{};
-    std::size_t i = 0;
-    for (; i + 4 <= n; i += 4)
-        for (std::size_t j = 0; j < 4; ++j) acc[j] += p[i + j];
-    for (; i < n; ++i) acc[0] += p[i];
-    return (acc[0] + acc[1]) + (acc[2] + acc[3]);
+// Σ (p[i] − c) and Σ (p[i] − c)² in double, four partial sums each (no chain of additions
+// through one register). With the shift c near the mean, Σ (v − m)² = Σ (v − c)² − n (m − c)²
+// loses nothing to cancellation, so one read of the values gives both the sums and the spread.
+struct ShiftedSums {
+    double sum = 0.0;      // Σ (v − c)
+    double squares = 0.0;  // Σ (v − c)²
+};
+
+// Four doubles as one value (GCC/Clang vector extension: four lanes, one AVX2 register or two
+// SSE2 ones); lane j sums the values i ≡ j (mod 4), as four scalar partial sums would.
+using Double4 = double __attribute__((vector_size(32)));
+using Float4 = float __attribute__((vector_size(16)));
+
+// (Vectors by reference: passed by value they would change the calling convention with the
+// instruction set, which GCC warns about.)
+void load4(const float* p, Double4& out) {
+    Float4 f;
+    std::memcpy(&f, p, sizeof f);
+    out = __builtin_convertvector(f, Double4);
 }
 
-// Σ (p[i] − m)² in double.
-double squares_about(const float* p, std::size_t n, double m) {
-    std::array<double, 4> acc{};
+double lanes_sum(const Double4& v) { return (v[0] + v[1]) + (v[2] + v[3]); }
+
+ROUGHSCOPE_VECTOR_CLONES ShiftedSums shifted_sums(const float* p, std::size_t n, double c) {
+    const Double4 shift = {c, c, c, c};
+    Double4 acc{};
+    Double4 acc2{};
     std::size_t i = 0;
-    for (; i + 4 <= n; i += 4)
-        for (std::size_t j = 0; j < 4; ++j) {
-            const double d = static_cast<double>(p[i + j]) - m;
-            acc[j] += d * d;
-        }
-    for (; i < n; ++i) {
-        const double d = static_cast<double>(p[i]) - m;
-        acc[0] += d * d;
+    for (; i + 4 <= n; i += 4) {
+        Double4 d;
+        load4(p + i, d);
+        d -= shift;
+        acc += d;
+        acc2 += d * d;
     }
-    return (acc[0] + acc[1]) + (acc[2] + acc[3]);
+    for (; i < n; ++i) {
+        const double d = static_cast<double>(p[i]) - c;
+        acc[0] += d;
+        acc2[0] += d * d;
+    }
+    return {lanes_sum(acc), lanes_sum(acc2)};
+}
+
+// shifted_sums of three planes at once, and of their per-pixel average (v₀ + v₁ + v₂) / 3 in
+// double about its own shift.
+struct RgbShiftedSums {
+    std::array<ShiftedSums, 3> plane;
+    ShiftedSums average;
+};
+
+ROUGHSCOPE_VECTOR_CLONES RgbShiftedSums shifted_sums_rgb(const std::array<const float*, 3>& p,
+                                                         std::size_t n,
+                                                         const std::array<double, 3>& c,
+                                                         double c_average) {
+    std::array<Double4, 3> shift{};
+    std::array<Double4, 3> acc{};
+    std::array<Double4, 3> acc2{};
+    for (std::size_t k = 0; k < 3; ++k) shift[k] = Double4{c[k], c[k], c[k], c[k]};
+    const Double4 shift_average = {c_average, c_average, c_average, c_average};
+    const Double4 third = {3.0, 3.0, 3.0, 3.0};
+    Double4 acc_average{};
+    Double4 acc2_average{};
+    std::size_t i = 0;
+    for (; i + 4 <= n; i += 4) {
+        Double4 v0;
+        Double4 v1;
+        Double4 v2;
+        load4(p[0] + i, v0);
+        load4(p[1] + i, v1);
+        load4(p[2] + i, v2);
+        const std::array<Double4, 3> d = {v0 - shift[0], v1 - shift[1], v2 - shift[2]};
+        for (std::size_t k = 0; k < 3; ++k) {
+            acc[k] += d[k];
+            acc2[k] += d[k] * d[k];
+        }
+        const Double4 da = (v0 + v1 + v2) / third - shift_average;
+        acc_average += da;
+        acc2_average += da * da;
+    }
+    for (; i < n; ++i) {
+        const double v0 = p[0][i];
+        const double v1 = p[1][i];
+        const double v2 = p[2][i];
+        const double d[3] = {v0 - c[0], v1 - c[1], v2 - c[2]};
+        for (std::size_t k = 0; k < 3; ++k) {
+            acc[k][0] += d[k];
+            acc2[k][0] += d[k] * d[k];
+        }
+        const double da = (v0 + v1 + v2) / 3.0 - c_average;
+        acc_average[0] += da;
+        acc2_average[0] += da * da;
+    }
+    RgbShiftedSums out;
+    for (std::size_t k = 0; k < 3; ++k) out.plane[k] = {lanes_sum(acc[k]), lanes_sum(acc2[k])};
+    out.average = {lanes_sum(acc_average), lanes_sum(acc2_average)};
+    return out;
+}
+
+// The 8 bytes at p as one word (any alignment).
+std::uint64_t load_word(const std::uint8_t* p) {
+    std::uint64_t w = 0;
+    std::memcpy(&w, p, sizeof w);
+    return w;
+}
+
+// True when none of the 8 bytes of w is zero.
+bool no_zero_byte(std::uint64_t w) {
+    constexpr std::uint64_t kOnes = 0x0101010101010101ULL;
+    constexpr std::uint64_t kHighs = 0x8080808080808080ULL;
+    return ((w - kOnes) & ~w & kHighs) == 0;
 }
 
 struct Box {
@@ -153,10 +248,11 @@ double robust_location(const ValueSeries& series) {
     const std::size_t stride = (series.count + kRobustMaxSamples - 1) / kRobustMaxSamples;
     std::vector<float> sample;
     sample.reserve(series.count / stride + 1);
-    std::size_t index = 0;
+    // The offset of the next sample in the current span (scan-order index a multiple of stride).
+    std::size_t next = 0;
     for_each_span(series, [&](const float* p, std::size_t n) {
-        for (std::size_t k = 0; k < n; ++k, ++index)
-            if (index % stride == 0) sample.push_back(p[k]);
+        for (; next < n; next += stride) sample.push_back(p[next]);
+        next -= n;
     });
     return huber_location(std::span<const float>(sample)).location;
 }
@@ -170,19 +266,27 @@ double robust_location(std::span<const float> values) {
     return huber_location(std::span<const float>(sample)).location;
 }
 
-// Mean, spread and robust mean of a series whose Σ is known.
-void set_spread_and_robust_mean(const ValueSeries& series, double sum, ChannelStatistics& s) {
-    s.count = series.count;
+// Count, mean and spread of `count` values from their shifted sums about c.
+void set_moments(std::size_t count, double c, const ShiftedSums& sums, ChannelStatistics& s) {
+    s.count = count;
     assert(s.count > 0);
-    s.mean = sum / static_cast<double>(s.count);
-    if (s.count > 1) {
-        double ss = 0.0;
-        for_each_span(series,
-                      [&](const float* p, std::size_t n) { ss += squares_about(p, n, s.mean); });
-        s.std_dev = std::sqrt(ss / static_cast<double>(s.count - 1));
-    }
-    s.stderr_pixel = s.std_dev / std::sqrt(static_cast<double>(s.count));
-    s.robust_mean = robust_location(series);
+    const auto n = static_cast<double>(s.count);
+    const double offset = sums.sum / n;  // m − c
+    s.mean = c + offset;
+    if (s.count > 1)
+        s.std_dev = std::sqrt(std::max(0.0, sums.squares - n * offset * offset) / (n - 1.0));
+    s.stderr_pixel = s.std_dev / std::sqrt(n);
+}
+
+// The InvalidArgument of check_linear_image for the first non-finite used value of plane c.
+[[noreturn]] void throw_first_non_finite(const LinearImage& image, std::size_t c,
+                                         const std::vector<ValueRun>& runs) {
+    const std::size_t offset = c * image.pixel_count();
+    for (const ValueRun& r : runs)
+        for (std::size_t k = r.start; k < std::size_t{r.start} + r.length; ++k)
+            if (!std::isfinite(image.values[offset + k])) throw_non_finite_value(image, offset + k);
+    assert(false && "a non-finite sum of finite values");
+    throw_non_finite_value(image, offset + runs.front().start);
 }
 
 }  // namespace
@@ -199,7 +303,10 @@ void check_region_statistics_options(const RegionStatisticsOptions& options) {
 
 RegionStatistics region_statistics(const LinearImage& image, const std::vector<std::uint8_t>& mask,
                                    const RegionStatisticsOptions& options) {
-    check_linear_image(image);
+    // The values are checked where they are read: a non-finite used value makes the plane's
+    // shifted sums non-finite (finite floats cannot overflow them in double), and only then are
+    // the used values searched for it.
+    check_linear_image_layout(image);
     check_region_statistics_options(options);
     const std::string name = image_name(image);
     const std::size_t pixels = image.pixel_count();
@@ -225,19 +332,35 @@ RegionStatistics region_statistics(const LinearImage& image, const std::vector<s
     const std::uint8_t* m = mask.data();
     const std::uint8_t* flags = image.flags.data();
     constexpr std::uint8_t kKnownFlags = kPixelSaturated | kPixelClippedLow;
+    // Eight pixels at a time where the mask is all out (a zero word) or all in with no flag.
+    const auto eight_used = [&](std::size_t k) {
+        return no_zero_byte(load_word(m + k)) && load_word(flags + k) == 0;
+    };
     for (std::size_t y = 0; y < image.height; ++y) {
         const std::size_t row = y * image.width;
         std::size_t x = 0;
         while (x < image.width) {
-            for (; x < image.width && (m[row + x] == 0 || flags[row + x] != 0); ++x) {
-                if (m[row + x] == 0) continue;
-                const std::uint8_t f = flags[row + x];
-                ++out.pixels_in_region;
-                if (f & kPixelSaturated) ++out.pixels_saturated;
-                if (f & kPixelClippedLow) ++out.pixels_clipped_low;
-                if (f & ~kKnownFlags) ++other;
+            // Pixels not used: outside the mask, or flagged (counted by reason).
+            while (x < image.width) {
+                if (x + 8 <= image.width) {
+                    if (load_word(m + row + x) == 0) {
+                        x += 8;
+                        continue;
+                    }
+                    if (eight_used(row + x)) break;
+                }
+                if (m[row + x] != 0) {
+                    const std::uint8_t f = flags[row + x];
+                    if (f == 0) break;
+                    ++out.pixels_in_region;
+                    if (f & kPixelSaturated) ++out.pixels_saturated;
+                    if (f & kPixelClippedLow) ++out.pixels_clipped_low;
+                    if (f & ~kKnownFlags) ++other;
+                }
+                ++x;
             }
             const std::size_t start = x;
+            while (x + 8 <= image.width && eight_used(row + x)) x += 8;
             while (x < image.width && m[row + x] != 0 && flags[row + x] == 0) ++x;
             if (x == start) continue;
             runs.push_back(
@@ -274,54 +397,80 @@ RegionStatistics region_statistics(const LinearImage& image, const std::vector<s
     const TileGrid grid = tile_grid(box, out.tile_size_px);
     const std::vector<std::uint32_t> tile_n = tile_pixel_counts(runs, grid, image.width);
 
-    // Per plane: one read for the tile sums (their total is Σ v), one for Σ (v − v̄)², then the
-    // reads of the robust mean (robust_location.hpp). The planes are read in place.
+    // One read of every plane: per plane the tile sums and Σ (v − c)², c the mean of the first
+    // run (shifted_sums), and for RGB the same of the per-pixel average (in double); then the
+    // reads of the robust means (robust_location.hpp). The planes are read in place.
     const std::size_t planes = image.channels;
-    std::vector<double> tile_sums(grid.cells());
-    std::vector<double> average_tile_sums(planes > 1 ? grid.cells() : 0, 0.0);
-    double average_sum = 0.0;
+    assert(planes == 1 || planes == 3);
+    const ValueRun& first_run = runs.front();
+    std::array<double, 3> shift{};
+    for (std::size_t c = 0; c < planes; ++c)
+        shift[c] = shifted_sums(image.plane(c) + first_run.start, first_run.length, 0.0).sum /
+                   static_cast<double>(first_run.length);
+    const double average_shift = (shift[0] + shift[1] + shift[2]) / 3.0;
+    std::vector<std::vector<double>> tile_sums(planes, std::vector<double>(grid.cells(), 0.0));
+    std::array<ShiftedSums, 3> total{};
+    ShiftedSums average_total;
+    for_each_tile_piece(
+        runs, grid, image.width, [&](std::size_t cell, std::size_t first, std::size_t length) {
+            const auto n = static_cast<double>(length);
+            if (planes == 1) {
+                const ShiftedSums piece = shifted_sums(image.plane(0) + first, length, shift[0]);
+                tile_sums[0][cell] += piece.sum + n * shift[0];
+                total[0].sum += piece.sum;
+                total[0].squares += piece.squares;
+                return;
+            }
+            const RgbShiftedSums piece = shifted_sums_rgb(
+                {image.plane(0) + first, image.plane(1) + first, image.plane(2) + first}, length,
+                shift, average_shift);
+            for (std::size_t c = 0; c < 3; ++c) {
+                tile_sums[c][cell] += piece.plane[c].sum + n * shift[c];
+                total[c].sum += piece.plane[c].sum;
+                total[c].squares += piece.plane[c].squares;
+            }
+            average_total.sum += piece.average.sum;
+            average_total.squares += piece.average.squares;
+        });
     for (std::size_t c = 0; c < planes; ++c) {
-        const float* plane = image.plane(c);
-        std::fill(tile_sums.begin(), tile_sums.end(), 0.0);
-        for_each_tile_piece(runs, grid, image.width,
-                            [&](std::size_t cell, std::size_t first, std::size_t length) {
-                                tile_sums[cell] += sum_of(plane + first, length);
-                            });
-        double sum = 0.0;
-        for (const double t : tile_sums) sum += t;
+        if (!(std::isfinite(total[c].sum) && std::isfinite(total[c].squares)))
+            throw_first_non_finite(image, c, runs);
         ChannelStatistics s;
-        set_spread_and_robust_mean({plane, runs, out.pixels_used}, sum, s);
-        set_tile_error(tile_sums, tile_n, out.tile_size_px, s);
+        set_moments(out.pixels_used, shift[c], total[c], s);
+        s.robust_mean = robust_location(ValueSeries{image.plane(c), runs, out.pixels_used});
+        set_tile_error(tile_sums[c], tile_n, out.tile_size_px, s);
         out.channels.push_back(s);
-        if (planes > 1) {
-            for (std::size_t cell = 0; cell < tile_sums.size(); ++cell)
-                average_tile_sums[cell] += tile_sums[cell] / static_cast<double>(planes);
-            average_sum += sum / static_cast<double>(planes);
-        }
     }
     if (planes == 1) {
         out.average = out.channels[0];
     } else {
-        // The per-pixel average in double for mean and spread; rounded to float, the series of
-        // the robust mean (one contiguous array).
+        // The robust mean's series of the per-pixel average (rounded to float): every pixel up to
+        // kRobustMaxSamples, else every stride-th in scan order (robust_location's subsample,
+        // taken here without forming the rest).
         ChannelStatistics& a = out.average;
-        a.count = out.pixels_used;
-        a.mean = average_sum / static_cast<double>(a.count);
+        const std::size_t stride =
+            out.pixels_used <= kRobustMaxSamples
+                ? 1
+                : (out.pixels_used + kRobustMaxSamples - 1) / kRobustMaxSamples;
         std::vector<float> series;
-        assign_large(series, out.pixels_used, 0.0F);
-        std::size_t i = 0;
-        double ss = 0.0;
-        for (const ValueRun& r : runs)
-            for (std::size_t k = r.start; k < std::size_t{r.start} + r.length; ++k, ++i) {
-                double v = 0.0;
-                for (std::size_t c = 0; c < planes; ++c) v += image.plane(c)[k];
-                v /= static_cast<double>(planes);
-                series[i] = static_cast<float>(v);
-                ss += (v - a.mean) * (v - a.mean);
+        series.reserve(out.pixels_used / stride + 1);
+        std::size_t next = 0;  // offset of the next sample in the current run
+        for (const ValueRun& r : runs) {
+            for (; next < r.length; next += stride) {
+                const std::size_t k = std::size_t{r.start} + next;
+                const double v = (static_cast<double>(image.plane(0)[k]) + image.plane(1)[k] +
+                                  image.plane(2)[k]) /
+                                 3.0;
+                series.push_back(static_cast<float>(v));
             }
-        if (a.count > 1) a.std_dev = std::sqrt(ss / static_cast<double>(a.count - 1));
-        a.stderr_pixel = a.std_dev / std::sqrt(static_cast<double>(a.count));
+            next -= r.length;
+        }
+        set_moments(out.pixels_used, average_shift, average_total, a);
         a.robust_mean = robust_location(std::span<const float>(series));
+        std::vector<double> average_tile_sums(grid.cells(), 0.0);
+        for (std::size_t cell = 0; cell < average_tile_sums.size(); ++cell)
+            average_tile_sums[cell] =
+                (tile_sums[0][cell] + tile_sums[1][cell] + tile_sums[2][cell]) / 3.0;
         set_tile_error(average_tile_sums, tile_n, out.tile_size_px, a);
     }
     if (out.average.tiles < 2)

@@ -1,7 +1,8 @@
 """Peak memory of `roughscope measure` on a pair of large photographs.
 
-The captures are processed one at a time (read, region statistics, released), so the peak is a
-few times one decoded image, not the pair. A 12-MP pair of 16-bit TIFFs is written with
+Each capture is read, measured and released by one thread; on two or more cores both captures of
+the pair are in flight at once (MeasureRequest::threads), so the peak is about two decoded images
+and their flags, the region's mask and the two mapped files, not more. A 12-MP pair of 16-bit TIFFs is written with
 `roughscope simulate capture`; the measurement runs from a fresh interpreter that reports the
 peak resident set size of its child (getrusage(RUSAGE_CHILDREN).ru_maxrss). The limit: 6× one
 decoded float image (12 MP × 4 bytes). Under ROUGHSCOPE_SANITIZED=1 (the ASan build, whose

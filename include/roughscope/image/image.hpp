@@ -80,6 +80,13 @@ struct LinearImage {
 // every value finite.
 void check_linear_image(const LinearImage& image);
 
+// The same checks but the finiteness of the values: for a caller that reads only some of them
+// (region_statistics: the region's used pixels) and checks those itself.
+void check_linear_image_layout(const LinearImage& image);
+
+// Throws the InvalidArgument of check_linear_image for the non-finite values[sample].
+[[noreturn]] void throw_non_finite_value(const LinearImage& image, std::size_t sample);
+
 // Pixels whose flags have any bit of `mask` set.
 std::size_t count_flagged(const LinearImage& image, std::uint8_t mask);
 

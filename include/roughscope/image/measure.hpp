@@ -117,6 +117,10 @@ struct MeasureRequest {
     Radiometry radiometry = Radiometry::Radiance;
     HighlightOptions highlight;
     RegionStatisticsOptions statistics;
+    // Captures read and measured at once, each by its own thread (0: one per core, at most 4);
+    // every result is the same whatever the number. Each capture in flight holds its decoded
+    // image, so the peak memory grows with the number.
+    std::size_t threads = 0;
 };
 
 // One capture as measured.

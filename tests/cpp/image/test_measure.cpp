@@ -27,6 +27,7 @@
 #include "roughscope/io/output_file.hpp"
 #include "roughscope/scattering/beckmann.hpp"
 #include "roughscope/scattering/geometry.hpp"
+#include "roughscope/serialize/measure.hpp"
 #include "roughscope/simulation/capture.hpp"
 
 namespace roughscope::image {
@@ -564,6 +565,69 @@ TEST(MeasureFailures, CapturesOfDifferentSizesAreADataError) {
     } catch (const DataError& e) {
         EXPECT_NE(std::string(e.what()).find("same size"), std::string::npos) << e.what();
         EXPECT_NE(std::string(e.what()).find("other.tiff"), std::string::npos) << e.what();
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Captures measured in parallel: the same result and the same error as one at a time.
+
+TEST(MeasureThreads, OneAndSeveralThreadsGiveTheSameResult) {
+    const fs::path dir = roughscope::testing::fresh_dir("measure_threads");
+    const Geometry g1 = normal_view(20.0), g2 = normal_view(35.0), g3 = normal_view(50.0);
+    MeasureRequest request = request_for(kLinear16);
+    request.captures = {
+        diffuse_capture(write_capture(dir, "c1", kLinear16, g1,
+                                      {very_rough(0.3, Correlation::Gaussian)}, {}, 1.0, 1),
+                        g1, 1.0),
+        diffuse_capture(write_capture(dir, "c2", kLinear16, g2,
+                                      {very_rough(0.3, Correlation::Gaussian)}, {}, 1.0, 2),
+                        g2, 1.0),
+        diffuse_capture(write_capture(dir, "c3", kLinear16, g3,
+                                      {very_rough(0.3, Correlation::Gaussian)}, {}, 1.0, 3),
+                        g3, 1.0)};
+    request.threads = 1;
+    const std::string one = serialize::to_json(measure(request), request).dump();
+    for (const std::size_t threads : {2U, 3U, 8U}) {
+        request.threads = threads;
+        EXPECT_EQ(serialize::to_json(measure(request), request).dump(), one) << threads;
+    }
+}
+
+TEST(MeasureThreads, TheFirstFailingCaptureGivesTheError) {
+    const fs::path dir = roughscope::testing::fresh_dir("measure_threads_errors");
+    MeasureRequest request = pair_with_ratio(dir, "a", 1.05);
+    // Capture 1 missing, capture 2 of another size: capture 1's error whatever the threads.
+    sim::Scene scene;
+    scene.width = kSize + 2;
+    scene.height = kSize;
+    sim::CameraModel camera = camera_for(kLinear16, 1.0, 1);
+    const fs::path other = dir / "other.tiff";
+    io::write_file_atomic(
+        other, sim::encode_capture(sim::render_capture(scene, {constant(1.0)}, {}, camera), camera,
+                                   sim::CaptureFormat::Tiff));
+    CaptureSpec third = request.captures[1];
+    third.image = other.string();
+    request.captures[1].image = (dir / "nope.tiff").string();
+    request.captures.push_back(third);
+    for (const std::size_t threads : {1U, 2U, 3U}) {
+        request.threads = threads;
+        try {
+            (void)measure(request);
+            FAIL() << "no error";
+        } catch (const DataError& e) {
+            EXPECT_NE(std::string(e.what()).find("nope.tiff"), std::string::npos) << e.what();
+        }
+    }
+    // Capture 0 missing: its own error (not the others' wait for its size).
+    request.captures[0].image = (dir / "first_missing.tiff").string();
+    for (const std::size_t threads : {1U, 2U, 3U}) {
+        request.threads = threads;
+        try {
+            (void)measure(request);
+            FAIL() << "no error";
+        } catch (const DataError& e) {
+            EXPECT_NE(std::string(e.what()).find("first_missing"), std::string::npos) << e.what();
+        }
     }
 }
 

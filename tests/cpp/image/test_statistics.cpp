@@ -3,13 +3,17 @@
 // equation, texture seen by the tile error; mostly saturated regions and invalid options.
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <random>
+#include <span>
 #include <string>
 #include <vector>
 
 #include <gtest/gtest.h>
 
+#include "image/robust_location.hpp"
 #include "roughscope/core/errors.hpp"
+#include "roughscope/core/text.hpp"
 #include "roughscope/image/region.hpp"
 #include "roughscope/image/statistics.hpp"
 
@@ -320,6 +324,87 @@ TEST(RegionStatistics, LargeRegionsGetARobustMeanFromASubsample) {
     EXPECT_GT(s.channels[0].mean - 0.3, 0.02);                    // the outliers pull the mean
     EXPECT_LT(std::abs(s.channels[0].robust_mean - 0.3), 0.002);  // not the robust mean
     EXPECT_EQ(s.channels[0].count, image.pixel_count());
+}
+
+}  // namespace
+}  // namespace roughscope::image
+
+namespace roughscope::image {
+namespace {
+
+// A non-finite value is an error where it would be averaged in (a used pixel of any plane) and
+// is ignored where it is not (outside the region, or flagged): the values are checked where they
+// are read.
+TEST(RegionStatistics, NonFiniteValuesAreRefusedOnlyWhereTheyAreUsed) {
+    const LinearImage image = noisy_image(32, 32, 3, {0.2, 0.5, 0.8}, 0.01, 11);
+    const auto mask = rasterize(RectangleRegion{4, 4, 20, 20}, 32, 32);
+    const RegionStatistics clean = region_statistics(image, mask);
+    const std::size_t plane = image.pixel_count();
+    for (const float bad :
+         {std::numeric_limits<float>::quiet_NaN(), std::numeric_limits<float>::infinity(),
+          -std::numeric_limits<float>::infinity()}) {
+        for (const std::size_t c : {0U, 2U}) {
+            LinearImage used = image;
+            used.values[c * plane + 10 * 32 + 10] = bad;  // inside the region
+            try {
+                (void)region_statistics(used, mask);
+                ADD_FAILURE() << "non-finite value accepted in plane " << c;
+            } catch (const InvalidArgument& e) {
+                const std::string what = e.what();
+                EXPECT_NE(what.find("synthetic.tif"), std::string::npos) << what;
+                EXPECT_NE(what.find(concat("at sample ", std::to_string(c * plane + 330))),
+                          std::string::npos)
+                    << what;
+                EXPECT_NE(what.find("is not finite"), std::string::npos) << what;
+            }
+            LinearImage unused = image;
+            unused.values[c * plane + 1] = bad;  // outside the region
+            unused.values[c * plane + 12 * 32 + 12] = bad;
+            unused.flags[12 * 32 + 12] = kPixelSaturated;  // inside, but flagged
+            RegionStatistics s = region_statistics(unused, mask);
+            EXPECT_EQ(s.pixels_used + 1, clean.pixels_used);
+            EXPECT_TRUE(std::isfinite(s.channels[c].mean));
+            EXPECT_TRUE(std::isfinite(s.average.std_dev));
+        }
+    }
+}
+
+// The robust means of a large region (more than 2^20 used pixels, runs of many lengths) are the
+// Huber estimates of exactly the subsample the documentation names: every ⌈n / 2^20⌉-th used
+// pixel in scan order, per plane and for the per-pixel average (rounded to float).
+TEST(RegionStatistics, TheRobustSubsampleIsEveryStrideThUsedPixel) {
+    LinearImage image = noisy_image(1300, 1300, 3, {0.3, 0.5, 0.7}, 0.02, 12);
+    for (std::size_t k = 0; k < image.pixel_count(); k += 97) image.flags[k] = kPixelSaturated;
+    const auto mask = rasterize(CircleRegion{650, 650, 640}, 1300, 1300);
+    const RegionStatistics s = region_statistics(image, mask);
+    const std::size_t n = s.pixels_used;
+    ASSERT_GT(n, std::size_t{1} << 20);
+    const std::size_t stride = (n + (std::size_t{1} << 20) - 1) >> 20;
+    ASSERT_GE(stride, 2U);
+    std::vector<std::vector<float>> sample(4);
+    std::size_t index = 0;
+    for (std::size_t k = 0; k < image.pixel_count(); ++k) {
+        if (mask[k] == 0 || image.flags[k] != 0) continue;
+        if (index++ % stride != 0) continue;
+        double sum = 0.0;
+        for (std::size_t c = 0; c < 3; ++c) {
+            sample[c].push_back(image.plane(c)[k]);
+            sum += image.plane(c)[k];
+        }
+        sample[3].push_back(static_cast<float>(sum / 3.0));
+    }
+    for (std::size_t c = 0; c < 3; ++c)
+        EXPECT_EQ(s.channels[c].robust_mean,
+                  huber_location(std::span<const float>(sample[c])).location)
+            << c;
+    EXPECT_EQ(s.average.robust_mean, huber_location(std::span<const float>(sample[3])).location);
+    // And the moments over all used pixels, against the direct two-pass sums.
+    for (std::size_t c = 0; c < 3; ++c) {
+        std::vector<double> v;
+        for (std::size_t k = 0; k < image.pixel_count(); ++k)
+            if (mask[k] != 0 && image.flags[k] == 0) v.push_back(image.plane(c)[k]);
+        expect_matches(s.channels[c], v);
+    }
 }
 
 }  // namespace
