@@ -8,6 +8,7 @@
 //        x3p/raw_memcpy/<n>        baseline: memcpy of the 8·n² data bytes into a new buffer
 //        x3p/raw_md5/<n>           baseline: one MD5 pass over the 8·n² bytes (the checksum
 //                                  ISO 5436-2 requires a reader to verify)
+//        x3p/decode_unverified/<n> the same without the MD5 passes (--no-verify-checksums)
 //        x3p/decode_deflated/<n>   the same file with data.bin deflated (as instruments write
 //                                  it); its counter time_vs_inflate is the ratio to
 //        x3p/raw_inflate/<n>       baseline: libzip's decompression of that data.bin alone
@@ -25,6 +26,7 @@
 #include <openssl/evp.h>
 #include <zip.h>
 
+#include "roughscope/core/memory.hpp"
 #include "roughscope/surface/formats.hpp"
 #include "roughscope/surface/height_map.hpp"
 
@@ -148,6 +150,37 @@ void BM_x3p_decode(benchmark::State& state) {
     state.SetBytesProcessed(static_cast<std::int64_t>(state.iterations() * n * n * sizeof(double)));
 }
 
+// The same without verifying the checksums (HeightReadOptions::x3p_verify_checksums = false,
+// CLI --no-verify-checksums): the zip, the XML and the conversion only. time_vs_memcpy as above;
+// time_vs_fresh_copy against a memcpy of the bytes into newly allocated storage with the
+// library's large-buffer policy (core/memory.hpp), as any reader's result is.
+void BM_x3p_decode_unverified(benchmark::State& state) {
+    const auto n = static_cast<std::size_t>(state.range(0));
+    const std::string& bytes = x3p_bytes(n);
+    HeightReadOptions unverified;
+    unverified.x3p_verify_checksums = false;
+    for (auto _ : state) {
+        HeightMap map = formats::decode_x3p(bytes, "bench.x3p", unverified);
+        benchmark::DoNotOptimize(map.heights_um.data());
+    }
+    const std::vector<double> raw(n * n, 1.0);
+    std::vector<double> out;
+    const double t_decode =
+        seconds_of([&] { (void)formats::decode_x3p(bytes, "bench.x3p", unverified); }, 3);
+    const double t_memcpy = seconds_of([&] { raw_memcpy(out, raw); }, 3);
+    const double t_fresh = seconds_of(
+        [&] {
+            std::vector<double> fresh;
+            roughscope::assign_large(fresh, raw.size(), 0.0);
+            std::memcpy(fresh.data(), raw.data(), raw.size() * sizeof(double));
+            benchmark::DoNotOptimize(fresh.data());
+        },
+        3);
+    state.counters["time_vs_memcpy"] = t_decode / t_memcpy;
+    state.counters["time_vs_fresh_copy"] = t_decode / t_fresh;
+    state.SetBytesProcessed(static_cast<std::int64_t>(state.iterations() * n * n * sizeof(double)));
+}
+
 void BM_x3p_raw_memcpy(benchmark::State& state) {
     const auto n = static_cast<std::size_t>(state.range(0));
     const std::vector<double> raw(n * n, 1.0);
@@ -202,6 +235,12 @@ BENCHMARK(BM_x3p_raw_inflate)
     ->Iterations(1);
 BENCHMARK(BM_x3p_decode)
     ->Name("x3p/decode")
+    ->Arg(256)
+    ->Arg(4096)
+    ->Unit(benchmark::kMillisecond)
+    ->Iterations(1);
+BENCHMARK(BM_x3p_decode_unverified)
+    ->Name("x3p/decode_unverified")
     ->Arg(256)
     ->Arg(4096)
     ->Unit(benchmark::kMillisecond)

@@ -47,6 +47,7 @@ struct ReadArgs {
     std::size_t nx = 0, ny = 0;
     surface::RawSampleType raw_type = surface::RawSampleType::Float64;
     bool big_endian = false;
+    bool no_verify_checksums = false;
     CLI::Option *o_dx{}, *o_dy{}, *o_unit{}, *o_z{}, *o_nx{}, *o_ny{};
 };
 
@@ -94,6 +95,10 @@ void add_read_options(CLI::App& cmd, ReadArgs& r) {
                     "Raw sample type: float32 or float64 (default)")
         ->group(g);
     cmd.add_flag("--big-endian", r.big_endian, "Raw samples are big-endian")->group(g);
+    cmd.add_flag("--no-verify-checksums", r.no_verify_checksums,
+                 "x3p: read a file whose MD5 checksums do not match (edited after they were "
+                 "written); default: a mismatch is an error")
+        ->group(g);
 }
 
 surface::HeightReadOptions read_options(const ReadArgs& r) {
@@ -110,6 +115,7 @@ surface::HeightReadOptions read_options(const ReadArgs& r) {
     if (given(r.o_ny)) o.ny = r.ny;
     o.raw_type = r.raw_type;
     o.raw_big_endian = r.big_endian;
+    o.x3p_verify_checksums = !r.no_verify_checksums;
     return o;
 }
 

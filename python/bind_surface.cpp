@@ -133,7 +133,7 @@ void bind_surface(py::module_& m) {
         "read_height_map",
         [](const std::string& path, std::optional<std::string> format, py::handle dx_um,
            py::handle dy_um, std::optional<std::string> unit, py::handle z_scale_um, py::handle nx,
-           py::handle ny, const std::string& raw_type, bool big_endian) {
+           py::handle ny, const std::string& raw_type, bool big_endian, bool verify_checksums) {
             surface::HeightReadOptions o;
             if (format) o.format = surface::parse_height_format(normalize_name(*format));
             o.dx_um = optional_real("dx_um", dx_um);
@@ -153,6 +153,7 @@ void bind_surface(py::module_& m) {
             }
             o.raw_type = raw_type_of(raw_type);
             o.raw_big_endian = big_endian;
+            o.x3p_verify_checksums = verify_checksums;
             const surface::HeightMap map = surface::read_height_map(path, o);
             const auto f = o.format ? o.format : surface::height_format_from_extension(path);
             py::dict out = to_python(serialize::summary_json(map)).cast<py::dict>();
@@ -166,11 +167,12 @@ void bind_surface(py::module_& m) {
         arg("path"), py::kw_only(), arg("format") = py::none(), arg("dx_um") = py::none(),
         arg("dy_um") = py::none(), arg("unit") = py::none(), arg("z_scale_um") = py::none(),
         arg("nx") = py::none(), arg("ny") = py::none(), arg("raw_type") = "float64",
-        arg("big_endian") = false,
+        arg("big_endian") = false, arg("verify_checksums") = true,
         "Read a height file (csv, xyz, sdf, x3p, gwy, gsf, png, tiff, raw; format from the "
         "extension unless given). Returns a dict: heights_um (a (ny, nx) float64 array, NaN = "
         "missing), nx, ny, dx_um, dy_um, the summary keys (points, missing, min_um, ...), "
-        "format, x_offset_um, y_offset_um. DataError for a malformed file.");
+        "format, x_offset_um, y_offset_um. DataError for a malformed file, or for an x3p whose "
+        "stated MD5 checksums do not match unless verify_checksums=False.");
 
     m.def(
         "write_height_map",

@@ -262,8 +262,20 @@ class ZipArchive {
         return st.size;
     }
 
-    ZipFilePtr open(const std::string& entry) const {
-        zip_file_t* file = zip_fopen(archive_.get(), entry.c_str(), 0);
+    // With check_crc false, an entry stored without compression or encryption is read as its
+    // raw bytes, without the zip's CRC-32 check (the same bytes; a read that verifies no
+    // checksum). Any other entry is read (and checked) as usual.
+    ZipFilePtr open(const std::string& entry, bool check_crc = true) const {
+        zip_flags_t flags = 0;
+        if (!check_crc) {
+            zip_stat_t st;
+            zip_stat_init(&st);
+            if (zip_stat(archive_.get(), entry.c_str(), 0, &st) == 0 &&
+                (st.valid & ZIP_STAT_COMP_METHOD) && st.comp_method == ZIP_CM_STORE &&
+                (st.valid & ZIP_STAT_ENCRYPTION_METHOD) && st.encryption_method == ZIP_EM_NONE)
+                flags = ZIP_FL_COMPRESSED;
+        }
+        zip_file_t* file = zip_fopen(archive_.get(), entry.c_str(), flags);
         if (!file) {
             std::string what = "cannot open the zip entry ";
             what.append(quote_input(entry))
@@ -466,7 +478,10 @@ void check_md5(const std::string& name, const std::string& file, std::string_vie
             .append(" but ")
             .append(which)
             .append(" says ")
-            .append(want);
+            .append(want)
+            .append(
+                " (changed after the checksum was written, or corrupt; a read that does not "
+                "verify checksums takes it as it is)");
         fail(name, what);
     }
 }
@@ -476,7 +491,7 @@ void check_md5(const std::string& name, const std::string& file, std::string_vie
 void read_binary_heights(const ZipArchive& zip, const std::string& name, const std::string& entry,
                          SampleType type, const Scale& scale, std::size_t points,
                          std::optional<std::string_view> expected_md5, bool verify,
-                         std::vector<double>& heights) {
+                         std::vector<double>& heights, HeightsScan& scan) {
     if (!zip.has(entry))
         fail(name, concat("main.xml links ", quote_input(entry), ", absent from the zip"));
     const std::size_t bytes_per_point = sample_bytes(type);
@@ -493,27 +508,41 @@ void read_binary_heights(const ZipArchive& zip, const std::string& name, const s
         fail(name, what);
     }
     assign_large(heights, points, 0.0);
-    ZipFilePtr file = zip.open(entry);
+    ZipFilePtr file = zip.open(entry, verify);
     Md5 md5;
     constexpr std::size_t kChunkPoints = 1 << 16;
-    std::vector<char> buffer(kChunkPoints * bytes_per_point);
+    // Doubles already in µm are read straight into the heights (checksummed there, before
+    // non-finite values become NaN); other samples through a chunk buffer.
+    const bool direct =
+        type == SampleType::Float64 && scale.factor_um == 1.0 && scale.offset_um == 0.0;
+    std::vector<char> buffer(direct ? 0 : kChunkPoints * bytes_per_point);
     for (std::size_t done = 0; done < points;) {
         const std::size_t n = std::min(kChunkPoints, points - done);
-        zip.read_exact(file.get(), entry, buffer.data(), n * bytes_per_point);
-        if (verify) md5.update(buffer.data(), n * bytes_per_point);
         double* out = heights.data() + done;
-        if (type == SampleType::Float64 && scale.factor_um == 1.0 && scale.offset_um == 0.0) {
-            std::memcpy(out, buffer.data(), n * sizeof(double));
+        if (direct) {
+            zip.read_exact(file.get(), entry, reinterpret_cast<char*>(out), n * sizeof(double));
+            if (verify) md5.update(reinterpret_cast<const char*>(out), n * sizeof(double));
+            // ±inf and NaN (exponent bits all ones) become the quiet NaN; branch-free.
+            constexpr std::uint64_t kExponent = 0x7ff0000000000000ULL;
+            constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
             for (std::size_t i = 0; i < n; ++i) {
-                if (!std::isfinite(out[i])) out[i] = std::numeric_limits<double>::quiet_NaN();
+                const bool finite = (std::bit_cast<std::uint64_t>(out[i]) & kExponent) != kExponent;
+                out[i] = finite ? out[i] : kNaN;
             }
         } else {
+            zip.read_exact(file.get(), entry, buffer.data(), n * bytes_per_point);
+            if (verify) md5.update(buffer.data(), n * bytes_per_point);
             for (std::size_t i = 0; i < n; ++i) {
                 const double v = sample_value(type, buffer.data() + i * bytes_per_point);
                 out[i] =
                     std::isfinite(v) ? scale.apply(v) : std::numeric_limits<double>::quiet_NaN();
             }
         }
+        // validate's height rule on the chunk while it is in cache.
+        const HeightsScan chunk = scan_heights(out, n);
+        if (chunk.first_out_of_range < n && scan.first_out_of_range == points)
+            scan.first_out_of_range = done + chunk.first_out_of_range;
+        scan.any_valid = scan.any_valid || chunk.any_valid;
         done += n;
     }
     if (verify && expected_md5)
@@ -706,6 +735,7 @@ HeightMap decode_x3p(std::string_view bytes, const std::string& name,
         map.y_offset_um = cy.offset_um;
     }
 
+    std::optional<HeightsScan> scanned;  // the heights as read, when nothing changed them after
     if (const auto* link = child(record3, "DataLink")) {
         if (!cx.incremental || !cy.incremental) {
             fail(name, "binary data with absolute CX/CY axes are not supported");
@@ -719,8 +749,10 @@ HeightMap decode_x3p(std::string_view bytes, const std::string& name,
         // Z in the file's units: physical = offset + increment × value (metres), so µm =
         // offset_um + increment_um × value; a float axis without <Increment> is in metres.
         const Scale scale{cz.increment_um, cz.offset_um};
+        HeightsScan scan{nx * ny, false};
         read_binary_heights(zip, name, folder + std::string(data_link), cz.type, scale, nx * ny,
-                            data_md5, verify, map.heights_um);
+                            data_md5, verify, map.heights_um, scan);
+        scanned = scan;
         if (const auto* valid = child(link, "ValidPointsLink");
             valid && !trim(text_of(valid)).empty()) {
             std::optional<std::string_view> valid_md5;
@@ -730,6 +762,7 @@ HeightMap decode_x3p(std::string_view bytes, const std::string& name,
             }
             apply_validity(zip, name, folder + std::string(trim(text_of(valid))), valid_md5, verify,
                            map.heights_um);
+            scanned.reset();  // points marked invalid are missing, whatever their value
         }
     } else if (const auto* list = child(record3, "DataList")) {
         read_data_list(list, name, cx, cy, cz, nx, ny, map);
@@ -753,7 +786,10 @@ HeightMap decode_x3p(std::string_view bytes, const std::string& name,
     if (const auto* r2 = child(root, "Record2"))
         map.title = std::string(trim(text_of(child(r2, "Comment"))));
     try {
-        validate(map, name);
+        if (scanned)
+            validate(map, name, *scanned);
+        else
+            validate(map, name);
     } catch (const InvalidArgument& e) {
         throw DataError(e.what());
     }

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <cstdint>
 #include <string>
 
 #include "roughscope/core/errors.hpp"
@@ -70,7 +71,7 @@ HeightMap make_height_map(std::size_t nx, std::size_t ny, double dx_um, double d
     return map;
 }
 
-void validate(const HeightMap& map, const std::string& what) {
+void validate(const HeightMap& map, const std::string& what, const HeightsScan& heights) {
     check_dimensions(what, map.nx, map.ny);
     check_spacing(what, "dx_um", map.dx_um);
     check_spacing(what, "dy_um", map.dy_um);
@@ -92,20 +93,52 @@ void validate(const HeightMap& map, const std::string& what) {
             .append(" points");
         throw InvalidArgument(message);
     }
-    bool any_valid = false;
-    for (const double z : map.heights_um) {
-        if (std::abs(z) > kMaxLengthUm) {  // also ±inf (NaN compares false: missing)
-            std::string message = what;
-            message.append(": heights must be NaN (missing) or within +-")
-                .append(format_message(kMaxLengthUm))
-                .append(" um (got ")
-                .append(format_message(z))
-                .append(")");
-            throw InvalidArgument(message);
-        }
-        any_valid = any_valid || !std::isnan(z);
+    if (heights.first_out_of_range < map.heights_um.size()) {
+        std::string message = what;
+        message.append(": heights must be NaN (missing) or within +-")
+            .append(format_message(kMaxLengthUm))
+            .append(" um (got ")
+            .append(format_message(map.heights_um[heights.first_out_of_range]))
+            .append(")");
+        throw InvalidArgument(message);
     }
-    if (!any_valid) throw InvalidArgument(what + ": every point is missing (no valid height)");
+    if (!heights.any_valid)
+        throw InvalidArgument(what + ": every point is missing (no valid height)");
+}
+
+void validate(const HeightMap& map, const std::string& what) {
+    validate(map, what, scan_heights(map.heights_um.data(), map.heights_um.size()));
+}
+
+HeightsScan scan_heights(const double* z, std::size_t n) {
+    // Blocks of 1024 tested branch-free on the bit patterns of |z| (ordered as the values: NaN
+    // above +inf's; out of range above kMaxLengthUm's, ±inf included, NaN not); only a block with
+    // a height out of range is searched for it.
+    constexpr std::size_t kBlock = 1024;
+    constexpr std::uint64_t kAbs = 0x7fffffffffffffffULL;
+    constexpr std::uint64_t kInfBits = 0x7ff0000000000000ULL;
+    const std::uint64_t max_bits = std::bit_cast<std::uint64_t>(kMaxLengthUm);
+    HeightsScan scan{n, false};
+    for (std::size_t start = 0; start < n; start += kBlock) {
+        const std::size_t end = std::min(n, start + kBlock);
+        std::uint64_t out_of_range = 0;
+        std::uint64_t valid = 0;
+        for (std::size_t i = start; i < end; ++i) {
+            const std::uint64_t a = std::bit_cast<std::uint64_t>(z[i]) & kAbs;
+            const auto not_nan = static_cast<std::uint64_t>(a <= kInfBits);
+            out_of_range |= static_cast<std::uint64_t>(a > max_bits) & not_nan;
+            valid |= not_nan;
+        }
+        scan.any_valid = scan.any_valid || valid != 0;
+        if (out_of_range != 0) {
+            for (std::size_t i = start; i < end; ++i)
+                if (std::abs(z[i]) > kMaxLengthUm) {
+                    scan.first_out_of_range = i;
+                    return scan;
+                }
+        }
+    }
+    return scan;
 }
 
 bool bitwise_equal(const HeightMap& a, const HeightMap& b) {

@@ -197,6 +197,36 @@ def test_convert_failures(gaussian_x3p, tmp_path):
                  EXIT_DATA, "o.gsf")
 
 
+def stale_checksum_copy(source, path):
+    """`source` (an x3p) with one byte of bindata/data.bin changed and main.xml untouched: its
+    MD5ChecksumPointData no longer matches, as in a file edited after it was written."""
+    import zipfile
+    with zipfile.ZipFile(source) as zin, zipfile.ZipFile(path, "w") as zout:
+        for item in zin.infolist():
+            data = zin.read(item.filename)
+            if item.filename.endswith("data.bin"):
+                data = data[:100] + bytes([data[100] ^ 0x01]) + data[101:]
+            zout.writestr(item, data)
+    return path
+
+
+def test_a_stale_x3p_checksum_is_an_error_unless_not_verified(gaussian_x3p, tmp_path):
+    stale = stale_checksum_copy(gaussian_x3p, tmp_path / "stale.x3p")
+    for command in (["stats"], ["convert"], ["predict"]):
+        extra = {"stats": [], "convert": [tmp_path / "o.gsf"],
+                 "predict": ["--theta-i", 20, "--theta-s", 0, "--phi-s", 180]}[command[0]]
+        assert_error(run("surface", *command, stale, *extra, check=False), EXIT_DATA,
+                     "stale.x3p", "checksum mismatch", "MD5ChecksumPointData")
+        run("surface", *command, stale, *extra, "--no-verify-checksums")
+    assert (tmp_path / "o.gsf").exists()
+    with pytest.raises(rs.DataError, match="checksum mismatch"):
+        rs.read_height_map(str(stale))
+    lax = rs.read_height_map(str(stale), verify_checksums=False)
+    good = rs.read_height_map(str(gaussian_x3p))
+    # One byte of one height differs; every other height is the file's.
+    assert np.count_nonzero(lax["heights_um"] != good["heights_um"]) == 1
+
+
 # ---- predict -------------------------------------------------------------------------------
 
 def test_predict_given_matches_the_model():

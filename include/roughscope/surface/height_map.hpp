@@ -54,6 +54,18 @@ HeightMap make_height_map(std::size_t nx, std::size_t ny, double dx_um, double d
 // it on what they built, so a HeightMap that leaves the library is always well formed.
 void validate(const HeightMap& map, const std::string& what);
 
+// The height rule of validate over z[0, n): the first index whose height is beyond ±1e30 µm (±inf
+// included; NaN is a missing point), or n when none is; and whether any height is not NaN.
+struct HeightsScan {
+    std::size_t first_out_of_range = 0;
+    bool any_valid = false;
+};
+HeightsScan scan_heights(const double* z, std::size_t n);
+
+// validate with the heights already scanned by the caller (a reader that scans them chunk by
+// chunk while they are in cache, merging the chunks' results): the same rules and messages.
+void validate(const HeightMap& map, const std::string& what, const HeightsScan& heights);
+
 // Largest map accepted anywhere (2^28 points = 2 GiB of doubles): protects against a corrupt
 // header asking for terabytes.
 inline constexpr std::size_t kMaxHeightMapPoints = std::size_t{1} << 28;

@@ -137,6 +137,47 @@ TEST(X3pFormat, IndependentlyWrittenFileReadsAsIntended) {
     EXPECT_EQ(map.count_valid(), 5U);
 }
 
+// Doubles in µm (CZ Increment 1e-6 m) are checked against the height rule of validate chunk by
+// chunk as they are read: a height beyond ±1e30 µm past the first chunk of 65536 points is named,
+// ±inf is a missing point, a file of missing points only is refused; checksums verified or not.
+TEST(X3pFormat, DoubleHeightsAreCheckedAsTheyAreRead) {
+    constexpr std::size_t kSide = 300;  // 90000 points: two chunks
+    std::string xml = spec_main_xml("", std::to_string(kSide));
+    const std::string float_z = "<CZ><AxisType>A</AxisType><DataType>F</DataType></CZ>";
+    const std::string double_z =
+        "<CZ><AxisType>A</AxisType><DataType>D</DataType><Increment>1.0E-6</Increment>"
+        "<Offset>0</Offset></CZ>";
+    xml.replace(xml.find(float_z), float_z.size(), double_z);
+    xml.replace(xml.find("<SizeY>2</SizeY>"), 16, "<SizeY>" + std::to_string(kSide) + "</SizeY>");
+    const auto file_of = [&](const std::vector<double>& z) {
+        const std::string data(reinterpret_cast<const char*>(z.data()), z.size() * sizeof(double));
+        std::string with_md5 = xml;
+        with_md5.replace(with_md5.find("<MD5ChecksumPointData></MD5ChecksumPointData>"),
+                         std::string("<MD5ChecksumPointData></MD5ChecksumPointData>").size(),
+                         "<MD5ChecksumPointData>" + md5(data) + "</MD5ChecksumPointData>");
+        return spec_x3p(with_md5, data);
+    };
+    std::vector<double> z(kSide * kSide, 0.25);
+    z[10] = -std::numeric_limits<double>::infinity();
+    HeightReadOptions unverified;
+    unverified.x3p_verify_checksums = false;
+    for (const HeightReadOptions& options : {HeightReadOptions{}, unverified}) {
+        const HeightMap map = formats::decode_x3p(file_of(z), "good.x3p", options);
+        EXPECT_EQ(map.count_valid(), z.size() - 1);
+        EXPECT_TRUE(std::isnan(map.heights_um[10]));
+        EXPECT_EQ(map.heights_um[70000], 0.25);
+        std::vector<double> far = z;
+        far[70000] = 5e30;
+        far[80000] = -7e30;
+        const std::string error = decode_error(file_of(far), options);
+        EXPECT_NE(error.find("bad.x3p"), std::string::npos) << error;
+        EXPECT_NE(error.find("got 5e+30"), std::string::npos) << error;
+        const std::vector<double> missing(z.size(), kNaN);
+        EXPECT_NE(decode_error(file_of(missing), options).find("every point is missing"),
+                  std::string::npos);
+    }
+}
+
 TEST(X3pFormat, NestedFolderAndOsMetadataEntriesAreIgnored) {
     const std::string data = spec_data();
     const std::string xml = spec_main_xml(md5(data));
