@@ -4,11 +4,13 @@
 //   build*/bin/roughscope_bench --benchmark_filter='maps'
 //
 // Names: maps/decode/<rows>          baseline: read_image of the two 16-bit TIFFs
+//        maps/registration/<rows>    estimate_misregistration of the decoded pair (part of a map)
 //        maps/map_tiles8/<rows>      read_image of both + roughness_map, window 8
 //        maps/map_pixels/<rows>      read_image of both + roughness_map, per pixel
 // <rows> = 4096 is the 24-MP pair (5859 x 4096 = 24.0 MP, the size of the other image benchmarks;
 // 6000 x 4000 has the same pixel count); 256 a small one (the smoke run skips /4096).
-// Counters: time_vs_decode = (decode + map) / decode of the two files by read_image;
+// Counters: time_vs_decode = (decode + map) / decode of the two files by read_image (one after
+// the other; decode + map reads them at once, as `measure` does);
 // time_vs_opencv_decode = the same over OpenCV's imread of the two files (IMREAD_UNCHANGED: the
 // decoding baseline of bench_measure.cpp, a decoder this project does not tune — read_image
 // itself is 3-7x faster than it since its buffers ask for huge pages); peak_vs_image = the peak
@@ -20,6 +22,7 @@
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include <benchmark/benchmark.h>
@@ -29,6 +32,7 @@
 #include "bench_timing.hpp"
 #include "roughscope/image/maps.hpp"
 #include "roughscope/image/read.hpp"
+#include "roughscope/image/registration.hpp"
 #include "roughscope/io/output_file.hpp"
 #include "roughscope/simulation/capture.hpp"
 
@@ -90,9 +94,12 @@ void opencv_decode_pair(const PairFiles& p) {
     }
 }
 
+// As `measure` makes a map: the two photographs read at once (one thread each), then the map.
 img::RoughnessMap decode_and_map(const PairFiles& p, std::size_t window) {
+    img::LinearImage b;
+    std::thread second([&] { b = img::read_image(p.files[1].string(), read_options()); });
     const img::LinearImage a = img::read_image(p.files[0].string(), read_options());
-    const img::LinearImage b = img::read_image(p.files[1].string(), read_options());
+    second.join();
     std::vector<img::MapCapture> c(2);
     c[0].image = &a;
     c[0].geometry = roughscope::normal_view_geometry(roughscope::deg_to_rad(30.0));
@@ -148,6 +155,23 @@ void BM_maps_map(benchmark::State& state, std::size_t window) {
     state.counters["peak_MB"] = static_cast<double>(map) / 1024.0;
 }
 
+// The registration check alone (phase correlation of the central 1024² crop), on the decoded pair.
+void BM_maps_registration(benchmark::State& state) {
+    PairFiles p;
+    make_pair(p, static_cast<std::size_t>(state.range(0)));
+    const img::LinearImage a = img::read_image(p.files[0].string(), read_options());
+    const img::LinearImage b = img::read_image(p.files[1].string(), read_options());
+    for (auto _ : state) benchmark::DoNotOptimize(img::estimate_misregistration(a, b).shift_x_px);
+    const double t_decode = seconds_of([&] { decode_pair(p); }, 3);
+    const double t_registration = seconds_of([&] { (void)img::estimate_misregistration(a, b); }, 3);
+    state.counters["time_vs_decode"] = t_registration / t_decode;
+}
+
+BENCHMARK(BM_maps_registration)
+    ->Name("maps/registration")
+    ->Arg(256)
+    ->Arg(4096)
+    ->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_maps_decode)->Name("maps/decode")->Arg(256)->Arg(4096)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_maps_map, tiles8, 8)
     ->Name("maps/map_tiles8")

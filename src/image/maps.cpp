@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <exception>
 #include <limits>
+#include <optional>
 #include <string>
 #include <thread>
 #include <utility>
@@ -314,7 +315,8 @@ void check_map_input(const std::vector<MapCapture>& captures, const MapOptions& 
         const MapCapture& c = captures[k];
         const std::string name = concat("roughness map: captures[", std::to_string(k), "]");
         if (c.image == nullptr) throw InvalidArgument(concat(name, ": no image"));
-        check_linear_image(*c.image);
+        // The values are checked where they are read (load_row): one pass over the images less.
+        check_linear_image_layout(*c.image);
         check::positive(concat(name, ": exposure_scale"), c.exposure_scale);
         const LinearImage& first = *captures[0].image;
         if (c.image->width != first.width || c.image->height != first.height)
@@ -413,19 +415,33 @@ struct Sums {
     }
 };
 
-// The brightness of one row of a capture: channel average / s_k.
+// The brightness of one row of a capture: channel average / s_k. A non-finite value in the row
+// (any plane: the sum of finite floats in double is finite) is check_linear_image's
+// InvalidArgument, so every value of the images is checked once, as it is read.
 void load_row(const MapCapture& c, std::size_t r, std::vector<double>& out) {
     const LinearImage& im = *c.image;
     const double scale = 1.0 / (static_cast<double>(im.channels) * c.exposure_scale);
     const float* p0 = im.plane(0) + r * im.width;
+    double total = 0.0;
     if (im.channels == 1) {
-        for (std::size_t x = 0; x < im.width; ++x) out[x] = static_cast<double>(p0[x]) * scale;
-        return;
+        for (std::size_t x = 0; x < im.width; ++x) {
+            out[x] = static_cast<double>(p0[x]) * scale;
+            total += out[x];
+        }
+    } else {
+        const float* p1 = im.plane(1) + r * im.width;
+        const float* p2 = im.plane(2) + r * im.width;
+        for (std::size_t x = 0; x < im.width; ++x) {
+            out[x] = (static_cast<double>(p0[x]) + p1[x] + p2[x]) * scale;
+            total += out[x];
+        }
     }
-    const float* p1 = im.plane(1) + r * im.width;
-    const float* p2 = im.plane(2) + r * im.width;
-    for (std::size_t x = 0; x < im.width; ++x)
-        out[x] = (static_cast<double>(p0[x]) + p1[x] + p2[x]) * scale;
+    if (std::isfinite(total)) return;
+    for (std::size_t ch = 0; ch < im.channels; ++ch)
+        for (std::size_t x = 0; x < im.width; ++x) {
+            const std::size_t k = ch * im.pixel_count() + r * im.width + x;
+            if (!std::isfinite(im.values[k])) throw_non_finite_value(im, k);
+        }
 }
 
 // What a band of rows counted.
@@ -892,30 +908,21 @@ RoughnessMap roughness_map(const std::vector<MapCapture>& captures, const MapOpt
                                       " captures given; the map uses the first two (",
                                       capture_name(captures[0], 0), ", ",
                                       capture_name(captures[1], 1), ") and ignores the others"));
-    if (o.check_registration && a.width >= 16 && a.height >= 16) {
-        const Registration reg = estimate_misregistration(a, b, o.registration);
-        map.registration = reg;
-        if (reg.magnitude_px > o.max_shift_px) {
-            const std::string shift = concat(
-                capture_name(captures[1], 1), " is shifted by (",
-                check::format_number(reg.shift_x_px), ", ", check::format_number(reg.shift_y_px),
-                ") px = ", check::format_number(reg.magnitude_px), " px against ",
-                capture_name(captures[0], 0), " (phase correlation, peak-to-sidelobe ",
-                check::format_number(reg.peak_to_sidelobe), "); the threshold max_shift_px is ",
-                check::format_number(o.max_shift_px), " px");
-            if (reg.peak_to_sidelobe < o.min_peak_to_sidelobe)
-                map.warnings.push_back(concat("roughness map: ", shift,
-                                              ", but the peak-to-sidelobe ratio is below ",
-                                              check::format_number(o.min_peak_to_sidelobe),
-                                              ": the images share too little structure to tell"));
-            else if (!o.allow_misregistration)
-                throw DataError(concat("roughness map: ", shift,
-                                       ": register the images (or allow the misregistration)"));
-            else
-                map.warnings.push_back(concat("roughness map: ", shift,
-                                              " (allowed: ratios near edges are unreliable)"));
-        }
-    }
+    // The registration check runs beside the map (its own thread): its verdict, an error or a
+    // warning in its place among the others, is applied when both are done.
+    const bool register_pair = o.check_registration && a.width >= 16 && a.height >= 16;
+    std::optional<Registration> registration;
+    std::exception_ptr registration_error;
+    std::jthread registration_worker;
+    if (register_pair)
+        registration_worker = std::jthread([&] {
+            try {
+                registration = estimate_misregistration(a, b, o.registration);
+            } catch (...) {
+                registration_error = std::current_exception();
+            }
+        });
+    const std::size_t registration_warning_at = map.warnings.size();
     const std::size_t cells = map.width * map.height;
     for (auto* layer :
          {&map.E1_over_E2, &map.sigma_over_T_gaussian, &map.sigma_over_T_gaussian_stderr,
@@ -954,6 +961,36 @@ RoughnessMap roughness_map(const std::vector<MapCapture>& captures, const MapOpt
         std::vector<std::jthread> workers;
         for (std::size_t t = 1; t < threads; ++t) workers.emplace_back(run, t);
         run(0);
+    }
+    if (registration_worker.joinable()) registration_worker.join();
+    if (registration_error) std::rethrow_exception(registration_error);
+    if (registration) {
+        const Registration& reg = *registration;
+        map.registration = reg;
+        if (reg.magnitude_px > o.max_shift_px) {
+            const std::string shift = concat(
+                capture_name(captures[1], 1), " is shifted by (",
+                check::format_number(reg.shift_x_px), ", ", check::format_number(reg.shift_y_px),
+                ") px = ", check::format_number(reg.magnitude_px), " px against ",
+                capture_name(captures[0], 0), " (phase correlation, peak-to-sidelobe ",
+                check::format_number(reg.peak_to_sidelobe), "); the threshold max_shift_px is ",
+                check::format_number(o.max_shift_px), " px");
+            const auto warn = [&](std::string text) {
+                map.warnings.insert(
+                    map.warnings.begin() + static_cast<std::ptrdiff_t>(registration_warning_at),
+                    std::move(text));
+            };
+            if (reg.peak_to_sidelobe < o.min_peak_to_sidelobe)
+                warn(concat("roughness map: ", shift, ", but the peak-to-sidelobe ratio is below ",
+                            check::format_number(o.min_peak_to_sidelobe),
+                            ": the images share too little structure to tell"));
+            else if (!o.allow_misregistration)
+                throw DataError(concat("roughness map: ", shift,
+                                       ": register the images (or allow the misregistration)"));
+            else
+                warn(concat("roughness map: ", shift,
+                            " (allowed: ratios near edges are unreliable)"));
+        }
     }
     for (const auto& e : errors)
         if (e) std::rethrow_exception(e);

@@ -3,13 +3,16 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <numeric>
+#include <string>
 #include <vector>
 
 #include <gtest/gtest.h>
 
 #include "map_captures.hpp"
 #include "roughscope/core/errors.hpp"
+#include "roughscope/core/text.hpp"
 #include "roughscope/estimation/estimation.hpp"
 #include "roughscope/image/maps.hpp"
 
@@ -436,6 +439,40 @@ TEST(RoughnessMap, BadInputIsRefused) {
         MapOptions s = o;
         s.sigma_um = -1.0;
         EXPECT_THROW(roughness_map(c, s), InvalidArgument);
+    }
+}
+
+// The images' values are checked where the map reads them: a non-finite value anywhere in a
+// capture (outside the registration's central crop, in a flagged pixel too, per pixel and per
+// tile, with one thread or several) is an InvalidArgument naming the image and the sample.
+TEST(RoughnessMap, NonFiniteValuesAreRefusedWhereverTheyAre) {
+    const LitPair p =
+        render_lit_pair(plane(300, 260), {very_rough_truth(0.7)}, {}, {}, kTheta1, kTheta2, 82);
+    for (const std::size_t at : {std::size_t{0}, std::size_t{259 * 300 + 299}}) {
+        for (const std::size_t window : {std::size_t{1}, std::size_t{4}}) {
+            for (const std::size_t threads : {std::size_t{1}, std::size_t{2}}) {
+                LinearImage broken = p.b;
+                broken.values[at] = std::numeric_limits<float>::infinity();
+                broken.flags[at] = kPixelSaturated;
+                broken.info.source = "broken.tiff";
+                auto c = flat_captures(p);
+                c[1].image = &broken;
+                MapOptions o;
+                o.window_px = window;
+                o.threads = threads;
+                o.registration.max_side_px = 64;  // both samples outside its central crop
+                try {
+                    (void)roughness_map(c, o);
+                    ADD_FAILURE() << "accepted an infinite value at " << at;
+                } catch (const InvalidArgument& e) {
+                    const std::string what = e.what();
+                    EXPECT_NE(what.find("broken.tiff"), std::string::npos) << what;
+                    EXPECT_NE(what.find(concat("at sample ", std::to_string(at))),
+                              std::string::npos)
+                        << what;
+                }
+            }
+        }
     }
 }
 
