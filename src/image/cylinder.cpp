@@ -1,6 +1,8 @@
 #include "roughscope/image/cylinder.hpp"
 
 #include <algorithm>
+#include <array>
+#include <cassert>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -21,6 +23,10 @@ using check::format_number;
 
 constexpr double kSubBinsPerPx = 8.0;     // resolution of the distribution across the axis
 constexpr std::size_t kNodesPerBin = 32;  // geometry nodes of a bin's model average
+// Bands of rows of the pass over the pixels: at most kMaxBands, of at least kRowsPerBand rows
+// (fixed, so the sums do not depend on the number of threads).
+constexpr std::size_t kRowsPerBand = 256;
+constexpr std::size_t kMaxBands = 8;
 // Floor of a bin's standard error, in units of the profile's maximum: a quantisation step of a
 // 14-bit camera (noise-free synthetic data have none of their own).
 constexpr double kMinRelativeStandardError = 1e-4;
@@ -171,17 +177,18 @@ CylinderProfile measure_cylinder_profile(const LinearImage& image,
     out.bin_width_rad = deg_to_rad(options.bin_width_deg);
 
     // The axis, and the object mask when it comes from the silhouette.
-    std::vector<std::uint8_t> object;
+    std::vector<detail::RowRun> object_rows;  // empty: every pixel
     double silhouette_level = 0.0;
     if (options.axis) {
         out.axis = cylinder_axis_from_line(options.axis->point_x_px, options.axis->point_y_px,
                                            options.axis->direction_x, options.axis->direction_y,
                                            options.axis->radius_px);
     } else {
-        Silhouette s = detail::find_silhouette_of_checked_image(image, options.silhouette);
-        out.axis = fit_cylinder_axis(s, options.axis_fit);
-        silhouette_level = s.threshold;
-        object = std::move(s.mask);
+        detail::Outline outline =
+            detail::find_outline_of_checked_image(image, options.silhouette, options.threads);
+        out.axis = fit_cylinder_axis(outline.silhouette, options.axis_fit);
+        silhouette_level = outline.silhouette.threshold;
+        object_rows = std::move(outline.rows);
     }
     const CylinderAxis& axis = out.axis;
     const double R = axis.radius_px;
@@ -245,75 +252,296 @@ CylinderProfile measure_cylinder_profile(const LinearImage& image,
         }
     const auto n_slices = static_cast<std::size_t>(std::ceil(t_max - t_min)) + 1;
 
+    // The single pass, over bands of rows (a fixed number, whatever the number of threads: the
+    // sums do not depend on it). Each band sums into its own accumulators over the ranges of
+    // sub-bins, bins and slices its rows can reach; they are added in band order. Noise from
+    // differences with the previous pixel along the axis' closer image direction (previous row
+    // for a steep axis, previous column otherwise), same bin.
+    const bool rows_along_axis = std::abs(ay) >= std::abs(ax);
+    const float* p0 = image.plane(0);
+    const float* p1 = image.channels == 3 ? image.plane(1) : nullptr;
+    const float* p2 = image.channels == 3 ? image.plane(2) : nullptr;
+    const std::uint8_t* reg = region_mask ? region_mask->data() : nullptr;
+    const double sub_offset = R * kSubBinsPerPx;
+    struct Band {
+        std::size_t r0 = 0, r1 = 0;
+        std::size_t sub_lo = 0, n_subs = 0;       // half-sub-bins [sub_lo, sub_lo + n_subs)
+        std::size_t bin_lo = 0, n_band_bins = 0;  // bins of those half-sub-bins
+        std::size_t slice_lo = 0, n_band_slices = 0;
+        std::vector<BinSums> bins;
+        std::vector<std::uint32_t> sub_count;
+        std::vector<double> sub_d;
+        std::vector<double> slice_sum;  // (b − bin_lo) · n_band_slices + (j − slice_lo)
+        std::vector<std::uint32_t> slice_count;
+        std::size_t flagged = 0;
+    };
+    const std::size_t n_bands = std::clamp<std::size_t>(h / kRowsPerBand, 1, kMaxBands);
+    std::vector<Band> bands(n_bands);
+    // Ranges from the band's corners, one sub-bin and one slice of margin for rounding.
+    const auto prepare_band = [&](Band& band, std::size_t r0, std::size_t r1) {
+        band.r0 = r0;
+        band.r1 = r1;
+        double d_lo = std::numeric_limits<double>::infinity(), d_hi = -d_lo;
+        double t_lo = d_lo, t_hi = -d_lo;
+        for (const double x : {0.0, static_cast<double>(w)})
+            for (const double y : {static_cast<double>(r0), static_cast<double>(r1)}) {
+                const double d = (x - axis.point_x_px) * ux + (y - axis.point_y_px) * uy;
+                const double t = (x - axis.point_x_px) * ax + (y - axis.point_y_px) * ay - t_min;
+                d_lo = std::min(d_lo, d);
+                d_hi = std::max(d_hi, d);
+                t_lo = std::min(t_lo, t);
+                t_hi = std::max(t_hi, t);
+            }
+        const auto index_in = [](double x, std::size_t n) {
+            return static_cast<std::size_t>(
+                std::clamp(std::floor(x), 0.0, static_cast<double>(n - 1)));
+        };
+        const std::size_t k_lo = index_in(d_lo * kSubBinsPerPx + sub_offset - 1.0, n_sub);
+        const std::size_t k_hi = index_in(d_hi * kSubBinsPerPx + sub_offset + 1.0, n_sub);
+        band.sub_lo = 2 * k_lo;
+        band.n_subs = 2 * (k_hi - k_lo + 1);
+        std::int32_t b_lo = std::numeric_limits<std::int32_t>::max(), b_hi = -1;
+        for (std::size_t sk = band.sub_lo; sk < band.sub_lo + band.n_subs; ++sk)
+            if (sub_bin[sk] >= 0) {
+                b_lo = std::min(b_lo, sub_bin[sk]);
+                b_hi = std::max(b_hi, sub_bin[sk]);
+            }
+        band.bin_lo = b_hi >= 0 ? static_cast<std::size_t>(b_lo) : 0;
+        band.n_band_bins = b_hi >= 0 ? static_cast<std::size_t>(b_hi - b_lo + 1) : 0;
+        band.slice_lo = index_in(t_lo - 1.0, n_slices);
+        band.n_band_slices = index_in(t_hi + 1.0, n_slices) - band.slice_lo + 1;
+        band.bins.assign(n_bins, BinSums{});
+        band.sub_count.assign(band.n_subs, 0);
+        band.sub_d.assign(band.n_subs, 0.0);
+        band.slice_sum.assign(band.n_band_bins * band.n_band_slices, 0.0);
+        band.slice_count.assign(band.n_band_bins * band.n_band_slices, 0);
+    };
+    // The bin of pixel (r, c) at distance d and its half-sub-bin, or −1: outside the object's
+    // run of the row (silhouette.hpp: the mask is one run a row), the region, the half or the
+    // limb. Flags are not looked at.
+    struct PixelBin {
+        std::int32_t bin = -1;
+        std::size_t sub = 0;
+    };
+    // Sub-bin k's edge and the bins on either side of it, side by side (one cache line a pixel;
+    // the two bins are read while the edge is compared).
+    struct SubBinEntry {
+        double split = 0.0;
+        std::array<std::int32_t, 2> bin{};
+    };
+    std::vector<SubBinEntry> sub_bins(n_sub);
+    for (std::size_t k = 0; k < n_sub; ++k)
+        sub_bins[k] = {split[k], {sub_bin[2 * k], sub_bin[2 * k + 1]}};
+    const auto pixel_bin = [=, table = sub_bins.data()](std::size_t i, double d) -> PixelBin {
+        const double sf = d * kSubBinsPerPx + sub_offset;
+        if (!(sf >= 0.0 && sf < static_cast<double>(n_sub)) || (reg && !reg[i])) return {};
+        const auto k = static_cast<std::size_t>(sf);
+        const SubBinEntry& e = table[k];
+        const std::size_t side = d >= e.split ? 1 : 0;
+        return {e.bin[side], 2 * k + side};
+    };
+    const auto row_run = [&](std::size_t r) -> detail::RowRun {
+        return object_rows.empty() ? detail::RowRun{0, w} : object_rows[r];
+    };
+    const auto scan_band = [&](Band& band) {
+        // Local copies (kept in registers: the stores below cannot alias them).
+        const auto bin_at = pixel_bin;
+        // The previous row's entry of the sub-bin table per column: along a steep axis a column
+        // keeps its sub-bin from row to row, and the table (one entry per 1/8 px, one cache line
+        // a pixel) is read only where it changes.
+        struct ColumnEntry {
+            SubBinEntry entry;
+            std::size_t k = std::numeric_limits<std::size_t>::max();
+        };
+        std::vector<ColumnEntry> column(w);
+        ColumnEntry* const column_entry = column.data();
+        const SubBinEntry* const table = sub_bins.data();
+        const auto cached_bin = [=](std::size_t i, std::size_t c, double d) -> PixelBin {
+            const double sf = d * kSubBinsPerPx + sub_offset;
+            if (!(sf >= 0.0 && sf < static_cast<double>(n_sub)) || (reg && !reg[i])) return {};
+            const auto k = static_cast<std::size_t>(sf);
+            ColumnEntry& ce = column_entry[c];
+            if (ce.k != k) ce = {table[k], k};
+            const std::size_t side = d >= ce.entry.split ? 1 : 0;
+            return {ce.entry.bin[side], 2 * k + side};
+        };
+        const std::uint8_t* const flags = image.flags.data();
+        const float *const v0 = p0, *const v1 = p1, *const v2 = p2;
+        const double step_d = ux, step_t = ax, t_origin = t_min;
+        const bool steep = rows_along_axis;
+        const std::size_t last_slice = n_slices - 1, sub_lo = band.sub_lo, bin_lo = band.bin_lo;
+        const std::size_t band_slices = band.n_band_slices, slice_lo = band.slice_lo;
+        BinSums* const band_bins = band.bins.data();
+        std::uint32_t* const sub_count = band.sub_count.data();
+        double* const sub_d = band.sub_d.data();
+        double* const slice_sum = band.slice_sum.data();
+        std::uint32_t* const slice_count = band.slice_count.data();
+        std::vector<float> prev_value(w, 0.0F);
+        std::vector<std::int32_t> prev_bin(w, -1);
+        float* const prev_v = prev_value.data();
+        std::int32_t* const prev_b = prev_bin.data();
+        std::size_t prev_begin = 0, prev_end = 0;  // columns of the previous row visited
+        // The row before the band: bins and values only (it is summed by the band above).
+        const auto row_d0 = [&](std::size_t r) {
+            const double yc = static_cast<double>(r) + 0.5 - axis.point_y_px;
+            return (0.5 - axis.point_x_px) * ux + yc * uy;
+        };
+        if (band.r0 > 0 && rows_along_axis) {
+            const std::size_t r = band.r0 - 1;
+            const detail::RowRun run = row_run(r);
+            const double d0 = row_d0(r);
+            for (std::size_t c = run.begin; c < run.end; ++c) {
+                const std::size_t i = r * w + c;
+                std::int32_t b = bin_at(i, d0 + static_cast<double>(c) * ux).bin;
+                if (b >= 0 && flags[i] != 0) b = -1;
+                if (b >= 0) {
+                    float v = v0[i];
+                    if (v1) v = (v + v1[i] + v2[i]) * (1.0F / 3.0F);
+                    prev_v[c] = v;
+                }
+                prev_b[c] = b;
+            }
+            prev_begin = run.begin;
+            prev_end = run.end;
+        }
+        for (std::size_t r = band.r0; r < band.r1; ++r) {
+            const detail::RowRun run = row_run(r);
+            // Columns of the previous row's run outside this one: no pixel above.
+            std::fill(prev_b + prev_begin,
+                      prev_b + std::max(prev_begin, std::min(prev_end, run.begin)), -1);
+            std::fill(prev_b + std::min(prev_end, std::max(prev_begin, run.end)), prev_b + prev_end,
+                      -1);
+            prev_begin = run.begin;
+            prev_end = run.end;
+            const double yc = static_cast<double>(r) + 0.5 - axis.point_y_px;
+            const double xc0 = 0.5 - axis.point_x_px;
+            const double d0 = row_d0(r);
+            const double t0 = xc0 * ax + yc * ay - t_origin;
+            float left_value = 0.0F;
+            std::int32_t left_bin = -1;
+            // Runs of one bin, one half-sub-bin and one slice along the row are summed here and
+            // added to the band's accumulators when they end.
+            BinSums bin_run;
+            std::int32_t bin_run_of = -1;
+            std::size_t sub_run_of = 0, sub_run_count = 0;
+            double sub_run_d = 0.0;
+            std::size_t slice_run_of = 0, slice_run_count = 0;
+            double slice_run_sum = 0.0;
+            const auto end_bin_run = [&] {
+                if (bin_run_of < 0) return;
+                BinSums& bs = band_bins[static_cast<std::size_t>(bin_run_of)];
+                bs.sum += bin_run.sum;
+                bs.sum2 += bin_run.sum2;
+                bs.diff2 += bin_run.diff2;
+                bs.count += bin_run.count;
+                bs.diffs += bin_run.diffs;
+                bin_run = BinSums{};
+            };
+            const auto end_sub_run = [&] {
+                if (sub_run_count == 0) return;
+                sub_count[sub_run_of] += static_cast<std::uint32_t>(sub_run_count);
+                sub_d[sub_run_of] += sub_run_d;
+                sub_run_count = 0;
+                sub_run_d = 0.0;
+            };
+            const auto end_slice_run = [&] {
+                if (slice_run_count == 0) return;
+                slice_sum[slice_run_of] += slice_run_sum;
+                slice_count[slice_run_of] += static_cast<std::uint32_t>(slice_run_count);
+                slice_run_count = 0;
+                slice_run_sum = 0.0;
+            };
+            for (std::size_t c = run.begin; c < run.end; ++c) {
+                const std::size_t i = r * w + c;
+                const double d = d0 + static_cast<double>(c) * step_d;
+                const PixelBin pbin = cached_bin(i, c, d);
+                std::int32_t b = pbin.bin;
+                if (b >= 0 && flags[i] != 0) {
+                    ++band.flagged;
+                    ++band_bins[static_cast<std::size_t>(b)].flagged;
+                    b = -1;
+                }
+                if (b >= 0) {
+                    float v = v0[i];
+                    if (v1) v = (v + v1[i] + v2[i]) * (1.0F / 3.0F);
+                    const double vd = v;
+                    if (b != bin_run_of) {
+                        end_bin_run();
+                        bin_run_of = b;
+                    }
+                    bin_run.sum += vd;
+                    bin_run.sum2 += vd * vd;
+                    ++bin_run.count;
+                    assert(pbin.sub >= band.sub_lo && pbin.sub < band.sub_lo + band.n_subs);
+                    if (pbin.sub - sub_lo != sub_run_of) {
+                        end_sub_run();
+                        sub_run_of = pbin.sub - sub_lo;
+                    }
+                    ++sub_run_count;
+                    sub_run_d += d;
+                    const std::size_t sl = std::min(static_cast<std::size_t>(std::max(
+                                                        0.0, t0 + static_cast<double>(c) * step_t)),
+                                                    last_slice);
+                    assert(sl >= band.slice_lo && sl < band.slice_lo + band.n_band_slices);
+                    const std::size_t si =
+                        (static_cast<std::size_t>(b) - bin_lo) * band_slices + (sl - slice_lo);
+                    if (si != slice_run_of) {
+                        end_slice_run();
+                        slice_run_of = si;
+                    }
+                    slice_run_sum += vd;
+                    ++slice_run_count;
+                    const std::int32_t nb = steep ? prev_b[c] : left_bin;
+                    if (nb == b) {
+                        const double diff = vd - (steep ? prev_v[c] : left_value);
+                        bin_run.diff2 += diff * diff;
+                        ++bin_run.diffs;
+                    }
+                    left_value = v;
+                    prev_v[c] = v;
+                }
+                left_bin = b;
+                prev_b[c] = b;
+            }
+            end_bin_run();
+            end_sub_run();
+            end_slice_run();
+        }
+    };
+    detail::run_bands(n_bands, options.threads, [&](std::size_t k) {
+        prepare_band(bands[k], h * k / n_bands, h * (k + 1) / n_bands);
+        scan_band(bands[k]);
+    });
+
+    // The bands' sums, in band order.
     std::vector<BinSums> bins(n_bins);
     std::vector<double> slice_sum(n_bins * n_slices, 0.0);
     std::vector<std::uint32_t> slice_count(n_bins * n_slices, 0);
     std::vector<std::uint32_t> sub_count(2 * n_sub, 0);
     std::vector<double> sub_d(2 * n_sub, 0.0);
-
-    // The single pass. Noise from differences with the previous pixel along the axis' closer
-    // image direction (previous row for a steep axis, previous column otherwise), same bin.
-    const bool rows_along_axis = std::abs(ay) >= std::abs(ax);
-    std::vector<float> prev_value(w, 0.0F);
-    std::vector<std::int32_t> prev_bin(w, -1);
-    const float* p0 = image.plane(0);
-    const float* p1 = image.channels == 3 ? image.plane(1) : nullptr;
-    const float* p2 = image.channels == 3 ? image.plane(2) : nullptr;
-    const std::uint8_t* reg = region_mask ? region_mask->data() : nullptr;
-    const std::uint8_t* obj = object.empty() ? nullptr : object.data();
-    const double sub_offset = R * kSubBinsPerPx;
-    for (std::size_t r = 0; r < h; ++r) {
-        const double yc = static_cast<double>(r) + 0.5 - axis.point_y_px;
-        const double xc0 = 0.5 - axis.point_x_px;
-        const double d0 = xc0 * ux + yc * uy;
-        const double t0 = xc0 * ax + yc * ay - t_min;
-        float left_value = 0.0F;
-        std::int32_t left_bin = -1;
-        const std::size_t row = r * w;
-        for (std::size_t c = 0; c < w; ++c) {
-            const std::size_t i = row + c;
-            std::int32_t b = -1;
-            const double d = d0 + static_cast<double>(c) * ux;
-            const double sf = d * kSubBinsPerPx + sub_offset;
-            if (sf >= 0.0 && sf < static_cast<double>(n_sub) && (!reg || reg[i]) &&
-                (!obj || obj[i])) {
-                const auto k = static_cast<std::size_t>(sf);
-                const std::size_t sk = 2 * k + (d >= split[k] ? 1 : 0);
-                b = sub_bin[sk];
-                if (b >= 0 && image.flags[i] != 0) {
-                    ++out.pixels_flagged;
-                    ++bins[static_cast<std::size_t>(b)].flagged;
-                    b = -1;
-                }
-                if (b >= 0) {
-                    float v = p0[i];
-                    if (p1) v = (v + p1[i] + p2[i]) * (1.0F / 3.0F);
-                    const double vd = v;
-                    BinSums& bs = bins[static_cast<std::size_t>(b)];
-                    bs.sum += vd;
-                    bs.sum2 += vd * vd;
-                    ++bs.count;
-                    ++sub_count[sk];
-                    sub_d[sk] += d;
-                    const auto sl =
-                        static_cast<std::size_t>(std::max(0.0, t0 + static_cast<double>(c) * ax));
-                    const std::size_t si =
-                        static_cast<std::size_t>(b) * n_slices + std::min(sl, n_slices - 1);
-                    slice_sum[si] += vd;
-                    ++slice_count[si];
-                    const std::int32_t nb = rows_along_axis ? prev_bin[c] : left_bin;
-                    if (nb == b) {
-                        const double diff = vd - (rows_along_axis ? prev_value[c] : left_value);
-                        bs.diff2 += diff * diff;
-                        ++bs.diffs;
-                    }
-                    left_value = v;
-                    prev_value[c] = v;
-                }
-            }
-            left_bin = b;
-            prev_bin[c] = b;
+    for (const Band& band : bands) {
+        out.pixels_flagged += band.flagged;
+        for (std::size_t b = 0; b < n_bins; ++b) {
+            BinSums& to = bins[b];
+            const BinSums& from = band.bins[b];
+            to.sum += from.sum;
+            to.sum2 += from.sum2;
+            to.diff2 += from.diff2;
+            to.count += from.count;
+            to.diffs += from.diffs;
+            to.flagged += from.flagged;
         }
+        for (std::size_t k = 0; k < band.n_subs; ++k) {
+            sub_count[band.sub_lo + k] += band.sub_count[k];
+            sub_d[band.sub_lo + k] += band.sub_d[k];
+        }
+        for (std::size_t b = 0; b < band.n_band_bins; ++b)
+            for (std::size_t j = 0; j < band.n_band_slices; ++j) {
+                const std::size_t from = b * band.n_band_slices + j;
+                const std::size_t to = (band.bin_lo + b) * n_slices + band.slice_lo + j;
+                slice_sum[to] += band.slice_sum[from];
+                slice_count[to] += band.slice_count[from];
+            }
     }
 
     // Bins: mean, standard errors, geometry nodes.

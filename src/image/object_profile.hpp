@@ -1,9 +1,12 @@
 // Internal pieces shared by the curved-object measurements (cylinder.cpp, sphere.cpp).
 #pragma once
 
+#include <algorithm>
 #include <cstddef>
+#include <exception>
 #include <optional>
 #include <string_view>
+#include <thread>
 #include <vector>
 
 #include <Eigen/Core>
@@ -13,10 +16,52 @@
 
 namespace roughscope::image::detail {
 
+// One row of an object: the columns [begin, end) (begin = end: none). The silhouette's mask is
+// filled along rows (find_silhouette), so one run a row is the whole mask.
+struct RowRun {
+    std::size_t begin = 0, end = 0;
+};
+
+// A silhouette (with an empty mask) and its mask as one run per row (height entries).
+struct Outline {
+    Silhouette silhouette;
+    std::vector<RowRun> rows;
+};
+
 // find_silhouette without check_linear_image (the caller has checked the image: one pass over
-// the pixels less).
-Silhouette find_silhouette_of_checked_image(const LinearImage& image,
-                                            const SilhouetteOptions& options);
+// the pixels less) and without the image-sized mask: the object's rows instead. `threads`: of
+// the passes over the image (0 = all cores; the result does not depend on it).
+Outline find_outline_of_checked_image(const LinearImage& image, const SilhouetteOptions& options,
+                                      std::size_t threads);
+
+// The worker threads of an options' `threads` (0 = all cores), at most `bands`.
+inline std::size_t worker_threads(std::size_t threads, std::size_t bands) {
+    if (threads == 0) threads = std::max(1U, std::thread::hardware_concurrency());
+    return std::clamp<std::size_t>(threads, 1, std::max<std::size_t>(1, bands));
+}
+
+// Runs work(band) for every band in [0, bands), band b on thread b mod threads; rethrows the
+// first exception. The caller makes the result independent of the number of threads (each band
+// writes only its own accumulators).
+template <class F>
+void run_bands(std::size_t bands, std::size_t threads, F&& work) {
+    threads = worker_threads(threads, bands);
+    std::vector<std::exception_ptr> errors(threads);
+    const auto run = [&](std::size_t t) {
+        try {
+            for (std::size_t b = t; b < bands; b += threads) work(b);
+        } catch (...) {
+            errors[t] = std::current_exception();
+        }
+    };
+    {
+        std::vector<std::jthread> workers;
+        for (std::size_t t = 1; t < threads; ++t) workers.emplace_back(run, t);
+        run(0);
+    }
+    for (const std::exception_ptr& e : errors)
+        if (e) std::rethrow_exception(e);
+}
 
 // InvalidArgument unless v is finite with |‖v‖ − 1| ≤ 1e−6.
 void check_unit_direction(std::string_view name, const Eigen::Vector3d& v);

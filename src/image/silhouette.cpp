@@ -28,18 +28,33 @@ std::string image_name(const LinearImage& image) {
     return image.info.source.empty() ? std::string("image") : image.info.source;
 }
 
-// The per-pixel channel average (R + G + B)/3, row-major: the plane itself for a grey image
-// (no copy), else computed into `storage`.
-std::span<const float> channel_average(const LinearImage& image, std::vector<float>& storage) {
-    const std::size_t n = image.pixel_count();
-    if (image.channels == 1) return {image.plane(0), n};
-    assign_large(storage, n, 0.0F);
-    const float* r = image.plane(0);
-    const float* g = image.plane(1);
-    const float* b = image.plane(2);
-    for (std::size_t i = 0; i < n; ++i) storage[i] = (r[i] + g[i] + b[i]) * (1.0F / 3.0F);
-    return storage;
-}
+// The per-pixel channel average (R + G + B)/3, row-major, read where it is needed: the plane
+// itself for a grey image, else computed per pixel or per row (no image-sized copy).
+class ChannelAverage {
+  public:
+    explicit ChannelAverage(const LinearImage& image)
+        : w_(image.width),
+          r_(image.plane(0)),
+          g_(image.channels == 3 ? image.plane(1) : nullptr),
+          b_(image.channels == 3 ? image.plane(2) : nullptr) {
+        if (g_) row_.resize(w_);
+    }
+    float operator()(std::size_t i) const { return g_ ? (r_[i] + g_[i] + b_[i]) * kThird : r_[i]; }
+    // Row r (valid until the next call).
+    const float* row(std::size_t r) {
+        const std::size_t i0 = r * w_;
+        if (!g_) return r_ + i0;
+        for (std::size_t c = 0; c < w_; ++c)
+            row_[c] = (r_[i0 + c] + g_[i0 + c] + b_[i0 + c]) * kThird;
+        return row_.data();
+    }
+
+  private:
+    static constexpr float kThird = 1.0F / 3.0F;
+    std::size_t w_;
+    const float *r_, *g_, *b_;
+    std::vector<float> row_;
+};
 
 void check_fraction(std::string_view name, double value) {
     if (!(value > 0.0 && value < 1.0))
@@ -47,19 +62,30 @@ void check_fraction(std::string_view name, double value) {
             concat(name, " = ", format_number(value), " is outside the valid range (0, 1)"));
 }
 
+// Bands of the passes over the image (threads: SilhouetteOptions; the results do not depend on
+// them).
+constexpr std::size_t kBands = 16;
+
+// Membership of the object given as one run of columns per row (detail::RowRun).
+struct RunMask {
+    const std::vector<detail::RowRun>& rows;
+    std::size_t w, h;
+    bool in(std::size_t c, std::size_t r) const { return rows[r].begin <= c && c < rows[r].end; }
+    // Clamped at the image edge (the Sobel gradient below).
+    int at(std::ptrdiff_t c, std::ptrdiff_t r) const {
+        c = std::clamp<std::ptrdiff_t>(c, 0, static_cast<std::ptrdiff_t>(w) - 1);
+        r = std::clamp<std::ptrdiff_t>(r, 0, static_cast<std::ptrdiff_t>(h) - 1);
+        return in(static_cast<std::size_t>(c), static_cast<std::size_t>(r)) ? 1 : 0;
+    }
+};
+
 // Sobel gradient of the 0/1 mask at (c, r), clamped at the image edge.
-std::array<int, 2> mask_gradient(const std::vector<std::uint8_t>& m, std::size_t w, std::size_t h,
-                                 std::size_t c, std::size_t r) {
-    auto at = [&](std::ptrdiff_t cc, std::ptrdiff_t rr) -> int {
-        cc = std::clamp<std::ptrdiff_t>(cc, 0, static_cast<std::ptrdiff_t>(w) - 1);
-        rr = std::clamp<std::ptrdiff_t>(rr, 0, static_cast<std::ptrdiff_t>(h) - 1);
-        return m[static_cast<std::size_t>(rr) * w + static_cast<std::size_t>(cc)];
-    };
+std::array<int, 2> mask_gradient(const RunMask& m, std::size_t c, std::size_t r) {
     const auto x = static_cast<std::ptrdiff_t>(c), y = static_cast<std::ptrdiff_t>(r);
-    const int gx = (at(x + 1, y - 1) + 2 * at(x + 1, y) + at(x + 1, y + 1)) -
-                   (at(x - 1, y - 1) + 2 * at(x - 1, y) + at(x - 1, y + 1));
-    const int gy = (at(x - 1, y + 1) + 2 * at(x, y + 1) + at(x + 1, y + 1)) -
-                   (at(x - 1, y - 1) + 2 * at(x, y - 1) + at(x + 1, y - 1));
+    const int gx = (m.at(x + 1, y - 1) + 2 * m.at(x + 1, y) + m.at(x + 1, y + 1)) -
+                   (m.at(x - 1, y - 1) + 2 * m.at(x - 1, y) + m.at(x - 1, y + 1));
+    const int gy = (m.at(x - 1, y + 1) + 2 * m.at(x, y + 1) + m.at(x + 1, y + 1)) -
+                   (m.at(x - 1, y - 1) + 2 * m.at(x, y - 1) + m.at(x + 1, y - 1));
     return {gx, gy};
 }
 
@@ -77,15 +103,259 @@ double crossing_fraction(float ai, float ao, float ai2, float ao2) {
     return (static_cast<double>(ai) - level) / step;
 }
 
+// The regular subsample of at most 2^20 pixels of the automatic level: every step-th pixel.
+std::size_t sample_step(std::size_t n) { return std::max<std::size_t>(1, n >> 20); }
+
+// The level t of SilhouetteOptions::threshold when it is automatic, from the subsample
+// (silhouette.hpp); sets s.otsu_threshold.
+double automatic_level(const LinearImage& image, std::vector<float> sample,
+                       const SilhouetteOptions& options, Silhouette& s) {
+    const auto [lo_it, hi_it] = std::minmax_element(sample.begin(), sample.end());
+    const double lo = *lo_it, hi = *hi_it;
+    if (!(hi > lo))
+        throw DataError(concat(image_name(image), ": no object found (the image is uniform, ",
+                               format_number(lo), ")"));
+    // Otsu on the subsample scaled to 8 bits between its extremes.
+    cv::Mat u8(1, static_cast<int>(sample.size()), CV_8UC1);
+    const double scale = 255.0 / (hi - lo);
+    for (std::size_t k = 0; k < sample.size(); ++k) {
+        // std::lround of x ∈ [0, 255] (halves away from zero), inline: x − ⌊x⌋ is exact.
+        const double x = (static_cast<double>(sample[k]) - lo) * scale;
+        const auto whole = static_cast<unsigned>(x);
+        u8.data[k] = static_cast<std::uint8_t>(whole + (x - whole >= 0.5 ? 1U : 0U));
+    }
+    cv::Mat unused;
+    const double t8 = cv::threshold(u8, unused, 0, 255, cv::THRESH_BINARY | cv::THRESH_OTSU);
+    const double t_otsu = lo + (t8 + 0.5) / scale;
+    s.otsu_threshold = t_otsu;
+    // Background level and noise: median and 1.4826 · MAD of the pixels below t_O (robust
+    // to the dark limb of the object, which falls below t_O too); object level: mean of the
+    // pixels above t_O.
+    std::vector<float> below;
+    double so = 0;
+    std::size_t no = 0;
+    for (const float v : sample) {
+        if (v <= t_otsu) {
+            below.push_back(v);
+        } else {
+            so += v;
+            ++no;
+        }
+    }
+    if (below.empty() || no == 0)
+        throw DataError(concat(image_name(image), ": no object found (no background)"));
+    auto median = [](std::vector<float>& x) {
+        const auto mid = x.begin() + static_cast<std::ptrdiff_t>(x.size() / 2);
+        std::nth_element(x.begin(), mid, x.end());
+        return static_cast<double>(*mid);
+    };
+    const double mb = median(below);
+    for (float& v : below) v = static_cast<float>(std::abs(v - mb));
+    const double sdb = 1.4826 * median(below);
+    const double mo = so / static_cast<double>(no);
+    return std::min(t_otsu, mb + std::max(6.0 * sdb, options.edge_fraction * (mo - mb)));
+}
+
+// One pass over the image for the object's mask: the maximum of A over each f × f block (the
+// mask reduced by blocks is then max > t: a block is on when any of its pixels is) and, when
+// asked, the automatic level's subsample, read from the rows while they are in cache.
+struct ImageSummary {
+    std::size_t blocks_wide = 0, blocks_high = 0;
+    std::vector<float> block_max;  // blocks_high · blocks_wide, row-major
+    std::vector<float> sample;     // pixels 0, step, 2 step, ... (sample_step)
+};
+
+// Block rows [br0, br1) of summarise_image: the element-wise maximum of a block's f rows, then
+// of its f columns (vectorisable).
+void summarise_block_rows(const LinearImage& image, std::size_t f, std::size_t br0, std::size_t br1,
+                          ImageSummary& out) {
+    const std::size_t w = image.width, h = image.height, sw = out.blocks_wide;
+    ChannelAverage avg(image);
+    std::vector<float> column_max(w);
+    for (std::size_t br = br0; br < br1; ++br) {
+        const std::size_t r0 = br * f, r1 = std::min(h, r0 + f);
+        float* m = column_max.data();
+        const float* a0 = avg.row(r0);
+        std::copy(a0, a0 + w, m);
+        for (std::size_t r = r0 + 1; r < r1; ++r) {
+            const float* a = avg.row(r);
+            for (std::size_t c = 0; c < w; ++c) m[c] = m[c] < a[c] ? a[c] : m[c];
+        }
+        float* b = out.block_max.data() + br * sw;
+        for (std::size_t bc = 0; bc < sw; ++bc) {
+            const std::size_t c0 = bc * f, c1 = std::min(w, c0 + f);
+            float mx = m[c0];
+            for (std::size_t c = c0 + 1; c < c1; ++c) mx = mx < m[c] ? m[c] : mx;
+            b[bc] = mx;
+        }
+        if (!out.sample.empty()) {  // the subsample's pixels in rows [r0, r1)
+            const std::size_t step = sample_step(image.pixel_count());
+            const std::size_t k1 = (r1 * w + step - 1) / step;
+            for (std::size_t k = (r0 * w + step - 1) / step; k < k1; ++k)
+                out.sample[k] = avg(k * step);
+        }
+    }
+}
+
+ImageSummary summarise_image(const LinearImage& image, std::size_t f, bool with_sample,
+                             std::size_t threads) {
+    ImageSummary out;
+    out.blocks_wide = (image.width + f - 1) / f;
+    out.blocks_high = (image.height + f - 1) / f;
+    out.block_max.resize(out.blocks_wide * out.blocks_high);
+    const std::size_t n = image.pixel_count(), step = sample_step(n);
+    if (with_sample) out.sample.resize((n + step - 1) / step);
+    const std::size_t sh = out.blocks_high, bands = std::min(kBands, sh);
+    detail::run_bands(bands, threads, [&](std::size_t band) {
+        summarise_block_rows(image, f, sh * band / bands, sh * (band + 1) / bands, out);
+    });
+    return out;
+}
+
+// The mask A > t reduced by f × f blocks.
+cv::Mat reduced_mask(const ImageSummary& summary, float t) {
+    cv::Mat small(static_cast<int>(summary.blocks_high), static_cast<int>(summary.blocks_wide),
+                  CV_8UC1);
+    for (std::size_t k = 0; k < summary.block_max.size(); ++k)
+        small.data[k] = summary.block_max[k] > t ? 1 : 0;
+    return small;
+}
+
+// Per row, the object's first and last pixel above t in the blocks of component `best` (labels of
+// the f × f reduced mask, sw blocks a row), as the run [first, last + 1); the blocks of other
+// labels are skipped whole, so only the background beside the object's blocks is read.
+std::vector<detail::RowRun> object_runs(const ChannelAverage& avg, const cv::Mat& labels,
+                                        const cv::Mat& stats, int best, std::size_t w,
+                                        std::size_t h, std::size_t f, float t) {
+    std::vector<detail::RowRun> runs(h);
+    const auto left = static_cast<std::size_t>(stats.at<int>(best, cv::CC_STAT_LEFT));
+    const auto top = static_cast<std::size_t>(stats.at<int>(best, cv::CC_STAT_TOP));
+    const std::size_t right =
+        left + static_cast<std::size_t>(stats.at<int>(best, cv::CC_STAT_WIDTH));
+    const std::size_t bottom =
+        top + static_cast<std::size_t>(stats.at<int>(best, cv::CC_STAT_HEIGHT));
+    const auto best_label = static_cast<std::int32_t>(best);
+    for (std::size_t r = top * f; r < std::min(h, bottom * f); ++r) {
+        const std::int32_t* lr = labels.ptr<std::int32_t>(static_cast<int>(r / f));
+        const auto above = [&](std::size_t c) { return avg(r * w + c) > t; };
+        std::size_t first = w;
+        for (std::size_t bc = left; bc < right && first == w; ++bc) {
+            if (lr[bc] != best_label) continue;
+            for (std::size_t c = bc * f; c < std::min(w, bc * f + f); ++c)
+                if (above(c)) {
+                    first = c;
+                    break;
+                }
+        }
+        if (first == w) continue;
+        std::size_t last = first;  // found again by the scan from the right at the latest
+        bool found = false;
+        for (std::size_t bc = right; bc-- > first / f && !found;) {
+            if (lr[bc] != best_label) continue;
+            for (std::size_t c = std::min(w, bc * f + f); c-- > bc * f;)
+                if (above(c)) {
+                    last = c;
+                    found = true;
+                    break;
+                }
+        }
+        runs[r] = {first, last + 1};
+    }
+    return runs;
+}
+
+// Sub-pixel boundary points of the object (Silhouette::boundary): along rows where the outline
+// is more vertical than horizontal, along columns elsewhere. Found from the rows' runs: a row
+// has its transitions at the two ends of its run, two rows differ where exactly one run holds
+// the column, so only the outline is visited.
+void add_boundary_points(const ChannelAverage& avg, const RunMask& m, Silhouette& s) {
+    const std::size_t w = m.w, h = m.h;
+    auto add_point = [&](std::size_t ci, std::size_t ri, std::size_t co, std::size_t ro,
+                         double frac) {
+        std::array<int, 2> g = mask_gradient(m, ci, ri);
+        const std::array<int, 2> g2 = mask_gradient(m, co, ro);
+        g[0] += g2[0];
+        g[1] += g2[1];
+        const bool along_row = ri == ro;
+        if (along_row ? std::abs(g[0]) < std::abs(g[1]) : std::abs(g[1]) <= std::abs(g[0])) return;
+        EdgePoint p;
+        p.x_px = static_cast<double>(ci) + 0.5 +
+                 frac * (static_cast<double>(co) - static_cast<double>(ci));
+        p.y_px = static_cast<double>(ri) + 0.5 +
+                 frac * (static_cast<double>(ro) - static_cast<double>(ri));
+        const double norm = std::hypot(static_cast<double>(g[0]), static_cast<double>(g[1]));
+        if (norm > 0) {  // the mask gradient points inwards
+            p.normal_x = -g[0] / norm;
+            p.normal_y = -g[1] / norm;
+        }
+        s.boundary.push_back(p);
+    };
+    // Along rows: inside pixel i next to outside pixel o; i2 and o2 one further in and out.
+    for (std::size_t r = s.row_min; r < s.row_max; ++r) {
+        const detail::RowRun run = m.rows[r];
+        if (run.begin == run.end) continue;
+        const std::size_t row = r * w;
+        if (run.begin > 0) {  // object on the right of the transition
+            const std::size_t i = run.begin, o = i - 1;
+            const std::size_t i2 = i + 1 < run.end ? i + 1 : i;
+            const std::size_t o2 = o > 0 ? o - 1 : o;
+            add_point(i, r, o, r,
+                      crossing_fraction(avg(row + i), avg(row + o), avg(row + i2), avg(row + o2)));
+        }
+        if (run.end < w) {  // object on the left
+            const std::size_t i = run.end - 1, o = run.end;
+            const std::size_t i2 = i > run.begin ? i - 1 : i;
+            const std::size_t o2 = o + 1 < w ? o + 1 : o;
+            add_point(i, r, o, r,
+                      crossing_fraction(avg(row + i), avg(row + o), avg(row + i2), avg(row + o2)));
+        }
+    }
+    // Along columns, between rows r and r + 1, by increasing column.
+    const std::size_t rr0 = s.row_min > 0 ? s.row_min - 1 : 0, rr1 = std::min(h, s.row_max + 1);
+    for (std::size_t r = rr0; r + 1 < rr1; ++r) {
+        const detail::RowRun a = m.rows[r], b = m.rows[r + 1];
+        std::array<std::size_t, 4> ends = {a.begin, a.end, b.begin, b.end};
+        std::sort(ends.begin(), ends.end());
+        for (std::size_t k = 0; k + 1 < ends.size(); ++k) {
+            if (ends[k] == ends[k + 1]) continue;
+            const bool inside_top = m.in(ends[k], r);
+            if (inside_top == m.in(ends[k], r + 1)) continue;
+            for (std::size_t c = ends[k]; c < ends[k + 1]; ++c) {
+                const std::size_t ri = inside_top ? r : r + 1, ro = inside_top ? r + 1 : r;
+                std::size_t ri2 = ri, ro2 = ro;
+                if (inside_top) {
+                    if (ri > 0 && m.in(c, ri - 1)) ri2 = ri - 1;
+                    if (ro + 1 < h && !m.in(c, ro + 1)) ro2 = ro + 1;
+                } else {
+                    if (ri + 1 < h && m.in(c, ri + 1)) ri2 = ri + 1;
+                    if (ro > 0 && !m.in(c, ro - 1)) ro2 = ro - 1;
+                }
+                add_point(c, ri, c, ro,
+                          crossing_fraction(avg(ri * w + c), avg(ro * w + c), avg(ri2 * w + c),
+                                            avg(ro2 * w + c)));
+            }
+        }
+    }
+}
+
 }  // namespace
 
 Silhouette find_silhouette(const LinearImage& image, const SilhouetteOptions& options) {
     check_linear_image(image);
-    return detail::find_silhouette_of_checked_image(image, options);
+    detail::Outline outline = detail::find_outline_of_checked_image(image, options, 0);
+    const Silhouette& s = outline.silhouette;
+    assign_large(outline.silhouette.mask, image.pixel_count(), std::uint8_t{0});
+    for (std::size_t r = 0; r < outline.rows.size(); ++r) {
+        const detail::RowRun run = outline.rows[r];
+        std::uint8_t* m = outline.silhouette.mask.data() + r * s.width;
+        std::fill(m + run.begin, m + run.end, std::uint8_t{1});
+    }
+    return std::move(outline.silhouette);
 }
 
-Silhouette detail::find_silhouette_of_checked_image(const LinearImage& image,
-                                                    const SilhouetteOptions& options) {
+detail::Outline detail::find_outline_of_checked_image(const LinearImage& image,
+                                                      const SilhouetteOptions& options,
+                                                      std::size_t threads) {
     check_fraction("silhouette edge_fraction", options.edge_fraction);
     check_fraction("silhouette min_object_fraction", options.min_object_fraction);
     if (options.threshold && !std::isfinite(*options.threshold))
@@ -95,81 +365,23 @@ Silhouette detail::find_silhouette_of_checked_image(const LinearImage& image,
         throw InvalidArgument(concat(image_name(image),
                                      ": a silhouette needs an image of at least "
                                      "3 x 3 and below 2^31 pixels"));
-    std::vector<float> avg_storage;
-    const std::span<const float> avg = channel_average(image, avg_storage);
+    ChannelAverage avg(image);
 
-    Silhouette s;
+    Outline outline;
+    Silhouette& s = outline.silhouette;
     s.width = w;
     s.height = h;
-    if (options.threshold) {
-        s.threshold = *options.threshold;
-    } else {
-        // Every statistic of the level from a regular subsample of at most 2^20 pixels.
-        const std::size_t step = std::max<std::size_t>(1, n >> 20);
-        std::vector<float> sample;
-        sample.reserve(n / step + 1);
-        for (std::size_t i = 0; i < n; i += step) sample.push_back(avg[i]);
-        const auto [lo_it, hi_it] = std::minmax_element(sample.begin(), sample.end());
-        const double lo = *lo_it, hi = *hi_it;
-        if (!(hi > lo))
-            throw DataError(concat(image_name(image), ": no object found (the image is uniform, ",
-                                   format_number(lo), ")"));
-        // Otsu on the subsample scaled to 8 bits between its extremes.
-        cv::Mat u8(1, static_cast<int>(sample.size()), CV_8UC1);
-        const double scale = 255.0 / (hi - lo);
-        for (std::size_t k = 0; k < sample.size(); ++k)
-            u8.data[k] = static_cast<std::uint8_t>(
-                std::lround((static_cast<double>(sample[k]) - lo) * scale));
-        cv::Mat unused;
-        const double t8 = cv::threshold(u8, unused, 0, 255, cv::THRESH_BINARY | cv::THRESH_OTSU);
-        const double t_otsu = lo + (t8 + 0.5) / scale;
-        s.otsu_threshold = t_otsu;
-        // Background level and noise: median and 1.4826 · MAD of the pixels below t_O (robust
-        // to the dark limb of the object, which falls below t_O too); object level: mean of the
-        // pixels above t_O.
-        std::vector<float> below;
-        double so = 0;
-        std::size_t no = 0;
-        for (const float v : sample) {
-            if (v <= t_otsu) {
-                below.push_back(v);
-            } else {
-                so += v;
-                ++no;
-            }
-        }
-        if (below.empty() || no == 0)
-            throw DataError(concat(image_name(image), ": no object found (no background)"));
-        auto median = [](std::vector<float>& x) {
-            const auto mid = x.begin() + static_cast<std::ptrdiff_t>(x.size() / 2);
-            std::nth_element(x.begin(), mid, x.end());
-            return static_cast<double>(*mid);
-        };
-        const double mb = median(below);
-        for (float& v : below) v = static_cast<float>(std::abs(v - mb));
-        const double sdb = 1.4826 * median(below);
-        const double mo = so / static_cast<double>(no);
-        s.threshold = std::min(t_otsu, mb + std::max(6.0 * sdb, options.edge_fraction * (mo - mb)));
-    }
-
     // Largest 8-connected component above the level, found on the mask reduced by f × f blocks
     // (a block is on when any of its pixels is; f = ⌊√(n / 2^20)⌋, 1 below 2^21 pixels): the
     // object's mask is then its pixels above the level in the blocks of that component.
     const std::size_t f =
         std::max<std::size_t>(1, static_cast<std::size_t>(std::sqrt(static_cast<double>(n >> 20))));
-    const std::size_t sw = (w + f - 1) / f, sh = (h + f - 1) / f;
+    ImageSummary summary = summarise_image(image, f, !options.threshold, threads);
+    s.threshold = options.threshold ? *options.threshold
+                                    : automatic_level(image, std::move(summary.sample), options, s);
+
     const auto t = static_cast<float>(s.threshold);
-    cv::Mat small = cv::Mat::zeros(static_cast<int>(sh), static_cast<int>(sw), CV_8UC1);
-    for (std::size_t r = 0; r < h; ++r) {
-        const float* a = avg.data() + r * w;
-        std::uint8_t* b = small.data + (r / f) * sw;
-        if (f == 1) {
-            for (std::size_t c = 0; c < w; ++c) b[c] = a[c] > t ? 1 : 0;
-        } else {
-            for (std::size_t c = 0; c < w; ++c)
-                if (a[c] > t) b[c / f] = 1;
-        }
-    }
+    const cv::Mat small = reduced_mask(summary, t);
     cv::Mat labels, stats, centroids;
     const int count = cv::connectedComponentsWithStats(small, labels, stats, centroids, 8, CV_32S);
     int best = 0, best_area = 0;
@@ -180,37 +392,27 @@ Silhouette detail::find_silhouette_of_checked_image(const LinearImage& image,
             best = k;
         }
     }
-    const auto* lab = labels.ptr<std::int32_t>(0);
-    assign_large(s.mask, n, std::uint8_t{0});
     std::size_t object_pixels = 0;
     double sx = 0, sy = 0;
     s.col_min = w;
     s.row_min = h;
     if (best != 0) {
-        // The mask, with the gaps along each row between its first and last pixel filled (the
-        // objects measured here — a cylinder or a sphere seen whole — are convex along rows).
+        // The mask is each row's run from its first to its last pixel (the gaps between them
+        // filled: the objects measured here — a cylinder or a sphere seen whole — are convex
+        // along rows).
+        outline.rows = object_runs(avg, labels, stats, best, w, h, f, t);
         for (std::size_t r = 0; r < h; ++r) {
-            const float* a = avg.data() + r * w;
-            const std::int32_t* lr = lab + (r / f) * sw;
-            std::uint8_t* m = s.mask.data() + r * w;
-            std::size_t first = w, last = 0;
-            for (std::size_t c = 0; c < w; ++c)
-                if (a[c] > t && lr[c / f] == best) {
-                    if (first == w) first = c;
-                    last = c;
-                }
-            if (first < w) {
-                std::fill(m + first, m + last + 1, std::uint8_t{1});
-                const std::size_t run = last + 1 - first;
-                object_pixels += run;
-                // Counts, centroid, bounding box of the filled rows.
-                sx += 0.5 * static_cast<double>(first + last) * static_cast<double>(run);
-                sy += static_cast<double>(r) * static_cast<double>(run);
-                s.col_min = std::min(s.col_min, first);
-                s.col_max = std::max(s.col_max, last + 1);
-                s.row_min = std::min(s.row_min, r);
-                s.row_max = r + 1;
-            }
+            const RowRun run = outline.rows[r];
+            if (run.begin == run.end) continue;
+            const std::size_t first = run.begin, last = run.end - 1, length = run.end - run.begin;
+            object_pixels += length;
+            // Counts, centroid, bounding box of the filled rows.
+            sx += 0.5 * static_cast<double>(first + last) * static_cast<double>(length);
+            sy += static_cast<double>(r) * static_cast<double>(length);
+            s.col_min = std::min(s.col_min, first);
+            s.col_max = std::max(s.col_max, last + 1);
+            s.row_min = std::min(s.row_min, r);
+            s.row_max = r + 1;
         }
     }
     if (best == 0 ||
@@ -229,73 +431,8 @@ Silhouette detail::find_silhouette_of_checked_image(const LinearImage& image,
     s.touches_right = s.col_max == w;
     s.touches_top = s.row_min == 0;
     s.touches_bottom = s.row_max == h;
-
-    // Sub-pixel boundary: along rows where the outline is more vertical than horizontal, along
-    // columns elsewhere.
-    auto add_point = [&](std::size_t ci, std::size_t ri, std::size_t co, std::size_t ro,
-                         double frac) {
-        std::array<int, 2> g = mask_gradient(s.mask, w, h, ci, ri);
-        const std::array<int, 2> g2 = mask_gradient(s.mask, w, h, co, ro);
-        g[0] += g2[0];
-        g[1] += g2[1];
-        const bool along_row = ri == ro;
-        if (along_row ? std::abs(g[0]) < std::abs(g[1]) : std::abs(g[1]) <= std::abs(g[0])) return;
-        EdgePoint p;
-        p.x_px = static_cast<double>(ci) + 0.5 +
-                 frac * (static_cast<double>(co) - static_cast<double>(ci));
-        p.y_px = static_cast<double>(ri) + 0.5 +
-                 frac * (static_cast<double>(ro) - static_cast<double>(ri));
-        const double norm = std::hypot(static_cast<double>(g[0]), static_cast<double>(g[1]));
-        if (norm > 0) {  // the mask gradient points inwards
-            p.normal_x = -g[0] / norm;
-            p.normal_y = -g[1] / norm;
-        }
-        s.boundary.push_back(p);
-    };
-    const std::size_t r0 = s.row_min, r1 = s.row_max;
-    const std::size_t c0 = s.col_min > 0 ? s.col_min - 1 : 0;
-    const std::size_t c1 = std::min(w, s.col_max + 1);
-    for (std::size_t r = r0; r < r1; ++r) {
-        const std::uint8_t* m = s.mask.data() + r * w;
-        const float* a = avg.data() + r * w;
-        for (std::size_t c = c0; c + 1 < c1; ++c) {
-            if (m[c] == m[c + 1]) continue;
-            const bool inside_left = m[c] != 0;
-            const std::size_t i = inside_left ? c : c + 1, o = inside_left ? c + 1 : c;
-            std::size_t i2 = i, o2 = o;
-            if (inside_left) {
-                if (i > 0 && m[i - 1]) i2 = i - 1;
-                if (o + 1 < w && !m[o + 1]) o2 = o + 1;
-            } else {
-                if (i + 1 < w && m[i + 1]) i2 = i + 1;
-                if (o > 0 && !m[o - 1]) o2 = o - 1;
-            }
-            add_point(i, r, o, r, crossing_fraction(a[i], a[o], a[i2], a[o2]));
-        }
-    }
-    const std::size_t rr0 = r0 > 0 ? r0 - 1 : 0, rr1 = std::min(h, r1 + 1);
-    for (std::size_t r = rr0; r + 1 < rr1; ++r) {
-        const std::uint8_t* m0 = s.mask.data() + r * w;
-        const std::uint8_t* m1 = m0 + w;
-        for (std::size_t c = s.col_min; c < s.col_max; ++c) {
-            if (m0[c] == m1[c]) continue;
-            const bool inside_top = m0[c] != 0;
-            const std::size_t ri = inside_top ? r : r + 1, ro = inside_top ? r + 1 : r;
-            std::size_t ri2 = ri, ro2 = ro;
-            auto in = [&](std::size_t rr) { return s.mask[rr * w + c] != 0; };
-            if (inside_top) {
-                if (ri > 0 && in(ri - 1)) ri2 = ri - 1;
-                if (ro + 1 < h && !in(ro + 1)) ro2 = ro + 1;
-            } else {
-                if (ri + 1 < h && in(ri + 1)) ri2 = ri + 1;
-                if (ro > 0 && !in(ro - 1)) ro2 = ro - 1;
-            }
-            add_point(c, ri, c, ro,
-                      crossing_fraction(avg[ri * w + c], avg[ro * w + c], avg[ri2 * w + c],
-                                        avg[ro2 * w + c]));
-        }
-    }
-    return s;
+    add_boundary_points(avg, RunMask{outline.rows, w, h}, s);
+    return outline;
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -70,9 +70,10 @@ SphereResult measure_sphere(const LinearImage& image, const std::vector<std::uin
     if (options.circle) {
         out.circle = *options.circle;
     } else {
-        out.circle =
-            fit_sphere_circle(detail::find_silhouette_of_checked_image(image, options.silhouette),
-                              options.circle_fit);
+        out.circle = fit_sphere_circle(
+            detail::find_outline_of_checked_image(image, options.silhouette, options.threads)
+                .silhouette,
+            options.circle_fit);
         out.circle_detected = true;
     }
     const double cx = out.circle.centre_x_px, cy = out.circle.centre_y_px;
@@ -100,49 +101,89 @@ SphereResult measure_sphere(const LinearImage& image, const std::vector<std::uin
     const auto r_hi = static_cast<std::size_t>(std::clamp(std::ceil(cy + R), 0.0, double(h)));
     const auto c_lo = static_cast<std::size_t>(std::clamp(std::floor(cx - R), 0.0, double(w)));
     const auto c_hi = static_cast<std::size_t>(std::clamp(std::ceil(cx + R), 0.0, double(w)));
-    for (std::size_t r = r_lo; r < r_hi; ++r) {
+    // Row r's pixels into its cells. Only the columns within 2 px of the chord ρ = ρ_max are
+    // visited (the test below is exact; the chord only skips pixels far outside it).
+    struct Counts {
+        std::size_t used = 0, flagged = 0;
+    };
+    const auto accumulate_row = [&](std::size_t r, Counts& counts) {
         const double ny = (cy - (static_cast<double>(r) + 0.5)) * inv_R;
+        if (ny * ny > rho2_max) return;  // ρ² ≥ ny² > ρ_max² on the whole row
+        const double half_chord = R * std::sqrt(rho2_max - ny * ny) + 2.0;
+        const std::size_t c_begin = std::max(
+            c_lo, static_cast<std::size_t>(std::max(0.0, std::floor(cx - half_chord - 0.5))));
+        const std::size_t c_end =
+            std::min(c_hi, static_cast<std::size_t>(std::max(0.0, std::ceil(cx + half_chord))));
         CellSums* row_cells = cells.data() + (r / k) * gw;
-        std::int64_t left_cell = -1;
-        float left_value = 0.0F;
-        for (std::size_t c = c_lo; c < c_hi; ++c) {
-            const double nx = (static_cast<double>(c) + 0.5 - cx) * inv_R;
-            const double rho2 = nx * nx + ny * ny;
-            const std::size_t i = r * w + c;
-            std::int64_t cell = -1;
-            if (rho2 <= rho2_max && (!reg || reg[i])) {
-                const double nz = std::sqrt(1.0 - rho2);
-                const double nl = nx * L.x() + ny * L.y() + nz * L.z();
-                const double nv = nx * V.x() + ny * V.y() + nz * V.z();
-                if (nl > cos_max && nv > cos_max) {
-                    if (image.flags[i] != 0) {
-                        ++out.pixels_flagged;
-                    } else {
-                        float v = p0[i];
-                        if (p1) v = (v + p1[i] + p2[i]) * (1.0F / 3.0F);
-                        const double vd = v;
-                        cell = static_cast<std::int64_t>(c / k);
-                        CellSums& cs = row_cells[c / k];
-                        cs.sum += vd;
-                        cs.sum2 += vd * vd;
-                        const double px = nx * R, py = ny * R;
-                        cs.sx += px;
-                        cs.sy += py;
-                        cs.sxx += px * px;
-                        cs.syy += py * py;
-                        ++cs.count;
-                        if (left_cell == cell) {
-                            const double diff = vd - left_value;
-                            cs.diff2 += diff * diff;
-                            ++cs.diffs;
+        // The row's pixels of one cell are summed here, then added to the cell.
+        for (std::size_t gx = c_begin / k; gx * k < c_end; ++gx) {
+            CellSums part;
+            bool left_used = false;  // the pixel on the left is used (and in this cell)
+            float left_value = 0.0F;
+            for (std::size_t c = std::max(c_begin, gx * k); c < std::min(c_end, gx * k + k); ++c) {
+                const double nx = (static_cast<double>(c) + 0.5 - cx) * inv_R;
+                const double rho2 = nx * nx + ny * ny;
+                const std::size_t i = r * w + c;
+                bool used = false;
+                if (rho2 <= rho2_max && (!reg || reg[i])) {
+                    const double nz = std::sqrt(1.0 - rho2);
+                    const double nl = nx * L.x() + ny * L.y() + nz * L.z();
+                    const double nv = nx * V.x() + ny * V.y() + nz * V.z();
+                    if (nl > cos_max && nv > cos_max) {
+                        if (image.flags[i] != 0) {
+                            ++counts.flagged;
+                        } else {
+                            float v = p0[i];
+                            if (p1) v = (v + p1[i] + p2[i]) * (1.0F / 3.0F);
+                            const double vd = v;
+                            part.sum += vd;
+                            part.sum2 += vd * vd;
+                            const double px = nx * R, py = ny * R;
+                            part.sx += px;
+                            part.sy += py;
+                            part.sxx += px * px;
+                            part.syy += py * py;
+                            ++part.count;
+                            if (left_used) {
+                                const double diff = vd - left_value;
+                                part.diff2 += diff * diff;
+                                ++part.diffs;
+                            }
+                            left_value = v;
+                            used = true;
                         }
-                        left_value = v;
-                        ++out.pixels_used;
                     }
                 }
+                left_used = used;
             }
-            left_cell = cell;
+            if (part.count == 0) continue;
+            CellSums& cs = row_cells[gx];
+            cs.sum += part.sum;
+            cs.sum2 += part.sum2;
+            cs.diff2 += part.diff2;
+            cs.sx += part.sx;
+            cs.sy += part.sy;
+            cs.sxx += part.sxx;
+            cs.syy += part.syy;
+            cs.count += part.count;
+            cs.diffs += part.diffs;
+            counts.used += part.count;
         }
+    };
+    // Bands of whole rows of cells, one thread each: a cell is summed by one band, in the same
+    // order whatever the number of threads.
+    const std::size_t gy_lo = r_lo / k, gy_hi = r_hi > r_lo ? (r_hi - 1) / k + 1 : gy_lo;
+    const std::size_t bands = std::min<std::size_t>(64, gy_hi - gy_lo);
+    std::vector<Counts> band_counts(bands);
+    detail::run_bands(bands, options.threads, [&](std::size_t band) {
+        const std::size_t g0 = gy_lo + (gy_hi - gy_lo) * band / bands;
+        const std::size_t g1 = gy_lo + (gy_hi - gy_lo) * (band + 1) / bands;
+        for (std::size_t r = std::max(r_lo, g0 * k); r < std::min(r_hi, g1 * k); ++r)
+            accumulate_row(r, band_counts[band]);
+    });
+    for (const Counts& bc : band_counts) {
+        out.pixels_used += bc.used;
+        out.pixels_flagged += bc.flagged;
     }
     if (out.pixels_flagged)
         out.warnings.push_back(concat(std::to_string(out.pixels_flagged),

@@ -79,6 +79,9 @@ struct CylinderOptions {
     // than departure_k standard errors.
     double departure_k = 3.0;
     std::size_t departure_bins = 2;
+    // Worker threads of the pass over the pixels (0 = all cores); the result does not depend on
+    // it (the pixels are summed in fixed bands of rows, added in order).
+    std::size_t threads = 0;
 };
 
 // Throws InvalidArgument naming the field and its valid range.

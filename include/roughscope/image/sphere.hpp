@@ -46,6 +46,9 @@ struct SphereOptions {
     std::size_t max_cells = 16384;  // ≥ 1
     // Cells with fewer used pixels than this fraction of cell_px² are dropped, [0, 1].
     double min_cell_fraction = 0.5;
+    // Worker threads of the pass over the pixels (0 = all cores); the result does not depend on
+    // it (each cell is summed by one thread, in the same order).
+    std::size_t threads = 0;
     ComparisonOptions comparison;
 };
 

@@ -318,4 +318,68 @@ TEST(CylinderProfile, BadInputIsAnError) {
     EXPECT_EQ(parse_profile_model("vh_exponential"), ProfileModel::VhExponential);
 }
 
+// A textured Lambert cylinder lit from the camera whose axis is tilted by `tilt_rad` from the
+// image vertical, with a few flagged pixels: deterministic, noisy, several bands of rows.
+LinearImage tilted_cylinder(std::size_t w, std::size_t h, double tilt_rad, double radius) {
+    LinearImage img;
+    img.width = w;
+    img.height = h;
+    img.channels = 1;
+    img.values.assign(w * h, 0.0F);
+    img.flags.assign(w * h, 0);
+    const double ax = std::sin(tilt_rad), ay = std::cos(tilt_rad);
+    for (std::size_t r = 0; r < h; ++r)
+        for (std::size_t c = 0; c < w; ++c) {
+            const double x = static_cast<double>(c) + 0.5 - 0.5 * static_cast<double>(w);
+            const double y = static_cast<double>(r) + 0.5 - 0.5 * static_cast<double>(h);
+            const double s = (x * ay - y * ax) / radius;
+            const double texture = 0.02 * static_cast<double>((r * 7 + c * 13) % 17) / 17.0;
+            img.values[r * w + c] = static_cast<float>(
+                0.01 + (s * s < 1.0 ? 0.8 * std::sqrt(1.0 - s * s) : 0.0) + texture);
+            if ((r * 31 + c * 17) % 997 == 0) img.flags[r * w + c] = kPixelSaturated;
+        }
+    return img;
+}
+
+TEST(CylinderProfile, ResultDoesNotDependOnTheNumberOfThreads) {
+    const LinearImage img = tilted_cylinder(700, 900, deg_to_rad(30.0), 200.0);
+    std::vector<std::uint8_t> region(img.pixel_count(), 1);
+    for (std::size_t i = 0; i < region.size(); i += 11) region[i] = 0;
+    for (const bool detected : {true, false})
+        for (const CylinderHalf half : {CylinderHalf::Right, CylinderHalf::Both}) {
+            CylinderOptions o;
+            o.half = half;
+            if (!detected)
+                o.axis = cylinder_axis_from_line(350.0, 450.0, std::sin(deg_to_rad(30.0)),
+                                                 std::cos(deg_to_rad(30.0)), 200.0);
+            o.threads = 1;
+            const CylinderProfile one = measure_cylinder_profile(img, &region, o);
+            ASSERT_GE(one.bins.size(), 20U);
+            EXPECT_GT(one.pixels_flagged, 0U);
+            for (const std::size_t threads : {2, 3}) {
+                o.threads = threads;
+                const CylinderProfile many = measure_cylinder_profile(img, &region, o);
+                ASSERT_EQ(many.bins.size(), one.bins.size());
+                EXPECT_EQ(many.axis.radius_px, one.axis.radius_px);
+                EXPECT_EQ(many.pixels_used, one.pixels_used);
+                EXPECT_EQ(many.pixels_flagged, one.pixels_flagged);
+                EXPECT_EQ(many.maximum, one.maximum);
+                for (std::size_t b = 0; b < one.bins.size(); ++b) {
+                    const ProfileBin &x = many.bins[b], &y = one.bins[b];
+                    EXPECT_EQ(x.across_px, y.across_px);
+                    EXPECT_EQ(x.brightness, y.brightness);
+                    EXPECT_EQ(x.stderr_slices, y.stderr_slices);
+                    EXPECT_EQ(x.stderr_pixel, y.stderr_pixel);
+                    EXPECT_EQ(x.count, y.count);
+                    EXPECT_EQ(x.flagged, y.flagged);
+                    EXPECT_EQ(x.slices, y.slices);
+                }
+                for (std::size_t m = 0; m < one.models.size(); ++m)
+                    EXPECT_EQ(many.models[m].prediction, one.models[m].prediction);
+                EXPECT_EQ(many.gaussian_fit.sigma_over_T, one.gaussian_fit.sigma_over_T);
+                EXPECT_EQ(many.exponential_fit.sigma_over_T, one.exponential_fit.sigma_over_T);
+            }
+        }
+}
+
 }  // namespace

@@ -183,4 +183,51 @@ TEST(SphereTable, BadInputIsAnError) {
     EXPECT_THROW(measure_sphere(cut, nullptr, {}), DataError);
 }
 
+TEST(SphereTable, ResultDoesNotDependOnTheNumberOfThreads) {
+    // A textured Lambert sphere lit from the camera, a few flagged pixels, a region mask: cells
+    // of several pixels, several bands of rows.
+    const std::size_t w = 520, h = 480;
+    LinearImage img;
+    img.width = w;
+    img.height = h;
+    img.channels = 1;
+    img.values.assign(w * h, 0.0F);
+    img.flags.assign(w * h, 0);
+    for (std::size_t r = 0; r < h; ++r)
+        for (std::size_t c = 0; c < w; ++c) {
+            const double x = (static_cast<double>(c) + 0.5 - 261.3) / 190.0;
+            const double y = (static_cast<double>(r) + 0.5 - 238.6) / 190.0;
+            const double rho2 = x * x + y * y;
+            const double texture = 0.02 * static_cast<double>((r * 7 + c * 13) % 17) / 17.0;
+            img.values[r * w + c] = static_cast<float>(
+                0.01 + (rho2 < 1.0 ? 0.8 * std::sqrt(1.0 - rho2) : 0.0) + texture);
+            if ((r * 31 + c * 17) % 997 == 0) img.flags[r * w + c] = kPixelSaturated;
+        }
+    std::vector<std::uint8_t> region(img.pixel_count(), 1);
+    for (std::size_t i = 0; i < region.size(); i += 11) region[i] = 0;
+    SphereOptions o;
+    o.comparison.fits = false;
+    o.threads = 1;
+    const SphereResult one = measure_sphere(img, &region, o);
+    ASSERT_GT(one.cell_px, 1U);
+    ASSERT_GT(one.table.measurements.size(), 1000U);
+    EXPECT_GT(one.pixels_flagged, 0U);
+    for (const std::size_t threads : {2, 3}) {
+        o.threads = threads;
+        const SphereResult many = measure_sphere(img, &region, o);
+        EXPECT_EQ(many.circle.radius_px, one.circle.radius_px);
+        EXPECT_EQ(many.pixels_used, one.pixels_used);
+        EXPECT_EQ(many.pixels_flagged, one.pixels_flagged);
+        ASSERT_EQ(many.table.measurements.size(), one.table.measurements.size());
+        for (std::size_t k = 0; k < one.table.measurements.size(); ++k) {
+            const BrdfMeasurement &x = many.table.measurements[k], &y = one.table.measurements[k];
+            EXPECT_EQ(x.theta_i_rad, y.theta_i_rad);
+            EXPECT_EQ(x.theta_v_rad, y.theta_v_rad);
+            EXPECT_EQ(x.phi_v_rad, y.phi_v_rad);
+            EXPECT_EQ(x.value, y.value);
+            EXPECT_EQ(x.weight, y.weight);
+        }
+    }
+}
+
 }  // namespace
