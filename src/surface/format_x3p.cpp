@@ -522,13 +522,11 @@ void read_binary_heights(const ZipArchive& zip, const std::string& name, const s
         if (direct) {
             zip.read_exact(file.get(), entry, reinterpret_cast<char*>(out), n * sizeof(double));
             if (verify) md5.update(reinterpret_cast<const char*>(out), n * sizeof(double));
-            // ±inf and NaN (exponent bits all ones) become the quiet NaN; branch-free.
-            constexpr std::uint64_t kExponent = 0x7ff0000000000000ULL;
+            // ±inf and NaN become the quiet NaN (a compare and a blend: vectorised).
+            constexpr double kLargest = std::numeric_limits<double>::max();
             constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-            for (std::size_t i = 0; i < n; ++i) {
-                const bool finite = (std::bit_cast<std::uint64_t>(out[i]) & kExponent) != kExponent;
-                out[i] = finite ? out[i] : kNaN;
-            }
+            for (std::size_t i = 0; i < n; ++i)
+                out[i] = std::abs(out[i]) <= kLargest ? out[i] : kNaN;
         } else {
             zip.read_exact(file.get(), entry, buffer.data(), n * bytes_per_point);
             if (verify) md5.update(buffer.data(), n * bytes_per_point);

@@ -545,12 +545,8 @@ TEST(MeasureChannels, ChannelsThatDisagreeAreFlagged) {
     EXPECT_TRUE(flagged);
 }
 
-// ---------------------------------------------------------------------------------------------
-// Failures: each a named error.
-
-TEST(MeasureFailures, CapturesOfDifferentSizesAreADataError) {
-    const fs::path dir = roughscope::testing::fresh_dir("measure_sizes");
-    MeasureRequest request = pair_with_ratio(dir, "a", 1.05);
+// A 16-bit TIFF capture two pixels wider than the others (other.tiff in dir).
+fs::path write_wider_capture(const fs::path& dir) {
     sim::Scene scene;
     scene.width = kSize + 2;
     scene.height = kSize;
@@ -558,6 +554,16 @@ TEST(MeasureFailures, CapturesOfDifferentSizesAreADataError) {
     const sim::Capture capture = sim::render_capture(scene, {constant(1.0)}, {}, camera);
     const fs::path other = dir / "other.tiff";
     io::write_file_atomic(other, sim::encode_capture(capture, camera, sim::CaptureFormat::Tiff));
+    return other;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Failures: each a named error.
+
+TEST(MeasureFailures, CapturesOfDifferentSizesAreADataError) {
+    const fs::path dir = roughscope::testing::fresh_dir("measure_sizes");
+    MeasureRequest request = pair_with_ratio(dir, "a", 1.05);
+    const fs::path other = write_wider_capture(dir);
     request.captures[1].image = other.string();
     try {
         (void)measure(request);
@@ -597,14 +603,7 @@ TEST(MeasureThreads, TheFirstFailingCaptureGivesTheError) {
     const fs::path dir = roughscope::testing::fresh_dir("measure_threads_errors");
     MeasureRequest request = pair_with_ratio(dir, "a", 1.05);
     // Capture 1 missing, capture 2 of another size: capture 1's error whatever the threads.
-    sim::Scene scene;
-    scene.width = kSize + 2;
-    scene.height = kSize;
-    sim::CameraModel camera = camera_for(kLinear16, 1.0, 1);
-    const fs::path other = dir / "other.tiff";
-    io::write_file_atomic(
-        other, sim::encode_capture(sim::render_capture(scene, {constant(1.0)}, {}, camera), camera,
-                                   sim::CaptureFormat::Tiff));
+    const fs::path other = write_wider_capture(dir);
     CaptureSpec third = request.captures[1];
     third.image = other.string();
     request.captures[1].image = (dir / "nope.tiff").string();
