@@ -1,7 +1,7 @@
 // Fuzz target: the x3p height-map reader (formats::decode_x3p), exactly as read_height_map()
 // drives it with a file's bytes, once with the checksums verified (the default) and once without
-// (--no-verify-checksums: stored entries read raw, and mutated data that a checksum would stop
-// reaches the conversion and the checks after it). Seeds: fuzz/corpus/height_x3p/
+// (--no-verify-checksums: mutated data that an MD5 checksum would stop reaches the conversion and
+// the checks after it). Seeds: fuzz/corpus/height_x3p/
 // (fuzz/make_height_seeds_x3p.py).
 #include <string>
 

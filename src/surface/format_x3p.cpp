@@ -262,20 +262,8 @@ class ZipArchive {
         return st.size;
     }
 
-    // With check_crc false, an entry stored without compression or encryption is read as its
-    // raw bytes, without the zip's CRC-32 check (the same bytes; a read that verifies no
-    // checksum). Any other entry is read (and checked) as usual.
-    ZipFilePtr open(const std::string& entry, bool check_crc = true) const {
-        zip_flags_t flags = 0;
-        if (!check_crc) {
-            zip_stat_t st;
-            zip_stat_init(&st);
-            if (zip_stat(archive_.get(), entry.c_str(), 0, &st) == 0 &&
-                (st.valid & ZIP_STAT_COMP_METHOD) && st.comp_method == ZIP_CM_STORE &&
-                (st.valid & ZIP_STAT_ENCRYPTION_METHOD) && st.encryption_method == ZIP_EM_NONE)
-                flags = ZIP_FL_COMPRESSED;
-        }
-        zip_file_t* file = zip_fopen(archive_.get(), entry.c_str(), flags);
+    ZipFilePtr open(const std::string& entry) const {
+        zip_file_t* file = zip_fopen(archive_.get(), entry.c_str(), 0);
         if (!file) {
             std::string what = "cannot open the zip entry ";
             what.append(quote_input(entry))
@@ -508,7 +496,7 @@ void read_binary_heights(const ZipArchive& zip, const std::string& name, const s
         fail(name, what);
     }
     assign_large(heights, points, 0.0);
-    ZipFilePtr file = zip.open(entry, verify);
+    ZipFilePtr file = zip.open(entry);
     Md5 md5;
     constexpr std::size_t kChunkPoints = 1 << 16;
     // Doubles already in µm are read straight into the heights (checksummed there, before
