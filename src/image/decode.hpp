@@ -125,6 +125,12 @@ Evidence icc_evidence(Bytes profile, std::string_view where);
 
 LinearImage decode_png(Bytes bytes, const std::string& name, const ReadOptions& options);
 LinearImage decode_jpeg(Bytes bytes, const std::string& name, const ReadOptions& options);
+// DataError unless the TIFF directories reachable from the header lie inside the file with
+// entries of known types (LibRaw's TIFF parser trusts them; decode_tiff.cpp). any_version: also
+// when the header's version is not TIFF's 42 (ORF, RW2 and any file starting with II or MM,
+// which LibRaw parses as TIFF directories too).
+void check_raw_structure(Bytes bytes, const std::string& name, bool any_version);
+
 // nullopt: the file is a TIFF-structured camera RAW (read.hpp), for decode_raw.
 std::optional<LinearImage> decode_tiff(Bytes bytes, const std::string& name,
                                        const ReadOptions& options);

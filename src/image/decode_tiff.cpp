@@ -201,12 +201,15 @@ void put_row(Linearizer& lin, int bits, bool is_float, const std::uint8_t* row, 
         lin.put_pixels(row, r, stride, {0, 1, 2});
 }
 
+}  // namespace
+
 // A TIFF-structured camera RAW goes to LibRaw, whose TIFF parser trusts the file (Debian's LibRaw
 // 0.20 reads out of bounds on some malformed directories). Its structure is checked here first:
 // every directory reachable from the header (the IFD chain, SubIFDs, the EXIF and GPS IFDs) lies
 // inside the file, has at most 1000 entries of a known type (1 to 13) whose values lie inside the
-// file. Classic TIFF only.
-void check_raw_structure(Bytes bytes, const std::string& name) {
+// file. Classic TIFF only; with any_version, whatever the two bytes after the byte order say
+// (LibRaw parses every file that starts with II or MM as TIFF directories from offset 4).
+void check_raw_structure(Bytes bytes, const std::string& name, bool any_version) {
     auto fail = [&](const std::string& what) {
         throw DataError(concat(name, ": camera RAW with a corrupt TIFF structure (", what, ")"));
     };
@@ -222,7 +225,7 @@ void check_raw_structure(Bytes bytes, const std::string& name) {
                       : (std::uint32_t{bytes[at]} << 24 | std::uint32_t{bytes[at + 1]} << 16 |
                          std::uint32_t{bytes[at + 2]} << 8 | std::uint32_t{bytes[at + 3]});
     };
-    if (u16(2) != 42) fail("BigTIFF or an unknown version");
+    if (!any_version && u16(2) != 42) fail("BigTIFF or an unknown version");
     static constexpr std::uint32_t kTypeBytes[14] = {0, 1, 1, 2, 4, 8, 1, 1, 2, 4, 8, 4, 8, 4};
     std::vector<std::uint32_t> pending = {u32(4)};
     std::vector<std::uint32_t> seen;
@@ -258,13 +261,11 @@ void check_raw_structure(Bytes bytes, const std::string& name) {
     }
 }
 
-}  // namespace
-
 std::optional<LinearImage> decode_tiff(Bytes bytes, const std::string& name,
                                        const ReadOptions& options) {
     // Canon CR2: a TIFF header followed by "CR" and the format's version.
     if (bytes.size() >= 10 && bytes[8] == 'C' && bytes[9] == 'R') {
-        check_raw_structure(bytes, name);
+        check_raw_structure(bytes, name, false);
         return std::nullopt;
     }
     TiffMemory memory{bytes, 0};
@@ -283,7 +284,7 @@ std::optional<LinearImage> decode_tiff(Bytes bytes, const std::string& name,
         (has_photometric &&
          (photometric == PHOTOMETRIC_CFA || photometric == kPhotometricLinearRaw)) ||
         (subfile & FILETYPE_REDUCEDIMAGE) != 0) {
-        check_raw_structure(bytes, name);
+        check_raw_structure(bytes, name, false);
         return std::nullopt;
     }
 

@@ -167,6 +167,11 @@ LinearImage decode_image(std::span<const std::uint8_t> bytes, const std::string&
         std::optional<LinearImage> tiff = detail::decode_tiff(bytes, name, options);
         image = tiff ? std::move(*tiff) : detail::decode_raw(bytes, name, options, false);
     } else {
+        // LibRaw reads any file that starts with II or MM as TIFF directories (ORF, RW2, ...),
+        // except Canon's CRW (HEAPCCDR at 6): checked first, as a TIFF-structured RAW is.
+        const bool tiff_like = starts_with(bytes, "II") || starts_with(bytes, "MM");
+        const bool crw = bytes.size() >= 6 && starts_with(bytes.subspan(6), "HEAPCCDR");
+        if (tiff_like && !crw) detail::check_raw_structure(bytes, name, true);
         image = detail::decode_raw(bytes, name, options, true);
     }
     if (options.white_balance && image.info.format != "raw")
