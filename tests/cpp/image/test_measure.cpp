@@ -608,26 +608,21 @@ TEST(MeasureThreads, TheFirstFailingCaptureGivesTheError) {
     third.image = other.string();
     request.captures[1].image = (dir / "nope.tiff").string();
     request.captures.push_back(third);
-    for (const std::size_t threads : {1U, 2U, 3U}) {
-        request.threads = threads;
-        try {
-            (void)measure(request);
-            FAIL() << "no error";
-        } catch (const DataError& e) {
-            EXPECT_NE(std::string(e.what()).find("nope.tiff"), std::string::npos) << e.what();
+    const auto expect_error_naming = [&](const std::string& needle) {
+        for (const std::size_t threads : {1U, 2U, 3U}) {
+            request.threads = threads;
+            try {
+                (void)measure(request);
+                ADD_FAILURE() << "no error with " << threads << " threads";
+            } catch (const DataError& e) {
+                EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
+            }
         }
-    }
+    };
+    expect_error_naming("nope.tiff");
     // Capture 0 missing: its own error (not the others' wait for its size).
     request.captures[0].image = (dir / "first_missing.tiff").string();
-    for (const std::size_t threads : {1U, 2U, 3U}) {
-        request.threads = threads;
-        try {
-            (void)measure(request);
-            FAIL() << "no error";
-        } catch (const DataError& e) {
-            EXPECT_NE(std::string(e.what()).find("first_missing"), std::string::npos) << e.what();
-        }
-    }
+    expect_error_naming("first_missing");
 }
 
 TEST(MeasureFailures, AMissingImageIsADataErrorNamingIt) {
