@@ -212,8 +212,9 @@ struct RoughnessMap {
     std::string method;  // "table (Eq. 17/19)", "table (two-geometry model)", "solver per tile"
 };
 
-// Throws InvalidArgument (fewer than 2 captures, a null image, images of different sizes,
-// window_px or other options out of range, a normal map or region labels of the wrong size,
+// Throws InvalidArgument (fewer than 2 captures, a null image, images of different sizes, a
+// non-finite value in either of the two images (checked as the map reads them), window_px or
+// other options out of range, a normal map or region labels of the wrong size,
 // missing light/view for a normal map) or DataError (capture 2 moved against capture 1 by more
 // than max_shift_px: the message gives the shift and the threshold). With more than two captures
 // the first two are used and a warning says so (a per-tile least-squares fit is left to

@@ -40,7 +40,8 @@ struct Registration {
     std::size_t crop_height_px = 0;
 };
 
-// Throws InvalidArgument when an image is inconsistent (check_linear_image), the two differ in
+// Throws InvalidArgument when an image is inconsistent (check_linear_image_layout, and a
+// non-finite value in the correlated crop: the only values read), the two differ in
 // width, height or channels, either side is below 16 pixels, or max_side_px < 16.
 Registration estimate_misregistration(const LinearImage& a, const LinearImage& b,
                                       const RegistrationOptions& options = {});

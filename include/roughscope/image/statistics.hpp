@@ -57,8 +57,10 @@ void check_region_statistics_options(const RegionStatisticsOptions& options);
 // Statistics of the pixels of `image` where mask is nonzero (mask: one byte per pixel, row-major,
 // as rasterize() returns). A pixel with any flag bit set (saturated, clipped low, or any other
 // bit) is never averaged in. Throws InvalidArgument for an inconsistent image
-// (check_linear_image), a mask whose size is not the image's, an empty region, a region with no
-// usable pixel, or more flagged pixels than options.max_excluded_fraction.
+// (check_linear_image_layout), a non-finite value at a used pixel (a value that is never read —
+// outside the region or flagged — is not checked), a mask whose size is not the image's, an empty
+// region, a region with no usable pixel, or more flagged pixels than
+// options.max_excluded_fraction.
 RegionStatistics region_statistics(const LinearImage& image, const std::vector<std::uint8_t>& mask,
                                    const RegionStatisticsOptions& options = {});
 
