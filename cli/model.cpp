@@ -280,14 +280,16 @@ std::vector<LafortuneLobe> lafortune_lobes(const Args& a) {
     return lobes;
 }
 
-json to_json_number(const std::optional<double>& v) { return serialize::number(v); }
-
 // A result record: its keys (string literals) in output order and their values. Unlike a JSON
 // object it allocates no key, and one record is reused row after row (clear() keeps the slots and
 // their strings' storage); to_json() gives the object, and RecordWriter formats the record
 // directly with the bytes the object's dump would give.
 class Record {
   public:
+    // A number to record: null when unknown or not finite, as serialize::number gives it.
+    struct NumberOrNull {
+        std::optional<double> value;
+    };
     // A JSON value: null, a boolean, a number, a string, or (Nested) any other JSON value.
     struct Value {
         enum class Kind { Null, Boolean, Number, Text, Nested };
@@ -332,8 +334,17 @@ class Record {
             return *this;
         }
         Value& operator=(const char* t) { return *this = std::string_view(t); }
-        // Numbers go through serialize::number (rounded as every printed result): a bare double
-        // would otherwise convert to bool.
+        // Numbers come as NumberOrNull (serialize::number's rule: finite, else null): a bare
+        // double would otherwise convert to bool.
+        Value& operator=(NumberOrNull n) {
+            if (n.value && std::isfinite(*n.value)) {
+                kind = Kind::Number;
+                number = *n.value;
+            } else {
+                kind = Kind::Null;
+            }
+            return *this;
+        }
         Value& operator=(double) = delete;
         Value& operator=(int) = delete;
         Value& operator=(const std::string& t) { return *this = std::string_view(t); }
@@ -372,10 +383,26 @@ class Record {
     };
 
     Record() { items_.reserve(32); }  // every key of a record without regrowing
-    void clear() { size_ = 0; }
+    void clear() {
+        previous_size_ = size_;
+        size_ = 0;
+        same_prefix_ = true;
+    }
     Value& operator[](std::string_view key) {
+        // Row after row the keys come in the same order: while this record's keys so far are the
+        // previous record's, a key that was new at this position then (it is not among them) is
+        // new now, found without a search. Keys are literals, compared by address first.
+        if (same_prefix_ && size_ < previous_size_) {
+            const std::string_view slot = items_[size_].key;
+            if (slot.data() == key.data() && slot.size() == key.size()) {
+                Item& item = items_[size_++];
+                item.value = nullptr;
+                return item.value;
+            }
+        }
         for (std::size_t k = 0; k < size_; ++k)
             if (items_[k].key == key) return items_[k].value;
+        same_prefix_ = false;
         if (size_ == items_.size()) items_.emplace_back();
         Item& item = items_[size_++];
         item.key = key;
@@ -396,6 +423,8 @@ class Record {
   private:
     std::vector<Item> items_;
     std::size_t size_ = 0;
+    std::size_t previous_size_ = 0;  // the keys of the record before clear()
+    bool same_prefix_ = false;       // items_[0, size_) are that record's first keys
 };
 
 // B–K model (Eq. 1–5, §3.2–3.3) at one point: adds its keys to `out`, returns the brightness.
@@ -420,14 +449,14 @@ double evaluate_bk(const Args& a, const Point& p, const Roughness& r, Record& ou
             // The keys of serialize::to_json(ScatteredPower), set directly (once per CSV row).
             const ScatteredPower power = mean_scattered_power(*p.geom, surface, options);
             brightness = serialize::number(power.brightness).get<double>();
-            out["coherent"] = serialize::number(power.coherent);
-            out["diffuse"] = serialize::number(power.diffuse);
-            out["total"] = serialize::number(power.total);
-            out["g"] = serialize::number(power.g);
+            out["coherent"] = Record::NumberOrNull{power.coherent};
+            out["diffuse"] = Record::NumberOrNull{power.diffuse};
+            out["total"] = Record::NumberOrNull{power.total};
+            out["g"] = Record::NumberOrNull{power.g};
             out["regime"] = std::string(to_string(power.regime));
             out["roughness_class"] = std::string(to_string(power.roughness_class));
             out["method"] = std::string(to_string(power.method));
-            out["relative_error_bound"] = serialize::number(power.relative_error_bound);
+            out["relative_error_bound"] = Record::NumberOrNull{power.relative_error_bound};
         } else {
             coherent = diffuse = total = 0.0;  // light or viewer below the horizon
         }
@@ -456,31 +485,31 @@ double evaluate_bk(const Args& a, const Point& p, const Roughness& r, Record& ou
     }
 
     if (!out.contains("coherent")) {  // not from the serialized ScatteredPower
-        out["coherent"] = to_json_number(coherent);
-        out["diffuse"] = to_json_number(diffuse);
-        out["total"] = to_json_number(total);
-        out["g"] = to_json_number(g);
+        out["coherent"] = Record::NumberOrNull{coherent};
+        out["diffuse"] = Record::NumberOrNull{diffuse};
+        out["total"] = Record::NumberOrNull{total};
+        out["g"] = Record::NumberOrNull{g};
         out["regime"] = regime ? json(*regime) : json(nullptr);
         out["roughness_class"] = roughness_class ? json(*roughness_class) : json(nullptr);
         out["method"] = std::string(to_string(DiffuseMethod::ClosedForm));
-        out["relative_error_bound"] = serialize::number(0.0);
+        out["relative_error_bound"] = Record::NumberOrNull{0.0};
     }
     out["scale"] = absolute ? "absolute" : "relative";
     out["correlation"] = std::string(to_string(a.correlation));
     out["factor"] = std::string(to_string(a.factor));
     out["radiometry"] = std::string(to_string(a.radiometry));
-    out["wavelength_um"] = serialize::number(a.wavelength_um);
-    out["patch_x_um"] = serialize::number(a.patch_x_um);
-    out["patch_y_um"] = serialize::number(a.patch_y_um);
-    out["sigma_um"] = to_json_number(r.sigma_um);
-    out["T_um"] = to_json_number(r.T_um);
-    out["sigma_over_T"] = to_json_number(m);
+    out["wavelength_um"] = Record::NumberOrNull{a.wavelength_um};
+    out["patch_x_um"] = Record::NumberOrNull{a.patch_x_um};
+    out["patch_y_um"] = Record::NumberOrNull{a.patch_y_um};
+    out["sigma_um"] = Record::NumberOrNull{r.sigma_um};
+    out["T_um"] = Record::NumberOrNull{r.T_um};
+    out["sigma_over_T"] = Record::NumberOrNull{m};
     // §3.5: Caron's angle of RMS slope (Gaussian height distribution and correlation only).
     std::optional<double> theta_K_deg;
     if (a.correlation == Correlation::Gaussian && m) {
         theta_K_deg = rad_to_deg(caron_theta_K_rad(*m));
     }
-    out["caron_theta_K_deg"] = to_json_number(theta_K_deg);
+    out["caron_theta_K_deg"] = Record::NumberOrNull{theta_K_deg};
     return brightness;
 }
 
@@ -516,8 +545,8 @@ void evaluate(const Args& a, const Point& p, const Roughness& r, Record& out) {
                                  ? oren_nayar_radiance(*p.geom, params)
                                  : oren_nayar_qualitative_radiance(*p.geom, params);
             }
-            out["on_sigma_rad"] = serialize::number(a.on_sigma_rad);
-            out["albedo"] = serialize::number(a.albedo);
+            out["on_sigma_rad"] = Record::NumberOrNull{a.on_sigma_rad};
+            out["albedo"] = Record::NumberOrNull{a.albedo};
             break;
         }
         case ModelKind::Lafortune: {
@@ -537,12 +566,12 @@ void evaluate(const Args& a, const Point& p, const Roughness& r, Record& out) {
                                       {"n", serialize::number(l.n)},
                                       {"rho", serialize::number(l.albedo)}});
             }
-            out["rho_d"] = serialize::number(a.rho_d);
+            out["rho_d"] = Record::NumberOrNull{a.rho_d};
             out["lobes"] = lobes_json;
             break;
         }
     }
-    out["brightness"] = serialize::number(brightness);
+    out["brightness"] = Record::NumberOrNull{brightness};
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -655,6 +684,10 @@ void append_csv_cell(std::string& out, const Record::Value& v) {
         return;
     }
     if (v.kind == Kind::Null) return;  // cell_text: ""
+    if (v.kind == Kind::Boolean) {
+        out += v.boolean ? "true" : "false";
+        return;
+    }
     if (v.kind == Kind::Text && plain_text(v.text)) {
         out += v.text;
         return;

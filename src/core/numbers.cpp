@@ -2,11 +2,13 @@
 #include "roughscope/core/numbers.hpp"
 
 #include <algorithm>
+#include <bit>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <limits>
+#include <optional>
 #include <system_error>
 
 #include "roughscope/core/errors.hpp"
@@ -53,6 +55,88 @@ int significant_digits(std::string_view text) {
     return count;
 }
 
+// printf's "%.*g" characters of the decimal ±0.d₁d₂…d_k·10^(exponent+1) rounded to `digits`
+// significant digits (dig holds k ≤ digits of them; trailing zeros are dropped here).
+char* write_g(char* out, bool negative, const char* dig, int k, int exponent, int digits) {
+    while (k > 1 && dig[k - 1] == '0') --k;  // %g drops trailing zeros
+    char* o = out;
+    if (negative) *o++ = '-';
+    if (exponent < -4 || exponent >= digits) {  // style e
+        *o++ = dig[0];
+        if (k > 1) {
+            *o++ = '.';
+            for (int i = 1; i < k; ++i) *o++ = dig[i];
+        }
+        *o++ = 'e';
+        *o++ = exponent < 0 ? '-' : '+';
+        const int e = std::abs(exponent);
+        if (e < 10) *o++ = '0';
+        o = std::to_chars(o, o + 4, e).ptr;
+    } else if (exponent >= 0) {  // style f, integer part of exponent + 1 digits
+        for (int i = 0; i <= exponent; ++i) *o++ = i < k ? dig[i] : '0';
+        if (k > exponent + 1) {
+            *o++ = '.';
+            for (int i = exponent + 1; i < k; ++i) *o++ = dig[i];
+        }
+    } else {  // style f, 0.000ddd
+        *o++ = '0';
+        *o++ = '.';
+        for (int i = 0; i < -exponent - 1; ++i) *o++ = '0';
+        for (int i = 0; i < k; ++i) *o++ = dig[i];
+    }
+    return o;
+}
+
+// |value| rounded to `digits` (1..15) significant digits, m·10^(exponent − digits + 1) with
+// 10^(digits−1) ≤ m < 10^digits, from one scaling t = |value|·10^s: with 10^s exact (|s| ≤ 22)
+// the product or quotient is correctly rounded, within half an ulp of t of the exact one, so
+// rounding t to an integer gives the correctly rounded m unless the exact value may lie within
+// that distance of a half-integer (an exact tie among them) — then, and outside the range of
+// exact powers, nullopt and the caller takes the exact path.
+struct ScaledDigits {
+    std::int64_t m = 0;
+    int exponent = 0;  // decimal exponent of the leading digit
+};
+
+constexpr double kExactPow10[] = {1e0,  1e1,  1e2,  1e3,  1e4,  1e5,  1e6,  1e7,
+                                  1e8,  1e9,  1e10, 1e11, 1e12, 1e13, 1e14, 1e15,
+                                  1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22};
+constexpr int kMaxExactPow10 = 22;
+
+double scale_by_pow10(double a, int s) {
+    return s >= 0 ? a * kExactPow10[s] : a / kExactPow10[-s];
+}
+
+std::optional<ScaledDigits> round_by_scaling(double value, int digits) {
+    const double a = std::abs(value);
+    if (!(a >= std::numeric_limits<double>::min()) || !std::isfinite(a)) return std::nullopt;
+    // a in [2^(b-1), 2^b) for the biased exponent field E: b = E − 1022; floor((b − 1)·log10 2),
+    // the decimal exponent or one less, as (b − 1)·78913 / 2^18 rounded down (exact for
+    // |b| < 1650).
+    const int binary_exponent =
+        static_cast<int>((std::bit_cast<std::uint64_t>(a) >> 52) & 0x7ff) - 1022;
+    int exponent = ((binary_exponent - 1) * 78913) >> 18;
+    const double top = kExactPow10[digits];
+    int s = digits - 1 - exponent;
+    if (s > kMaxExactPow10 || s < -kMaxExactPow10) return std::nullopt;
+    double t = scale_by_pow10(a, s);
+    if (t >= top) {
+        ++exponent;
+        --s;
+        if (s < -kMaxExactPow10) return std::nullopt;
+        t = scale_by_pow10(a, s);
+    }
+    const auto floor_t = static_cast<double>(static_cast<std::int64_t>(t));  // t < 10^15
+    const double fraction = t - floor_t;
+    if (std::abs(fraction - 0.5) <= t * 0x1p-52) return std::nullopt;  // a tie within the error
+    auto m = static_cast<std::int64_t>(floor_t) + (fraction > 0.5 ? 1 : 0);
+    if (m == static_cast<std::int64_t>(top)) {  // rounded up to 10^digits
+        m /= 10;
+        ++exponent;
+    }
+    if (m < static_cast<std::int64_t>(kExactPow10[digits - 1])) return std::nullopt;
+    return ScaledDigits{m, exponent};
+}
 }  // namespace
 
 std::string_view trim_space(std::string_view s) {
@@ -165,6 +249,22 @@ std::string format_roundtrip(double value, std::string_view name) {
 // among the shortest, closest) digits exclude; S ending on an exact tie ("…5" right after the
 // kept digits) goes to the exact path.
 SignificantDigits::SignificantDigits(double value) : value_(value) {
+    // The digits correctly rounded to kScaledDigits by one exact scaling (cheap), which serve
+    // every precision up to that; the shortest round-trip digits when that is not exact.
+    if (const auto r = round_by_scaling(value, kScaledDigits)) {
+        const char* const end = std::to_chars(digits_, digits_ + sizeof digits_, r->m).ptr;
+        count_ = static_cast<int>(end - digits_);
+        while (count_ > 1 && digits_[count_ - 1] == '0') --count_;
+        exponent_ = r->exponent;
+        negative_ = std::signbit(value);
+        decomposed_ = true;
+        precise_up_to_ = kScaledDigits;
+        return;
+    }
+    *this = SignificantDigits(value, Shortest{});
+}
+
+SignificantDigits::SignificantDigits(double value, Shortest) : value_(value) {
     const double magnitude = std::abs(value);
     if (!(magnitude >= std::numeric_limits<double>::min()) || !std::isfinite(value)) return;
     char sci[kSignificantBufferSize];
@@ -187,9 +287,30 @@ SignificantDigits::SignificantDigits(double value) : value_(value) {
     decomposed_ = true;
 }
 
+double SignificantDigits::parsed(int digits) const {
+    if (digits < 1 || digits > precise_up_to_ || !decomposed_)
+        return parse_significant(value_, digits);
+    if (count_ == digits + 1 && digits_[digits] == '5') return parse_significant(value_, digits);
+    const int k = std::min(count_, digits);
+    std::int64_t m = 0;
+    for (int i = 0; i < k; ++i) m = m * 10 + (digits_[i] - '0');
+    if (count_ > digits && digits_[digits] >= '5') ++m;  // may reach 10^digits: still exact
+    const int q = exponent_ - (k - 1);
+    if (q > kMaxExactPow10 || q < -kMaxExactPow10) return parse_significant(value_, digits);
+    // m < 2^53 and 10^|q| exact: one correctly rounded operation, as strtod rounds.
+    const double v = scale_by_pow10(static_cast<double>(m), q);
+    return negative_ ? -v : v;
+}
+
+bool SignificantDigits::rounding_may_stay_close(int digits) const {
+    if (!decomposed_ || digits < 1 || digits > 13 || digits >= count_) return true;
+    return digits_[digits] == '0' || digits_[digits] == '9';
+}
+
 char* SignificantDigits::write(char* out, int digits) const {
     if (digits < 1 || digits > 15 || !decomposed_)
         return write_significant_exact(out, value_, digits);
+    if (digits > precise_up_to_) return SignificantDigits(value_, Shortest{}).write(out, digits);
     char dig[24];
     int k = count_;
     int exponent = exponent_;
@@ -210,38 +331,38 @@ char* SignificantDigits::write(char* out, int digits) const {
             }
         }
     }
-    while (k > 1 && dig[k - 1] == '0') --k;  // %g drops trailing zeros
-    char* o = out;
-    if (negative_) *o++ = '-';
-    if (exponent < -4 || exponent >= digits) {  // style e
-        *o++ = dig[0];
-        if (k > 1) {
-            *o++ = '.';
-            for (int i = 1; i < k; ++i) *o++ = dig[i];
-        }
-        *o++ = 'e';
-        *o++ = exponent < 0 ? '-' : '+';
-        const int e = std::abs(exponent);
-        if (e < 10) *o++ = '0';
-        o = std::to_chars(o, o + 4, e).ptr;
-    } else if (exponent >= 0) {  // style f, integer part of exponent + 1 digits
-        for (int i = 0; i <= exponent; ++i) *o++ = i < k ? dig[i] : '0';
-        if (k > exponent + 1) {
-            *o++ = '.';
-            for (int i = exponent + 1; i < k; ++i) *o++ = dig[i];
-        }
-    } else {  // style f, 0.000ddd
-        *o++ = '0';
-        *o++ = '.';
-        for (int i = 0; i < -exponent - 1; ++i) *o++ = '0';
-        for (int i = 0; i < k; ++i) *o++ = dig[i];
-    }
-    return o;
+    return write_g(out, negative_, dig, k, exponent, digits);
 }
 
 char* write_significant(char* out, double value, int digits) {
     if (digits < 1 || digits > 15) return write_significant_exact(out, value, digits);
-    return SignificantDigits(value).write(out, digits);
+    if (const auto r = round_by_scaling(value, digits)) {
+        char dig[24];
+        const int k = static_cast<int>(std::to_chars(dig, dig + sizeof dig, r->m).ptr - dig);
+        return write_g(out, std::signbit(value), dig, k, r->exponent, digits);
+    }
+    return SignificantDigits(value, SignificantDigits::Shortest{}).write(out, digits);
+}
+
+double parse_significant(double value, int digits) {
+    if (digits >= 1 && digits <= 15) {
+        if (const auto r = round_by_scaling(value, digits)) {
+            const int q = r->exponent - (digits - 1);
+            if (q >= -kMaxExactPow10 && q <= kMaxExactPow10) {
+                // m < 2^53 and 10^|q| exact: one correctly rounded operation, as strtod rounds.
+                const double v = scale_by_pow10(static_cast<double>(r->m), q);
+                return std::signbit(value) ? -v : v;
+            }
+        }
+    }
+    char buf[kSignificantBufferSize + 1];
+    char* const end = write_significant(buf, value, digits);
+    double v = 0.0;
+    if (std::from_chars(buf, end, v).ec != std::errc()) {
+        *end = '\0';
+        v = std::strtod(buf, nullptr);  // from_chars refuses what strtod rounds to 0 or inf
+    }
+    return v;
 }
 
 std::string format_significant(double value, int digits, std::string_view name) {

@@ -1,11 +1,7 @@
 // JSON building blocks (serialize/json.hpp).
 #include "roughscope/serialize/json.hpp"
 
-#include <charconv>
 #include <cmath>
-#include <cstdio>
-#include <cstdlib>
-#include <system_error>
 
 #include "roughscope/core/numbers.hpp"
 #include "roughscope/scattering/geometry.hpp"
@@ -20,17 +16,12 @@ Json number(const std::optional<double>& value) { return value ? number(*value) 
 Json degrees(double radians) {
     const double deg = rad_to_deg(radians);
     if (!std::isfinite(deg)) return nullptr;
-    char buf[kSignificantBufferSize + 1];
-    const SignificantDigits significant(deg);  // the shortest digits found once
+    // A rounding that moves deg by relative 1e-14 or more cannot map to the same radians (they
+    // are within an ulp or two of each other): those precisions are not tried.
+    const SignificantDigits significant(deg);
     for (int digits = 1; digits <= 17; ++digits) {
-        // "%.*g" and strtod, without printf's format parsing (SignificantDigits gives printf's
-        // characters; from_chars rounds as strtod).
-        char* const end = significant.write(buf, digits);
-        double candidate = deg;
-        if (std::from_chars(buf, end, candidate).ec != std::errc()) {
-            *end = '\0';
-            candidate = std::strtod(buf, nullptr);
-        }
+        if (!significant.rounding_may_stay_close(digits)) continue;
+        const double candidate = significant.parsed(digits);  // strtod("%.*g")
         if (deg_to_rad(candidate) == radians) return candidate;
     }
     return deg;

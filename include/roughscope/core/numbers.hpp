@@ -66,21 +66,40 @@ std::string format_significant(double value, int digits, std::string_view name =
 
 // Writes the "%.*g" text of a finite `value` (1 <= digits <= 17, C locale, "-0" kept: the bytes
 // std::snprintf writes) at `out`, which must have room for kSignificantBufferSize characters;
-// returns the end. Digits <= 15 of a normal number come from the shortest round-trip digits
-// (which are the correctly rounded ones at that precision, rounded once more unless they end on
-// an exact tie); everything else from std::to_chars with a precision.
+// returns the end. Digits <= 15 of a normal number come from one scaling by an exact power of
+// ten rounded to an integer when that is provably the correct rounding (not near a tie, the
+// power within 10^±22), else from the shortest round-trip digits (which are the correctly rounded
+// ones at that precision, rounded once more unless they end on an exact tie); everything else
+// from std::to_chars with a precision.
 inline constexpr std::size_t kSignificantBufferSize = 32;
 char* write_significant(char* out, double value, int digits);
 
-// write_significant at several precisions of one value: the shortest round-trip digits are
-// found once (the costly step), and each write() rounds them (same bytes as write_significant).
+// The double that write_significant's text reads as (strtod of "%.*g"), for a finite `value`
+// and 1 <= digits <= 17; found without the text when it can be exactly (the rounded digits
+// m·10^q of exact operands, |q| <= 22, in one correctly rounded operation).
+double parse_significant(double value, int digits);
+
+// write_significant at several precisions of one value: its digits are found once — rounded to
+// 12 digits by one exact scaling where write_significant's fast path applies, else the shortest
+// round-trip digits — and each write() rounds them (same bytes as write_significant).
 class SignificantDigits {
   public:
     explicit SignificantDigits(double value);
     char* write(char* out, int digits) const;
+    // parse_significant(value, digits), from the digits found once.
+    double parsed(int digits) const;
+    // False when rounding to `digits` (<= 13) moves the value by at least a tenth of a unit in
+    // the last kept place (the dropped digits start with 1..8): relative 1e-14 or more.
+    bool rounding_may_stay_close(int digits) const;
 
   private:
+    friend char* write_significant(char* out, double value, int digits);
+    struct Shortest {};
+    static constexpr int kScaledDigits = 12;
+    SignificantDigits(double value, Shortest);  // the shortest round-trip digits
+
     double value_;
+    int precise_up_to_ = 15;   // the precisions the digits give (more: found again)
     bool decomposed_ = false;  // false: every precision through the exact path
     bool negative_ = false;
     int count_ = 0;  // digits in digits_

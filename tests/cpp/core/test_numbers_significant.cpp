@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <limits>
 #include <random>
@@ -116,17 +117,21 @@ TEST(WriteSignificant, MatchesPrintfOnRandomBitPatterns) {
 }
 
 TEST(WriteSignificant, MatchesPrintfOnRandomDecimalsAndSubnormals) {
-    // Short decimals (ties after rounding are common among them), and subnormals (whose
-    // shortest digits are not the rounded ones).
+    // Short decimals (ties after rounding are common among them), subnormals (whose shortest
+    // digits are not the rounded ones) and any mantissa between 2^-75 and 2^75.
     std::mt19937_64 rng(7);
     std::uniform_int_distribution<int> mantissa(0, 99999999), exponent(-30, 30);
     std::uniform_int_distribution<std::uint64_t> subnormal(1, (std::uint64_t{1} << 52) - 1);
     for (int i = 0; i < 100000; ++i) {
         const double d = mantissa(rng) * std::pow(10.0, exponent(rng));
         const double s = from_bits(subnormal(rng));
+        // Any bits in the range where one exact power of ten scales to the digits (10^±22).
+        const double r = std::ldexp(from_bits(0x3ff0000000000000 | (rng() >> 12)),
+                                    static_cast<int>(rng() % 150) - 75);
         for (int digits = 1; digits <= 17; ++digits) {
             expect_same(d, digits);
             expect_same(-s, digits);
+            expect_same(r, digits);
         }
     }
 }
@@ -136,9 +141,15 @@ TEST(WriteSignificant, OneDecompositionWritesEveryPrecisionAsPrintf) {
     // degrees echo of serialize::degrees tries 1, 2, ... digits): printf's bytes at each.
     std::mt19937_64 rng(31);
     std::vector<double> values = edge_values();
+    std::uniform_int_distribution<int> decimals(0, 99999999), places(0, 14);
     for (int i = 0; i < 20000; ++i) {
         const double v = from_bits(rng());
         if (std::isfinite(v)) values.push_back(v);
+        // Where the digits come from one exact scaling (to 12 digits): short decimals, whose
+        // roundings tie, and any mantissa between 2^-75 and 2^75.
+        values.push_back(decimals(rng) / std::pow(10.0, places(rng)));
+        values.push_back(std::ldexp(from_bits(0x3ff0000000000000 | (rng() >> 12)),
+                                    static_cast<int>(rng() % 150) - 75));
     }
     for (const double v : values) {
         const SignificantDigits sd(v);
@@ -146,6 +157,35 @@ TEST(WriteSignificant, OneDecompositionWritesEveryPrecisionAsPrintf) {
             char buf[kSignificantBufferSize];
             const std::string text(buf, sd.write(buf, digits));
             ASSERT_EQ(text, via_snprintf(v, digits)) << v << " digits " << digits;
+        }
+    }
+}
+
+TEST(WriteSignificant, ParseSignificantIsStrtodOfThePrintedText) {
+    // parse_significant(v, d) and SignificantDigits::parsed build the double from the rounded
+    // digits without the text:
+    // the same bits as strtod of printf's "%.*g" at every precision, for short decimals (the
+    // degrees that serialize::degrees echoes), values across the whole exponent range and the
+    // edge values (ties, powers of ten, subnormals: the text path).
+    std::mt19937_64 rng(47);
+    std::vector<double> values = edge_values();
+    std::uniform_int_distribution<int> decimals(0, 9999999), places(0, 12), exponent(-30, 30);
+    std::uniform_real_distribution<double> mantissa(1.0, 10.0);
+    for (int i = 0; i < 20000; ++i) {
+        values.push_back(decimals(rng) / std::pow(10.0, places(rng)));
+        values.push_back(-mantissa(rng) * std::pow(10.0, exponent(rng)));
+        const double v = from_bits(rng());
+        if (std::isfinite(v)) values.push_back(v);
+    }
+    for (const double v : values) {
+        for (int digits = 1; digits <= 17; ++digits) {
+            const double expected = std::strtod(via_snprintf(v, digits).c_str(), nullptr);
+            const double got = parse_significant(v, digits);
+            ASSERT_EQ(std::memcmp(&got, &expected, sizeof got), 0)
+                << v << " digits " << digits << ": " << got << " vs " << expected;
+            const double from_digits = SignificantDigits(v).parsed(digits);
+            ASSERT_EQ(std::memcmp(&from_digits, &expected, sizeof got), 0)
+                << v << " digits " << digits << ": " << from_digits << " vs " << expected;
         }
     }
 }

@@ -3,6 +3,8 @@
 // reject bad input naming the key (each failure test beside its success test).
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <limits>
 #include <random>
 #include <string>
@@ -10,6 +12,8 @@
 #include <gtest/gtest.h>
 
 #include "roughscope/core/errors.hpp"
+#include "roughscope/core/numbers.hpp"
+#include "roughscope/scattering/geometry.hpp"
 #include "roughscope/serialize/comparison.hpp"
 #include "roughscope/serialize/estimation.hpp"
 #include "roughscope/serialize/json.hpp"
@@ -57,6 +61,38 @@ TEST(SerializeJson, DoublesRoundTripExactlyThroughDumpAndParse) {
     ASSERT_EQ(back.size(), values.size());
     for (std::size_t k = 0; k < values.size(); ++k)
         EXPECT_EQ(back[k].get<double>(), values[k]) << k;  // bit-exact, no pre-rounding
+}
+
+TEST(SerializeJson, DegreesAreTheShortestDecimalThatMapsBackToTheRadians) {
+    // The definition, brute force: strtod of printf's "%.*g" of the degrees at 1, 2, ... 17
+    // digits, the first whose deg_to_rad is the radians (the serializer skips precisions that
+    // cannot qualify and builds the candidates without text).
+    const auto brute_force = [](double radians) {
+        const double deg = rad_to_deg(radians);
+        for (int digits = 1; digits <= 17; ++digits) {
+            char buf[64];
+            std::snprintf(buf, sizeof buf, "%.*g", digits, deg);
+            const double candidate = std::strtod(buf, nullptr);
+            if (deg_to_rad(candidate) == radians) return candidate;
+        }
+        return deg;
+    };
+    std::mt19937_64 rng(5);
+    std::uniform_int_distribution<int> tenths(-3600, 3600), places(0, 6);
+    std::uniform_real_distribution<double> any(-7.0, 7.0);
+    std::vector<double> radians = {0.0, deg_to_rad(30.0), deg_to_rad(45.0), deg_to_rad(89.99),
+                                   deg_to_rad(0.1), 1e-300, 1e300, -deg_to_rad(180.0)};
+    for (int k = 0; k < 20000; ++k) {
+        radians.push_back(deg_to_rad(tenths(rng) / std::pow(10.0, places(rng))));  // typed angles
+        radians.push_back(any(rng));  // from vectors: usually 16-17 digits
+        radians.push_back(std::nextafter(radians[radians.size() - 2], 10.0));
+    }
+    for (const double r : radians) {
+        const double expected = brute_force(r);
+        ASSERT_EQ(serialize::degrees(r).get<double>(), expected) << "radians " << r;
+    }
+    EXPECT_EQ(serialize::degrees(deg_to_rad(30.0)).get<double>(), 30.0);
+    EXPECT_TRUE(serialize::degrees(kNaN).is_null());
 }
 
 TEST(SerializeEstimation, RoughnessEstimateHasTheDocumentedKeys) {
