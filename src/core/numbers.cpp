@@ -103,9 +103,7 @@ constexpr double kExactPow10[] = {1e0,  1e1,  1e2,  1e3,  1e4,  1e5,  1e6,  1e7,
                                   1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22};
 constexpr int kMaxExactPow10 = 22;
 
-double scale_by_pow10(double a, int s) {
-    return s >= 0 ? a * kExactPow10[s] : a / kExactPow10[-s];
-}
+double scale_by_pow10(double a, int s) { return s >= 0 ? a * kExactPow10[s] : a / kExactPow10[-s]; }
 
 std::optional<ScaledDigits> round_by_scaling(double value, int digits) {
     const double a = std::abs(value);

@@ -3,6 +3,7 @@
 // (EXIF through libexif, ICC profiles). Not installed.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cstddef>
 #include <cstdint>
@@ -52,8 +53,9 @@ void check_expansion(const std::string& name, std::uint64_t decoded_bytes, std::
 
 // Stored codes to linear values (read.hpp, "The linear scale"). The constructor decides the
 // response (options, else the evidence, else the bit depth), the black and white levels, records
-// them and any warning in image.info, and allocates the image; put() then converts one plane of
-// one row at a time.
+// them and any warning in image.info, and allocates the image — the values uninitialised (no
+// pass over 100 MB that the decoder overwrites), the flags zero; put() then converts one plane of
+// one row at a time, and finish() makes sure every row of every plane came.
 class Linearizer {
   public:
     Linearizer(LinearImage& image, const Layout& layout, const Evidence& evidence,
@@ -71,6 +73,13 @@ class Linearizer {
     void put_pixels(const T* samples, std::size_t row, std::size_t stride,
                     const std::array<std::size_t, 3>& offsets);
 
+    // DataError naming the first row (and plane) that no put() wrote: a decoder that stopped
+    // early on a corrupt file never hands out uninitialised values.
+    void finish() const;
+    // For a decoder that writes image.values and image.flags itself, every pixel of every plane
+    // (LibRaw's): the rows count as written.
+    void mark_every_row_written() { std::fill(row_written_.begin(), row_written_.end(), 1); }
+
     // s = F · R⁻¹(q / F) (read.hpp).
     double linear_code(double code) const;
     double black(std::size_t plane) const { return black_[plane]; }
@@ -80,6 +89,7 @@ class Linearizer {
     void build_tables(int bits);
 
     LinearImage& image_;
+    std::vector<std::uint8_t> row_written_;  // plane · height + row
     Response response_ = Response::Linear;
     double gamma_ = 0.0;
     double full_scale_ = 1.0;

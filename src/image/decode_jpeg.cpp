@@ -165,6 +165,7 @@ bool jpeg_body(JpegState& st) {
         if (jpeg_read_scanlines(&st.cinfo, rows, 1) != 1) break;  // suspended: cannot happen
         st.linearizer->put_pixels(st.row.data(), r, st.layout.channels, {0, 1, 2});
     }
+    st.linearizer->finish();
     jpeg_finish_decompress(&st.cinfo);
     return true;
 }

@@ -232,6 +232,7 @@ bool png_body(PngState& st) {
         }
         for (std::size_t r = 0; r < height; ++r) put_row(st.pixels.data() + r * row_bytes, r);
     }
+    st.linearizer->finish();
     png_read_end(png, info);
     take_exif(st);
     return true;

@@ -204,6 +204,7 @@ LinearImage decode_raw(Bytes bytes, const std::string& name, const ReadOptions& 
                                              std::to_string(sizes.flip),
                                              ") not applied: the pixels are in sensor order"));
     Linearizer lin(image, layout, evidence, options);
+    lin.mark_every_row_written();  // the loops below write every value and flag (=, not |=)
 
     // The linear code of every 16-bit value, and the per-site black unless the options override.
     std::vector<float> linear(std::size_t{1} << 16);

@@ -428,6 +428,7 @@ std::optional<LinearImage> decode_tiff(Bytes bytes, const std::string& name,
             }
         }
     }
+    lin.finish();
     return image;
 }
 

@@ -4,6 +4,7 @@
 #include <bit>
 #include <cmath>
 #include <cstdint>
+#include <span>
 
 #include "roughscope/core/errors.hpp"
 #include "roughscope/core/text.hpp"
@@ -12,10 +13,11 @@ namespace roughscope::image {
 
 namespace {
 
-// The first value that is not finite (exponent bits all ones: ±inf, NaN), or end. Blocks of
-// 1024 are tested with a branch-free OR of comparisons on the bit patterns (vectorised; a plain
-// find_if with std::isfinite is not), and only a block with a hit is searched element by element.
-std::vector<float>::const_iterator first_non_finite(const std::vector<float>& values) {
+// The index of the first value that is not finite (exponent bits all ones: ±inf, NaN), or size.
+// Blocks of 1024 are tested with a branch-free OR of comparisons on the bit patterns (vectorised; a
+// plain find_if with std::isfinite is not), and only a block with a hit is searched element by
+// element.
+std::size_t first_non_finite(std::span<const float> values) {
     constexpr std::uint32_t kExponent = 0x7f800000U;
     constexpr std::size_t kBlock = 1024;
     const std::size_t n = values.size();
@@ -26,21 +28,19 @@ std::vector<float>::const_iterator first_non_finite(const std::vector<float>& va
             any |= static_cast<std::uint32_t>(
                 (std::bit_cast<std::uint32_t>(values[i]) & kExponent) == kExponent);
         if (any != 0) {
-            const auto first = values.begin() + static_cast<std::ptrdiff_t>(start);
-            return std::find_if(first, values.begin() + static_cast<std::ptrdiff_t>(end),
-                                [](float v) { return !std::isfinite(v); });
+            for (std::size_t i = start; i < end; ++i)
+                if (!std::isfinite(values[i])) return i;
         }
     }
-    return values.end();
+    return n;
 }
 
 }  // namespace
 
 void check_linear_image(const LinearImage& image) {
     check_linear_image_layout(image);
-    const auto bad = first_non_finite(image.values);
-    if (bad != image.values.end())
-        throw_non_finite_value(image, static_cast<std::size_t>(bad - image.values.begin()));
+    const std::size_t bad = first_non_finite(image.values);
+    if (bad != image.values.size()) throw_non_finite_value(image, bad);
 }
 
 void throw_non_finite_value(const LinearImage& image, std::size_t sample) {

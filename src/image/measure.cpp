@@ -471,12 +471,13 @@ struct CaptureOutcome {
     std::exception_ptr error;
 };
 
-// The first capture's size (a LinearImage without values) and the region's mask, which every
-// capture is measured with.
+// The first capture's size (a LinearImage without values) and the region, which every capture
+// is measured with: as spans, and as a mask for the measurements that take one (a highlight, a
+// cylinder, a sphere).
 struct FirstCapture {
     LinearImage header;
+    RegionSpans spans;
     std::vector<std::uint8_t> mask;
-    std::size_t region_pixels = 0;
 };
 
 // The captures measured by up to `threads` workers, each taking the next capture in order (so
@@ -513,6 +514,14 @@ class CaptureRun {
     std::vector<CaptureOutcome>& outcomes() { return outcomes_; }
     const FirstCapture& first() const { return first_ready_.get(); }
 
+    // Whether any capture is measured on the region's mask rather than its spans.
+    bool needs_mask() const {
+        return request_.object.shape == ObjectShape::Cylinder ||
+               request_.object.shape == ObjectShape::Sphere ||
+               std::any_of(request_.captures.begin(), request_.captures.end(),
+                           [](const CaptureSpec& c) { return c.role == CaptureRole::Specular; });
+    }
+
   private:
     void work() {
         for (;;) {
@@ -543,9 +552,8 @@ class CaptureRun {
             first.header.channels = image.channels;
             first.header.info.source = image.info.source;
             if (request_.roi) {
-                first.mask = rasterize(*request_.roi, image.width, image.height);
-                first.region_pixels = static_cast<std::size_t>(std::count_if(
-                    first.mask.begin(), first.mask.end(), [](std::uint8_t m) { return m != 0; }));
+                first.spans = region_spans(*request_.roi, image.width, image.height);
+                if (needs_mask()) first.mask = rasterize(first.spans);
             }
             first_.set_value(std::move(first));
             first_published_ = true;
@@ -589,7 +597,7 @@ class CaptureRun {
             for (const auto& w : capture.highlight->warnings)
                 out.warnings.push_back(concat(spec.image, ": ", w));
         } else if (request_.roi) {
-            capture.region = region_statistics(image, first.mask, request_.statistics);
+            capture.region = region_statistics(image, first.spans, request_.statistics);
             for (const auto& w : capture.region.warnings)
                 out.warnings.push_back(concat(spec.image, ": ", w));
         }
@@ -630,7 +638,7 @@ MeasureResult measure(const MeasureRequest& request) {
                 : request.threads);
     const FirstCapture& first_capture = run.first();
     const LinearImage* first = &first_capture.header;
-    result.region_pixels = first_capture.region_pixels;
+    result.region_pixels = first_capture.spans.pixel_count;
     // A map keeps the first two diffuse images (the pair it divides) and their captures' index.
     std::vector<LinearImage> map_images;
     std::vector<std::size_t> map_captures;

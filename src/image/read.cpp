@@ -284,9 +284,20 @@ Linearizer::Linearizer(LinearImage& image, const Layout& layout, const Evidence&
     image.width = layout.width;
     image.height = layout.height;
     image.channels = planes;
-    assign_large(image.values, planes * layout.width * layout.height, 0.0F);
+    resize_large_uninitialised(image.values, planes * layout.width * layout.height);
     assign_large(image.flags, layout.width * layout.height, std::uint8_t{0});
+    row_written_.assign(planes * layout.height, 0);
     bits_ = layout.bits;
+}
+
+void Linearizer::finish() const {
+    const auto missing = std::find(row_written_.begin(), row_written_.end(), 0);
+    if (missing == row_written_.end()) return;
+    const auto k = static_cast<std::size_t>(missing - row_written_.begin());
+    const std::size_t row = k % image_.height, plane = k / image_.height;
+    throw DataError(concat(image_.info.source, ": row ", std::to_string(row),
+                           image_.channels > 1 ? concat(" of plane ", std::to_string(plane)) : "",
+                           " was not decoded (truncated or corrupt)"));
 }
 
 double Linearizer::linear_code(double code) const {
@@ -328,6 +339,7 @@ template <class T>
 void Linearizer::put(const T* samples, std::size_t row, std::size_t stride, std::size_t offset,
                      std::size_t plane) {
     const std::size_t width = image_.width;
+    row_written_[plane * image_.height + row] = 1;
     float* out = image_.values.data() + (plane * image_.height + row) * width;
     std::uint8_t* flags = image_.flags.data() + row * width;
     const T* in = samples + offset;
@@ -442,6 +454,7 @@ void put_linear_pixels(LinearImage& image, const T* samples, std::size_t row, st
 template <class T>
 void Linearizer::put_pixels(const T* samples, std::size_t row, std::size_t stride,
                             const std::array<std::size_t, 3>& offsets) {
+    for (std::size_t c = 0; c < black_.size(); ++c) row_written_[c * image_.height + row] = 1;
     if constexpr (!std::is_same_v<T, float>) {
         if (response_ == Response::Linear) {
             if (black_.size() == 1)

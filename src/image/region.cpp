@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <type_traits>
 
 #include "roughscope/core/errors.hpp"
@@ -56,17 +58,18 @@ std::pair<std::size_t, std::size_t> centre_columns_closed(double lo, double hi, 
     return {static_cast<std::size_t>(first), static_cast<std::size_t>(end)};
 }
 
-void fill_rectangle(const RectangleRegion& r, std::size_t width, std::size_t height,
-                    std::vector<std::uint8_t>& mask) {
+// The shapes as spans of pixel centres within rows, in row order then x (emit(row, x0, x1) with
+// x0 < x1; the spans of a row are disjoint and increasing).
+template <class Emit>
+void rectangle_spans(const RectangleRegion& r, std::size_t width, std::size_t height, Emit&& emit) {
     const auto [x0, x1] = centre_columns_half_open(r.x_px, r.x_px + r.width_px, width);
     const auto [y0, y1] = centre_columns_half_open(r.y_px, r.y_px + r.height_px, height);
-    for (std::size_t y = y0; y < y1; ++y)
-        std::fill(mask.begin() + static_cast<std::ptrdiff_t>(y * width + x0),
-                  mask.begin() + static_cast<std::ptrdiff_t>(y * width + x1), std::uint8_t{1});
+    if (x1 <= x0) return;
+    for (std::size_t y = y0; y < y1; ++y) emit(y, x0, x1);
 }
 
-void fill_circle(const CircleRegion& c, std::size_t width, std::size_t height,
-                 std::vector<std::uint8_t>& mask) {
+template <class Emit>
+void circle_spans(const CircleRegion& c, std::size_t width, std::size_t height, Emit&& emit) {
     const auto [y0, y1] =
         centre_columns_closed(c.centre_y_px - c.radius_px, c.centre_y_px + c.radius_px, height);
     const double r2 = c.radius_px * c.radius_px;
@@ -85,14 +88,14 @@ void fill_circle(const CircleRegion& c, std::size_t width, std::size_t height,
         if (x1 < width && in(x1)) ++x1;
         while (x0 < x1 && !in(x0)) ++x0;
         while (x1 > x0 && !in(x1 - 1)) --x1;
-        for (std::size_t x = x0; x < x1; ++x) mask[y * width + x] = 1;
+        if (x0 < x1) emit(y, x0, x1);
     }
 }
 
 // Scan line through the row's pixel centres: the crossings of the outline (edges half-open in
 // y), sorted; the centres in [x_2k, x_2k+1) are inside (even-odd rule).
-void fill_polygon(const PolygonRegion& p, std::size_t width, std::size_t height,
-                  std::vector<std::uint8_t>& mask) {
+template <class Emit>
+void polygon_spans(const PolygonRegion& p, std::size_t width, std::size_t height, Emit&& emit) {
     const auto& v = p.vertices_px;
     std::vector<double> crossings;
     for (std::size_t y = 0; y < height; ++y) {
@@ -106,7 +109,29 @@ void fill_polygon(const PolygonRegion& p, std::size_t width, std::size_t height,
         std::sort(crossings.begin(), crossings.end());
         for (std::size_t k = 0; k + 1 < crossings.size(); k += 2) {
             const auto [x0, x1] = centre_columns_half_open(crossings[k], crossings[k + 1], width);
-            for (std::size_t x = x0; x < x1; ++x) mask[y * width + x] = 1;
+            if (x0 < x1) emit(y, x0, x1);
+        }
+    }
+}
+
+// The runs of nonzero bytes of a row-major width × height mask (zero words skipped 8 at a time).
+template <class Emit>
+void mask_spans(const std::uint8_t* mask, std::size_t width, std::size_t height, Emit&& emit) {
+    for (std::size_t y = 0; y < height; ++y) {
+        const std::uint8_t* row = mask + y * width;
+        std::size_t x = 0;
+        while (x < width) {
+            while (x + 8 <= width) {
+                std::uint64_t word = 0;
+                std::memcpy(&word, row + x, sizeof word);
+                if (word != 0) break;
+                x += 8;
+            }
+            while (x < width && row[x] == 0) ++x;
+            if (x == width) break;
+            const std::size_t start = x;
+            while (x < width && row[x] != 0) ++x;
+            emit(y, start, x);
         }
     }
 }
@@ -183,7 +208,7 @@ std::string describe(const Region& region) {
         region);
 }
 
-std::vector<std::uint8_t> rasterize(const Region& region, std::size_t width, std::size_t height) {
+RegionSpans region_spans(const Region& region, std::size_t width, std::size_t height) {
     check_region(region);
     if (width == 0 || height == 0)
         throw InvalidArgument(concat("region ", describe(region), ": image of ",
@@ -194,8 +219,14 @@ std::vector<std::uint8_t> rasterize(const Region& region, std::size_t width, std
                    size_text(width, height), " pixels (valid coordinates: x in [0, ",
                    std::to_string(width), "], y in [0, ", std::to_string(height), "])"));
     };
-    std::vector<std::uint8_t> mask;
-    assign_large(mask, width * height, std::uint8_t{0});
+    RegionSpans out;
+    out.width = width;
+    out.height = height;
+    const auto emit = [&](std::size_t y, std::size_t x0, std::size_t x1) {
+        out.spans.push_back({static_cast<std::uint32_t>(y), static_cast<std::uint32_t>(x0),
+                             static_cast<std::uint32_t>(x1)});
+        out.pixel_count += x1 - x0;
+    };
     std::visit(
         [&](const auto& r) {
             using T = std::decay_t<decltype(r)>;
@@ -203,18 +234,18 @@ std::vector<std::uint8_t> rasterize(const Region& region, std::size_t width, std
                 if (!inside_area(r.x_px, r.x_px + r.width_px, width) ||
                     !inside_area(r.y_px, r.y_px + r.height_px, height))
                     throw outside();
-                fill_rectangle(r, width, height, mask);
+                rectangle_spans(r, width, height, emit);
             } else if constexpr (std::is_same_v<T, CircleRegion>) {
                 if (!inside_area(r.centre_x_px - r.radius_px, r.centre_x_px + r.radius_px, width) ||
                     !inside_area(r.centre_y_px - r.radius_px, r.centre_y_px + r.radius_px, height))
                     throw outside();
-                fill_circle(r, width, height, mask);
+                circle_spans(r, width, height, emit);
             } else if constexpr (std::is_same_v<T, PolygonRegion>) {
                 for (const auto& vertex : r.vertices_px)
                     if (!inside_area(vertex[0], vertex[0], width) ||
                         !inside_area(vertex[1], vertex[1], height))
                         throw outside();
-                fill_polygon(r, width, height, mask);
+                polygon_spans(r, width, height, emit);
             } else {
                 static_assert(std::is_same_v<T, MaskRegion>, "unhandled region type");
                 if (r.width != width || r.height != height)
@@ -222,15 +253,48 @@ std::vector<std::uint8_t> rasterize(const Region& region, std::size_t width, std
                                                  " pixels for an image of ",
                                                  size_text(width, height),
                                                  " pixels; the sizes must be equal"));
-                for (std::size_t k = 0; k < mask.size(); ++k) mask[k] = r.inside[k] != 0 ? 1 : 0;
+                mask_spans(r.inside.data(), width, height, emit);
             }
         },
         region);
-    if (std::find(mask.begin(), mask.end(), std::uint8_t{1}) == mask.end())
+    if (out.pixel_count == 0)
         throw InvalidArgument(concat("region ", describe(region), " holds no pixel centre of the ",
                                      size_text(width, height),
                                      " image (pixel (i, j) has its centre at (i + 0.5, j + 0.5))"));
+    return out;
+}
+
+RegionSpans region_spans(const std::vector<std::uint8_t>& mask, std::size_t width,
+                         std::size_t height) {
+    if (mask.size() != width * height)
+        throw InvalidArgument(concat("region mask of ", std::to_string(mask.size()),
+                                     " pixels for an image of ", size_text(width, height), " = ",
+                                     std::to_string(width * height),
+                                     " pixels; the sizes must be equal"));
+    RegionSpans out;
+    out.width = width;
+    out.height = height;
+    mask_spans(mask.data(), width, height, [&](std::size_t y, std::size_t x0, std::size_t x1) {
+        out.spans.push_back({static_cast<std::uint32_t>(y), static_cast<std::uint32_t>(x0),
+                             static_cast<std::uint32_t>(x1)});
+        out.pixel_count += x1 - x0;
+    });
+    return out;
+}
+
+std::vector<std::uint8_t> rasterize(const RegionSpans& spans) {
+    std::vector<std::uint8_t> mask;
+    assign_large(mask, spans.width * spans.height, std::uint8_t{0});
+    for (const PixelSpan& s : spans.spans) {
+        const std::size_t row = std::size_t{s.row} * spans.width;
+        std::fill(mask.begin() + static_cast<std::ptrdiff_t>(row + s.x_begin),
+                  mask.begin() + static_cast<std::ptrdiff_t>(row + s.x_end), std::uint8_t{1});
+    }
     return mask;
+}
+
+std::vector<std::uint8_t> rasterize(const Region& region, std::size_t width, std::size_t height) {
+    return rasterize(region_spans(region, width, height));
 }
 
 MaskRegion mask_region_from_image(const LinearImage& mask_image) {

@@ -144,13 +144,6 @@ std::uint64_t load_word(const std::uint8_t* p) {
     return w;
 }
 
-// True when none of the 8 bytes of w is zero.
-bool no_zero_byte(std::uint64_t w) {
-    constexpr std::uint64_t kOnes = 0x0101010101010101ULL;
-    constexpr std::uint64_t kHighs = 0x8080808080808080ULL;
-    return ((w - kOnes) & ~w & kHighs) == 0;
-}
-
 struct Box {
     std::size_t x0, y0, x1, y1;  // half-open
 };
@@ -303,6 +296,19 @@ void check_region_statistics_options(const RegionStatisticsOptions& options) {
 
 RegionStatistics region_statistics(const LinearImage& image, const std::vector<std::uint8_t>& mask,
                                    const RegionStatisticsOptions& options) {
+    check_linear_image_layout(image);
+    const std::size_t pixels = image.pixel_count();
+    if (mask.size() != pixels)
+        throw InvalidArgument(concat(image_name(image), ": region mask of ",
+                                     std::to_string(mask.size()), " pixels for an image of ",
+                                     std::to_string(image.width), " x ",
+                                     std::to_string(image.height), " = ", std::to_string(pixels),
+                                     " pixels; the sizes must be equal"));
+    return region_statistics(image, region_spans(mask, image.width, image.height), options);
+}
+
+RegionStatistics region_statistics(const LinearImage& image, const RegionSpans& region,
+                                   const RegionStatisticsOptions& options) {
     // The values are checked where they are read: a non-finite used value makes the plane's
     // shifted sums non-finite (finite floats cannot overflow them in double), and only then are
     // the used values searched for it.
@@ -310,11 +316,11 @@ RegionStatistics region_statistics(const LinearImage& image, const std::vector<s
     check_region_statistics_options(options);
     const std::string name = image_name(image);
     const std::size_t pixels = image.pixel_count();
-    if (mask.size() != pixels)
-        throw InvalidArgument(concat(name, ": region mask of ", std::to_string(mask.size()),
-                                     " pixels for an image of ", std::to_string(image.width), " x ",
-                                     std::to_string(image.height), " = ", std::to_string(pixels),
-                                     " pixels; the sizes must be equal"));
+    if (region.width != image.width || region.height != image.height)
+        throw InvalidArgument(concat(
+            name, ": region of an image of ", std::to_string(region.width), " x ",
+            std::to_string(region.height), " pixels for an image of ", std::to_string(image.width),
+            " x ", std::to_string(image.height), " pixels; the sizes must be equal"));
 
     RegionStatistics out;
     // Pixel indices as 32 bits and the series as float (the image's own precision; sums are
@@ -324,48 +330,36 @@ RegionStatistics region_statistics(const LinearImage& image, const std::vector<s
         throw InvalidArgument(concat(name, ": ", std::to_string(pixels), " pixels, more than the ",
                                      std::to_string(kMaxImagePixelsForStatistics),
                                      " region statistics handle"));
-    // One read of mask and flags: the used pixels as runs within rows (a rectangle: one run per
-    // row), the counts and the bounding box.
+    // One read of the flags inside the region's spans: the used pixels as runs within rows (a
+    // rectangle: one run per row), the counts and the bounding box.
     std::vector<ValueRun> runs;
     Box box{image.width, image.height, 0, 0};
     std::size_t other = 0;  // flagged for another reason (e.g. no flat field)
-    const std::uint8_t* m = mask.data();
     const std::uint8_t* flags = image.flags.data();
     constexpr std::uint8_t kKnownFlags = kPixelSaturated | kPixelClippedLow;
-    // Eight pixels at a time where the mask is all out (a zero word) or all in with no flag.
-    const auto eight_used = [&](std::size_t k) {
-        return no_zero_byte(load_word(m + k)) && load_word(flags + k) == 0;
-    };
-    for (std::size_t y = 0; y < image.height; ++y) {
+    for (const PixelSpan& span : region.spans) {
+        assert(span.x_begin < span.x_end && span.x_end <= image.width && span.row < image.height);
+        const std::size_t y = span.row;
         const std::size_t row = y * image.width;
-        std::size_t x = 0;
-        while (x < image.width) {
-            // Pixels not used: outside the mask, or flagged (counted by reason).
-            while (x < image.width) {
-                if (x + 8 <= image.width) {
-                    if (load_word(m + row + x) == 0) {
-                        x += 8;
-                        continue;
-                    }
-                    if (eight_used(row + x)) break;
-                }
-                if (m[row + x] != 0) {
-                    const std::uint8_t f = flags[row + x];
-                    if (f == 0) break;
-                    ++out.pixels_in_region;
-                    if (f & kPixelSaturated) ++out.pixels_saturated;
-                    if (f & kPixelClippedLow) ++out.pixels_clipped_low;
-                    if (f & ~kKnownFlags) ++other;
-                }
+        const std::size_t end = span.x_end;
+        std::size_t x = span.x_begin;
+        out.pixels_in_region += end - x;
+        while (x < end) {
+            // Flagged pixels (not used), counted by reason.
+            while (x < end && flags[row + x] != 0) {
+                const std::uint8_t f = flags[row + x];
+                if (f & kPixelSaturated) ++out.pixels_saturated;
+                if (f & kPixelClippedLow) ++out.pixels_clipped_low;
+                if (f & ~kKnownFlags) ++other;
                 ++x;
             }
+            // A run of unflagged pixels, eight at a time while the flags are a zero word.
             const std::size_t start = x;
-            while (x + 8 <= image.width && eight_used(row + x)) x += 8;
-            while (x < image.width && m[row + x] != 0 && flags[row + x] == 0) ++x;
+            while (x + 8 <= end && load_word(flags + row + x) == 0) x += 8;
+            while (x < end && flags[row + x] == 0) ++x;
             if (x == start) continue;
             runs.push_back(
                 {static_cast<std::uint32_t>(row + start), static_cast<std::uint32_t>(x - start)});
-            out.pixels_in_region += x - start;
             out.pixels_used += x - start;
             box.x0 = std::min(box.x0, start);
             box.x1 = std::max(box.x1, x);

@@ -20,6 +20,7 @@
 #include <string_view>
 #include <vector>
 
+#include "roughscope/core/memory.hpp"
 #include "roughscope/core/response.hpp"
 
 namespace roughscope::image {
@@ -61,8 +62,10 @@ struct ImageInfo {
 struct LinearImage {
     std::size_t width = 0;
     std::size_t height = 0;
-    std::size_t channels = 0;         // 1 (grey) or 3 (R, G, B)
-    std::vector<float> values;        // channels · height · width, see the layout above
+    std::size_t channels = 0;  // 1 (grey) or 3 (R, G, B)
+    // channels · height · width, see the layout above (a std::vector<float> whose resize does
+    // not zero-fill: a decoder writes every value)
+    std::vector<float, DefaultInitAllocator<float>> values;
     std::vector<std::uint8_t> flags;  // height · width, kPixel* bits
     ImageInfo info;
 

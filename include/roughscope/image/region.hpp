@@ -63,6 +63,27 @@ std::string describe(const Region& region);
 // the image's.
 std::vector<std::uint8_t> rasterize(const Region& region, std::size_t width, std::size_t height);
 
+// The same pixels as spans within rows, without a byte per pixel: the region of a 24-MP image is
+// a few thousand spans (a rectangle: one per row) instead of 24 MB.
+struct PixelSpan {
+    std::uint32_t row = 0;
+    std::uint32_t x_begin = 0, x_end = 0;  // columns [x_begin, x_end), x_begin < x_end
+};
+struct RegionSpans {
+    std::size_t width = 0, height = 0;  // of the image
+    std::vector<PixelSpan> spans;       // by row, then x; disjoint
+    std::size_t pixel_count = 0;        // Σ (x_end − x_begin)
+};
+
+// rasterize()'s pixels as spans, with rasterize()'s checks and errors.
+RegionSpans region_spans(const Region& region, std::size_t width, std::size_t height);
+// The spans of a mask (nonzero bytes) of a width × height image; InvalidArgument when its size is
+// not width · height. An all-zero mask gives no span.
+RegionSpans region_spans(const std::vector<std::uint8_t>& mask, std::size_t width,
+                         std::size_t height);
+// The mask of the spans (1 inside, 0 outside).
+std::vector<std::uint8_t> rasterize(const RegionSpans& spans);
+
 // A mask from an image (e.g. one painted in an editor): pixel inside where the value of channel 0
 // is > 0.5 (on the linear scale, 1 = full scale). Throws InvalidArgument for an inconsistent
 // image (check_linear_image).

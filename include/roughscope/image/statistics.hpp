@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "roughscope/image/image.hpp"
+#include "roughscope/image/region.hpp"
 
 namespace roughscope::image {
 
@@ -62,6 +63,10 @@ void check_region_statistics_options(const RegionStatisticsOptions& options);
 // region, a region with no usable pixel, or more flagged pixels than
 // options.max_excluded_fraction.
 RegionStatistics region_statistics(const LinearImage& image, const std::vector<std::uint8_t>& mask,
+                                   const RegionStatisticsOptions& options = {});
+// The same for the region as spans (region_spans: no mask is read); InvalidArgument when the
+// spans are of an image of another size.
+RegionStatistics region_statistics(const LinearImage& image, const RegionSpans& region,
                                    const RegionStatisticsOptions& options = {});
 
 }  // namespace roughscope::image

@@ -43,7 +43,7 @@ inline image::LinearImage linear_from_radiance(const sim::Capture& capture) {
     img.width = capture.width;
     img.height = capture.height;
     img.channels = 1;
-    img.values = capture.radiance;
+    img.values.assign(capture.radiance.begin(), capture.radiance.end());
     img.flags.assign(capture.radiance.size(), 0);
     img.info.source = "synthetic";
     return img;

@@ -17,6 +17,7 @@
 #include <tiffio.h>
 #include <zlib.h>
 
+#include "image/decode.hpp"
 #include "image_files.hpp"
 #include "roughscope/core/errors.hpp"
 #include "roughscope/image/read.hpp"
@@ -745,13 +746,15 @@ TEST(ReadImage, NaNFloatSamplesAreMissingAndInfiniteOnesDataErrors) {
     const LinearImage g =
         decode(testing::tiff_image(3, 1, 1, 32, 3, testing::raw_bytes(grey)), {}, "nan.tif");
     EXPECT_EQ(g.flags, (std::vector<std::uint8_t>{0, kPixelMissing, 0}));
-    EXPECT_EQ(g.values, (std::vector<float>{0.5F, 0.0F, 0.25F}));
+    EXPECT_EQ(std::vector<float>(g.values.begin(), g.values.end()),
+              (std::vector<float>{0.5F, 0.0F, 0.25F}));
     // RGB (interleaved): one NaN channel flags the pixel; its other channels are kept.
     const std::vector<float> rgb = {0.1F, 0.2F, 0.3F, 0.4F, nan, 0.6F};
     const LinearImage c =
         decode(testing::tiff_image(2, 1, 3, 32, 3, testing::raw_bytes(rgb)), {}, "nan3.tif");
     EXPECT_EQ(c.flags, (std::vector<std::uint8_t>{0, kPixelMissing}));
-    EXPECT_EQ(c.values, (std::vector<float>{0.1F, 0.4F, 0.2F, 0.0F, 0.3F, 0.6F}));  // planar
+    EXPECT_EQ(std::vector<float>(c.values.begin(), c.values.end()),
+              (std::vector<float>{0.1F, 0.4F, 0.2F, 0.0F, 0.3F, 0.6F}));  // planar
     const std::vector<float> inf = {0.5F, -std::numeric_limits<float>::infinity()};
     const ByteVector file = testing::tiff_image(2, 1, 1, 32, 3, testing::raw_bytes(inf));
     expect_error<DataError>([&] { decode(file, {}, "inf.tif"); },
@@ -823,6 +826,40 @@ TEST(ReadOptionsCheck, PerPlaneBlackLevelsMustMatchThePlanes) {
     options.black_level_dn = std::vector<double>{300.0};  // above the 8-bit full scale
     expect_error<InvalidArgument>([&] { decode(testing::png_bytes(spec), options, "grey.png"); },
                                   {"grey.png", "not below the white level 255"});
+}
+
+TEST(Linearizer, AnImageIsHandedOutOnlyWhenEveryRowOfEveryPlaneWasWritten) {
+    // The values are allocated without a fill: finish() names the first row no put() wrote, so a
+    // decoder that stops early never passes uninitialised values on.
+    detail::Layout layout;
+    layout.width = 4;
+    layout.height = 3;
+    layout.channels = 3;
+    layout.bits = 16;
+    layout.full_scale = 65535.0;
+    const std::vector<std::uint16_t> row(12, 1000);
+    {
+        LinearImage image;
+        image.info.source = "rows.tif";
+        detail::Linearizer lin(image, layout, {}, {});
+        lin.put_pixels(row.data(), 0, 3, {0, 1, 2});
+        lin.put_pixels(row.data(), 2, 3, {0, 1, 2});
+        expect_error<DataError>([&] { lin.finish(); }, {"rows.tif", "row 1 of plane 0"});
+        lin.put_pixels(row.data(), 1, 3, {0, 1, 2});
+        EXPECT_NO_THROW(lin.finish());
+        EXPECT_FLOAT_EQ(image.value(2, 1, 3), 1000.0F / 65535.0F);
+    }
+    {
+        // Planes one at a time (a planar TIFF): a plane left out is named.
+        LinearImage image;
+        image.info.source = "planar.tif";
+        detail::Linearizer lin(image, layout, {}, {});
+        for (std::size_t r = 0; r < 3; ++r) {
+            lin.put(row.data(), r, 1, 0, 0);
+            lin.put(row.data(), r, 1, 0, 2);
+        }
+        expect_error<DataError>([&] { lin.finish(); }, {"planar.tif", "row 0 of plane 1"});
+    }
 }
 
 }  // namespace

@@ -220,10 +220,58 @@ LinearImage image_of(std::size_t width, std::size_t height, std::size_t channels
     image.width = width;
     image.height = height;
     image.channels = channels;
-    image.values = values;
+    image.values.assign(values.begin(), values.end());
     image.flags.assign(width * height, 0);
     image.info.source = "mask.png";
     return image;
+}
+
+TEST(Region, SpansAreTheMaskRowByRow) {
+    // Every shape's spans against its mask (itself checked against brute force above), and the
+    // spans of random masks: sorted, disjoint, non-empty, maximal, and back to the same mask.
+    const std::size_t w = 37, h = 23;
+    const std::vector<Region> shapes = {
+        RectangleRegion{2.5, 1.25, 30.0, 20.5}, CircleRegion{18.0, 11.0, 9.7},
+        PolygonRegion{{{{1.0, 1.0}}, {{35.0, 4.0}}, {{5.0, 21.0}}, {{30.0, 20.0}}}}};
+    std::mt19937 rng(3);
+    std::vector<std::vector<std::uint8_t>> masks;
+    for (const Region& r : shapes) masks.push_back(rasterize(r, w, h));
+    for (int k = 0; k < 20; ++k) {
+        std::vector<std::uint8_t> m(w * h);
+        std::bernoulli_distribution in(0.1 + 0.04 * k);
+        for (auto& b : m) b = in(rng) ? static_cast<std::uint8_t>(1 + rng() % 255) : 0;
+        masks.push_back(m);
+    }
+    for (std::size_t i = 0; i < masks.size(); ++i) {
+        const std::vector<std::uint8_t>& m = masks[i];
+        const RegionSpans spans =
+            i < shapes.size() ? region_spans(shapes[i], w, h) : region_spans(m, w, h);
+        EXPECT_EQ(spans.width, w);
+        EXPECT_EQ(spans.height, h);
+        EXPECT_EQ(spans.pixel_count, count(m)) << i;
+        for (std::size_t s = 0; s < spans.spans.size(); ++s) {
+            const PixelSpan& p = spans.spans[s];
+            ASSERT_LT(p.x_begin, p.x_end);
+            ASSERT_LE(p.x_end, w);
+            if (s > 0) {
+                const PixelSpan& q = spans.spans[s - 1];
+                ASSERT_TRUE(q.row < p.row || (q.row == p.row && q.x_end < p.x_begin)) << i;
+            }
+        }
+        std::vector<std::uint8_t> binary(m.size());
+        for (std::size_t k = 0; k < m.size(); ++k) binary[k] = m[k] != 0 ? 1 : 0;
+        EXPECT_EQ(rasterize(spans), binary) << i;
+    }
+    EXPECT_THROW((void)region_spans(std::vector<std::uint8_t>(w * h - 1, 1), w, h),
+                 InvalidArgument);
+    EXPECT_EQ(message_of(CircleRegion{5, 5, 0.1}, 10, 10), [&] {
+        try {
+            (void)region_spans(CircleRegion{5, 5, 0.1}, 10, 10);
+        } catch (const InvalidArgument& e) {
+            return std::string(e.what());
+        }
+        return std::string("(no error)");
+    }());
 }
 
 TEST(Region, MaskFromImageThresholdsChannelZero) {

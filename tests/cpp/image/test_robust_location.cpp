@@ -185,7 +185,8 @@ TEST(RegionRobustLocation, RegionStatisticsOfALargeRegionUseTheSameEstimates) {
     image.width = 160;
     image.height = 120;
     image.channels = 1;
-    image.values = normal(std::size_t{160} * 120, 0.3, 0.01, 13);
+    const std::vector<float> values = normal(std::size_t{160} * 120, 0.3, 0.01, 13);
+    image.values.assign(values.begin(), values.end());
     image.flags.assign(std::size_t{160} * 120, 0);
     image.info.source = "large.tif";
     for (std::size_t k = 0; k < image.values.size(); k += 20) image.values[k] = 0.9F;

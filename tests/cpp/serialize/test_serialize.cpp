@@ -80,8 +80,9 @@ TEST(SerializeJson, DegreesAreTheShortestDecimalThatMapsBackToTheRadians) {
     std::mt19937_64 rng(5);
     std::uniform_int_distribution<int> tenths(-3600, 3600), places(0, 6);
     std::uniform_real_distribution<double> any(-7.0, 7.0);
-    std::vector<double> radians = {0.0, deg_to_rad(30.0), deg_to_rad(45.0), deg_to_rad(89.99),
-                                   deg_to_rad(0.1), 1e-300, 1e300, -deg_to_rad(180.0)};
+    std::vector<double> radians = {
+        0.0,   deg_to_rad(30.0),  deg_to_rad(45.0), deg_to_rad(89.99), deg_to_rad(0.1), 1e-300,
+        1e300, -deg_to_rad(180.0)};
     for (int k = 0; k < 20000; ++k) {
         radians.push_back(deg_to_rad(tenths(rng) / std::pow(10.0, places(rng))));  // typed angles
         radians.push_back(any(rng));  // from vectors: usually 16-17 digits
