@@ -162,7 +162,8 @@ CylinderProfile measure_cylinder_profile(const LinearImage& image,
                                          const std::vector<std::uint8_t>* region_mask,
                                          const CylinderOptions& options) {
     check_cylinder_options(options);
-    check_linear_image(image);
+    // The values: read and checked by the silhouette's pass, or here when there is none.
+    check_linear_image_layout(image);
     const std::size_t w = image.width, h = image.height;
     if (region_mask && region_mask->size() != image.pixel_count())
         throw InvalidArgument(concat("cylinder region mask has ",
@@ -180,12 +181,12 @@ CylinderProfile measure_cylinder_profile(const LinearImage& image,
     std::vector<detail::RowRun> object_rows;  // empty: every pixel
     double silhouette_level = 0.0;
     if (options.axis) {
+        check_linear_image(image);
         out.axis = cylinder_axis_from_line(options.axis->point_x_px, options.axis->point_y_px,
                                            options.axis->direction_x, options.axis->direction_y,
                                            options.axis->radius_px);
     } else {
-        detail::Outline outline =
-            detail::find_outline_of_checked_image(image, options.silhouette, options.threads);
+        detail::Outline outline = detail::find_outline(image, options.silhouette, options.threads);
         out.axis = fit_cylinder_axis(outline.silhouette, options.axis_fit);
         silhouette_level = outline.silhouette.threshold;
         object_rows = std::move(outline.rows);

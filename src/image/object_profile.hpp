@@ -28,11 +28,12 @@ struct Outline {
     std::vector<RowRun> rows;
 };
 
-// find_silhouette without check_linear_image (the caller has checked the image: one pass over
-// the pixels less) and without the image-sized mask: the object's rows instead. `threads`: of
-// the passes over the image (0 = all cores; the result does not depend on it).
-Outline find_outline_of_checked_image(const LinearImage& image, const SilhouetteOptions& options,
-                                      std::size_t threads);
+// find_silhouette without the image-sized mask: the object's rows instead. The values are
+// checked as its pass over the image reads them (check_linear_image's InvalidArgument for a
+// non-finite one; no separate pass). `threads`: of the passes over the image (0 = all cores; the
+// result does not depend on it).
+Outline find_outline(const LinearImage& image, const SilhouetteOptions& options,
+                     std::size_t threads);
 
 // The worker threads of an options' `threads` (0 = all cores), at most `bands`.
 inline std::size_t worker_threads(std::size_t threads, std::size_t bands) {

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -163,7 +164,16 @@ struct ImageSummary {
     std::size_t blocks_wide = 0, blocks_high = 0;
     std::vector<float> block_max;  // blocks_high · blocks_wide, row-major
     std::vector<float> sample;     // pixels 0, step, 2 step, ... (sample_step)
+    // Per block row: 1 when an averaged value read was not finite (a non-finite sample, or an
+    // average of huge ones that overflowed: check_linear_image decides).
+    std::vector<std::uint8_t> non_finite;
 };
+
+// 1 when the float is ±inf or NaN (exponent bits all ones), as an integer a loop can OR.
+inline std::uint32_t non_finite_bit(float v) {
+    constexpr std::uint32_t kExponent = 0x7f800000U;
+    return static_cast<std::uint32_t>((std::bit_cast<std::uint32_t>(v) & kExponent) == kExponent);
+}
 
 // Block rows [br0, br1) of summarise_image: the element-wise maximum of a block's f rows, then
 // of its f columns (vectorisable).
@@ -176,11 +186,19 @@ void summarise_block_rows(const LinearImage& image, std::size_t f, std::size_t b
         const std::size_t r0 = br * f, r1 = std::min(h, r0 + f);
         float* m = column_max.data();
         const float* a0 = avg.row(r0);
-        std::copy(a0, a0 + w, m);
+        std::uint32_t bad = 0;
+        for (std::size_t c = 0; c < w; ++c) {
+            m[c] = a0[c];
+            bad |= non_finite_bit(a0[c]);
+        }
         for (std::size_t r = r0 + 1; r < r1; ++r) {
             const float* a = avg.row(r);
-            for (std::size_t c = 0; c < w; ++c) m[c] = m[c] < a[c] ? a[c] : m[c];
+            for (std::size_t c = 0; c < w; ++c) {
+                m[c] = m[c] < a[c] ? a[c] : m[c];
+                bad |= non_finite_bit(a[c]);
+            }
         }
+        out.non_finite[br] = bad != 0 ? 1 : 0;
         float* b = out.block_max.data() + br * sw;
         for (std::size_t bc = 0; bc < sw; ++bc) {
             const std::size_t c0 = bc * f, c1 = std::min(w, c0 + f);
@@ -203,6 +221,7 @@ ImageSummary summarise_image(const LinearImage& image, std::size_t f, bool with_
     out.blocks_wide = (image.width + f - 1) / f;
     out.blocks_high = (image.height + f - 1) / f;
     out.block_max.resize(out.blocks_wide * out.blocks_high);
+    out.non_finite.assign(out.blocks_high, 0);
     const std::size_t n = image.pixel_count(), step = sample_step(n);
     if (with_sample) out.sample.resize((n + step - 1) / step);
     const std::size_t sh = out.blocks_high, bands = std::min(kBands, sh);
@@ -341,8 +360,7 @@ void add_boundary_points(const ChannelAverage& avg, const RunMask& m, Silhouette
 }  // namespace
 
 Silhouette find_silhouette(const LinearImage& image, const SilhouetteOptions& options) {
-    check_linear_image(image);
-    detail::Outline outline = detail::find_outline_of_checked_image(image, options, 0);
+    detail::Outline outline = detail::find_outline(image, options, 0);
     const Silhouette& s = outline.silhouette;
     assign_large(outline.silhouette.mask, image.pixel_count(), std::uint8_t{0});
     for (std::size_t r = 0; r < outline.rows.size(); ++r) {
@@ -353,9 +371,9 @@ Silhouette find_silhouette(const LinearImage& image, const SilhouetteOptions& op
     return std::move(outline.silhouette);
 }
 
-detail::Outline detail::find_outline_of_checked_image(const LinearImage& image,
-                                                      const SilhouetteOptions& options,
-                                                      std::size_t threads) {
+detail::Outline detail::find_outline(const LinearImage& image, const SilhouetteOptions& options,
+                                     std::size_t threads) {
+    check_linear_image_layout(image);  // the values: as the summary reads them
     check_fraction("silhouette edge_fraction", options.edge_fraction);
     check_fraction("silhouette min_object_fraction", options.min_object_fraction);
     if (options.threshold && !std::isfinite(*options.threshold))
@@ -377,6 +395,9 @@ detail::Outline detail::find_outline_of_checked_image(const LinearImage& image,
     const std::size_t f =
         std::max<std::size_t>(1, static_cast<std::size_t>(std::sqrt(static_cast<double>(n >> 20))));
     ImageSummary summary = summarise_image(image, f, !options.threshold, threads);
+    if (std::find(summary.non_finite.begin(), summary.non_finite.end(), 1) !=
+        summary.non_finite.end())
+        check_linear_image(image);  // throws for the first non-finite value (if not an overflow)
     s.threshold = options.threshold ? *options.threshold
                                     : automatic_level(image, std::move(summary.sample), options, s);
 

@@ -60,7 +60,8 @@ void check_sphere_options(const SphereOptions& options) {
 SphereResult measure_sphere(const LinearImage& image, const std::vector<std::uint8_t>* region_mask,
                             const SphereOptions& options) {
     check_sphere_options(options);
-    check_linear_image(image);
+    // The values: read and checked by the silhouette's pass, or here when there is none.
+    check_linear_image_layout(image);
     const std::size_t w = image.width, h = image.height;
     if (region_mask && region_mask->size() != image.pixel_count())
         throw InvalidArgument(concat("sphere region mask has ", std::to_string(region_mask->size()),
@@ -68,11 +69,11 @@ SphereResult measure_sphere(const LinearImage& image, const std::vector<std::uin
                                      std::to_string(image.pixel_count()), " pixels"));
     SphereResult out;
     if (options.circle) {
+        check_linear_image(image);
         out.circle = *options.circle;
     } else {
         out.circle = fit_sphere_circle(
-            detail::find_outline_of_checked_image(image, options.silhouette, options.threads)
-                .silhouette,
+            detail::find_outline(image, options.silhouette, options.threads).silhouette,
             options.circle_fit);
         out.circle_detected = true;
     }

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -11,7 +12,9 @@
 
 #include "object_captures.hpp"
 #include "roughscope/core/errors.hpp"
+#include "roughscope/image/cylinder.hpp"
 #include "roughscope/image/silhouette.hpp"
+#include "roughscope/image/sphere.hpp"
 #include "roughscope/simulation/capture.hpp"
 
 namespace {
@@ -256,6 +259,67 @@ TEST(SilhouetteCircle, LargeImageUsesTheBlockReducedComponents) {
     EXPECT_NEAR(fit.centre_x_px, cx, 0.2);
     EXPECT_NEAR(fit.centre_y_px, cy, 0.2);
     EXPECT_NEAR(fit.radius_px, R, 0.2);
+}
+
+TEST(SilhouetteValues, ANonFiniteValueIsRefusedWhereverItIs) {
+    // No separate pass checks the values: the silhouette's pass does, for find_silhouette, the
+    // cylinder and the sphere (and they check every value themselves when the axis or circle is
+    // given). A NaN or an infinity in the background, on the object, in any plane: the
+    // InvalidArgument of check_linear_image, naming the file and the sample.
+    const LinearImage grey = lambert_capture(sim::SceneShape::Sphere, 96, 80, 3);
+    const std::size_t n = grey.pixel_count();
+    LinearImage rgb = grey;
+    rgb.channels = 3;
+    rgb.values.resize(3 * n);
+    for (std::size_t k = 0; k < n; ++k) rgb.values[n + k] = rgb.values[2 * n + k] = grey.values[k];
+    CylinderOptions given_axis;
+    given_axis.axis = CylinderAxis{48.0, 40.0, 0.0, 1.0, 30.0};
+    SphereOptions given_circle;
+    given_circle.circle = CircleFit{48.0, 40.0, 32.0};
+    given_circle.comparison.fits = false;
+    SphereOptions no_fits;
+    no_fits.comparison.fits = false;
+    for (const std::size_t sample :
+         {std::size_t{5}, std::size_t{40 * 96 + 48}, 2 * n + 40 * 96 + 50}) {
+        for (const float bad :
+             {std::numeric_limits<float>::quiet_NaN(), -std::numeric_limits<float>::infinity()}) {
+            LinearImage image = sample < n ? grey : rgb;
+            image.info.source = "bad.tif";
+            image.values[sample] = bad;
+            const std::string at = "at sample " + std::to_string(sample);
+            const auto expect_refused = [&](auto&& call, const char* what) {
+                try {
+                    call();
+                    ADD_FAILURE() << what << ": no error for sample " << sample;
+                } catch (const InvalidArgument& e) {
+                    const std::string m = e.what();
+                    EXPECT_NE(m.find("bad.tif"), std::string::npos) << m;
+                    EXPECT_NE(m.find(at + " is not finite"), std::string::npos) << what << m;
+                } catch (const std::exception& e) {
+                    ADD_FAILURE() << what << ": " << e.what();
+                }
+            };
+            expect_refused([&] { (void)find_silhouette(image); }, "silhouette");
+            expect_refused([&] { (void)measure_cylinder_profile(image, nullptr, {}); }, "cylinder");
+            expect_refused([&] { (void)measure_cylinder_profile(image, nullptr, given_axis); },
+                           "cylinder, axis given");
+            expect_refused([&] { (void)measure_sphere(image, nullptr, no_fits); }, "sphere");
+            expect_refused([&] { (void)measure_sphere(image, nullptr, given_circle); },
+                           "sphere, circle given");
+        }
+    }
+    // Huge finite values whose average overflows (the object's pixels) are not refused as
+    // non-finite (the silhouette may fail otherwise on such an image).
+    LinearImage huge = rgb;
+    for (std::size_t k = 0; k < 3 * n; ++k)
+        huge.values[k] =
+            grey.values[k % n] > 0.1F ? 0.9F * std::numeric_limits<float>::max() : 0.0F;
+    try {
+        (void)find_silhouette(huge);
+    } catch (const InvalidArgument& e) {
+        EXPECT_EQ(std::string(e.what()).find("not finite"), std::string::npos) << e.what();
+    } catch (const DataError&) {
+    }
 }
 
 }  // namespace
