@@ -8,8 +8,8 @@
 //                                            from the camera
 //        objects/cylinder_profile/<rows>     read_image + measure_cylinder_profile (silhouette,
 //                                            axis, bins, models, fits, departures)
-//        objects/sphere_table/<rows>         read_image + measure_sphere without the model
-//                                            comparison (silhouette, circle, cells → BrdfTable)
+//        objects/sphere_table/<rows>         read_image + measure_sphere_table (no model
+//                                            comparison: silhouette, circle, cells → BrdfTable)
 //        objects/sphere_compare/<rows>       read_image + measure_sphere with compare_brdf
 // <rows> = 4096 is the 24-MP image (5859 x 4096); 256 a small one (366 x 256) for the smoke run.
 // The counter time_vs_read is each one's time over read_image's; time_vs_opencv_decode over
@@ -102,9 +102,8 @@ void cylinder(const std::filesystem::path& path) {
 
 void sphere(const std::filesystem::path& path, bool compare) {
     const auto image = read(path);
-    roughscope::image::SphereOptions o;
-    if (!compare) o.comparison.fits = false;
-    const auto r = roughscope::image::measure_sphere(image, nullptr, o);
+    const auto r = compare ? roughscope::image::measure_sphere(image, nullptr, {})
+                           : roughscope::image::measure_sphere_table(image, nullptr, {});
     benchmark::DoNotOptimize(r.table.measurements.data());
 }
 

@@ -22,6 +22,7 @@
 #include "roughscope/core/errors.hpp"
 #include "roughscope/core/names.hpp"
 #include "roughscope/core/numbers.hpp"
+#include "roughscope/core/parallel.hpp"
 #include "roughscope/estimation/estimation.hpp"
 #include "roughscope/fit/engine.hpp"
 #include "roughscope/scattering/beckmann.hpp"
@@ -875,17 +876,28 @@ Comparison compare(const BrdfTable& table, const ComparisonOptions& o, BrdfTable
         const auto steps = static_cast<long>(
             std::floor((o.lafortune_n_max - o.lafortune_n_min) / o.lafortune_n_step + 1e-9));
         const LafortuneGroups groups = lafortune_groups(p);
-        std::vector<double> M;
+        // Every n's error on fixed bands of the grid (one slot each), then the lowest in grid
+        // order: the same n whatever the number of threads.
+        const auto grid_size = static_cast<std::size_t>(steps + 1);
+        const auto n_of = [&o](std::size_t k) {
+            return o.lafortune_n_min + static_cast<double>(k) * o.lafortune_n_step;
+        };
+        std::vector<double> error(grid_size);
+        constexpr std::size_t kBand = 64;
+        run_bands((grid_size + kBand - 1) / kBand, o.threads, [&](std::size_t band) {
+            std::vector<double> M;
+            for (std::size_t k = band * kBand; k < std::min(grid_size, (band + 1) * kBand); ++k)
+                error[k] = lafortune_paper_sse(p, groups, n_of(k), M);
+        });
         double best_err = kInf, worst_err = -kInf, best_n = o.lafortune_n_min;
         long best_k = 0;
-        for (long k = 0; k <= steps; ++k) {
-            const double n = o.lafortune_n_min + static_cast<double>(k) * o.lafortune_n_step;
-            const double e = lafortune_paper_sse(p, groups, n, M);
+        for (std::size_t k = 0; k < grid_size; ++k) {
+            const double e = error[k];
             worst_err = std::max(worst_err, e);
             if (e < best_err) {
                 best_err = e;
-                best_n = n;
-                best_k = k;
+                best_n = n_of(k);
+                best_k = static_cast<long>(k);
             }
         }
         // The data do not determine n_d when every n of the search gives the same error (to
@@ -1024,6 +1036,9 @@ std::vector<Comparison> compare_curet_all(const CuretDatabase& db, const Compari
     std::size_t workers = threads > 0 ? static_cast<std::size_t>(threads)
                                       : std::max(1u, std::thread::hardware_concurrency());
     workers = std::max<std::size_t>(1, std::min(workers, n));
+    // Samples in parallel, each comparison on one thread (unless one worker).
+    ComparisonOptions sample_options = options;
+    if (workers > 1) sample_options.threads = 1;
     std::atomic<std::size_t> next{0};
     std::exception_ptr error;
     std::mutex error_mutex;
@@ -1032,7 +1047,7 @@ std::vector<Comparison> compare_curet_all(const CuretDatabase& db, const Compari
             const std::size_t k = next.fetch_add(1);
             if (k >= n) return;
             try {
-                out[k] = compare_curet_sample(db, db.samples[k], options);
+                out[k] = compare_curet_sample(db, db.samples[k], sample_options);
             } catch (...) {
                 std::lock_guard<std::mutex> lock(error_mutex);
                 if (!error) error = std::current_exception();

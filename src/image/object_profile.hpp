@@ -11,6 +11,7 @@
 
 #include <Eigen/Core>
 
+#include "roughscope/core/parallel.hpp"
 #include "roughscope/image/cylinder.hpp"
 #include "roughscope/scattering/geometry.hpp"
 
@@ -35,34 +36,8 @@ struct Outline {
 Outline find_outline(const LinearImage& image, const SilhouetteOptions& options,
                      std::size_t threads);
 
-// The worker threads of an options' `threads` (0 = all cores), at most `bands`.
-inline std::size_t worker_threads(std::size_t threads, std::size_t bands) {
-    if (threads == 0) threads = std::max(1U, std::thread::hardware_concurrency());
-    return std::clamp<std::size_t>(threads, 1, std::max<std::size_t>(1, bands));
-}
-
-// Runs work(band) for every band in [0, bands), band b on thread b mod threads; rethrows the
-// first exception. The caller makes the result independent of the number of threads (each band
-// writes only its own accumulators).
-template <class F>
-void run_bands(std::size_t bands, std::size_t threads, F&& work) {
-    threads = worker_threads(threads, bands);
-    std::vector<std::exception_ptr> errors(threads);
-    const auto run = [&](std::size_t t) {
-        try {
-            for (std::size_t b = t; b < bands; b += threads) work(b);
-        } catch (...) {
-            errors[t] = std::current_exception();
-        }
-    };
-    {
-        std::vector<std::jthread> workers;
-        for (std::size_t t = 1; t < threads; ++t) workers.emplace_back(run, t);
-        run(0);
-    }
-    for (const std::exception_ptr& e : errors)
-        if (e) std::rethrow_exception(e);
-}
+using roughscope::run_bands;
+using roughscope::worker_threads;
 
 // InvalidArgument unless v is finite with |‖v‖ − 1| ≤ 1e−6.
 void check_unit_direction(std::string_view name, const Eigen::Vector3d& v);

@@ -104,8 +104,9 @@ double crossing_fraction(float ai, float ao, float ai2, float ao2) {
     return (static_cast<double>(ai) - level) / step;
 }
 
-// The regular subsample of at most 2^20 pixels of the automatic level: every step-th pixel.
-std::size_t sample_step(std::size_t n) { return std::max<std::size_t>(1, n >> 20); }
+// The regular subsample of the automatic level: every step-th pixel, step = ⌊n / 2^18⌋ (at least
+// 1): about 2^18 pixels, fewer than 2^19.
+std::size_t sample_step(std::size_t n) { return std::max<std::size_t>(1, n >> 18); }
 
 // The level t of SilhouetteOptions::threshold when it is automatic, from the subsample
 // (silhouette.hpp); sets s.otsu_threshold.
@@ -133,6 +134,7 @@ double automatic_level(const LinearImage& image, std::vector<float> sample,
     // to the dark limb of the object, which falls below t_O too); object level: mean of the
     // pixels above t_O.
     std::vector<float> below;
+    below.reserve(sample.size());
     double so = 0;
     std::size_t no = 0;
     for (const float v : sample) {
@@ -390,10 +392,10 @@ detail::Outline detail::find_outline(const LinearImage& image, const SilhouetteO
     s.width = w;
     s.height = h;
     // Largest 8-connected component above the level, found on the mask reduced by f × f blocks
-    // (a block is on when any of its pixels is; f = ⌊√(n / 2^20)⌋, 1 below 2^21 pixels): the
+    // (a block is on when any of its pixels is; f = ⌊√(n / 2^18)⌋, 1 below 2^20 pixels): the
     // object's mask is then its pixels above the level in the blocks of that component.
     const std::size_t f =
-        std::max<std::size_t>(1, static_cast<std::size_t>(std::sqrt(static_cast<double>(n >> 20))));
+        std::max<std::size_t>(1, static_cast<std::size_t>(std::sqrt(static_cast<double>(n >> 18))));
     ImageSummary summary = summarise_image(image, f, !options.threshold, threads);
     if (std::find(summary.non_finite.begin(), summary.non_finite.end(), 1) !=
         summary.non_finite.end())

@@ -1,6 +1,7 @@
 #include "roughscope/image/sphere.hpp"
 
 #include <algorithm>
+#include <cassert>
 #include <cmath>
 #include <cstdint>
 #include <string>
@@ -57,8 +58,9 @@ void check_sphere_options(const SphereOptions& options) {
     validate(options.comparison);
 }
 
-SphereResult measure_sphere(const LinearImage& image, const std::vector<std::uint8_t>* region_mask,
-                            const SphereOptions& options) {
+SphereResult measure_sphere_table(const LinearImage& image,
+                                  const std::vector<std::uint8_t>* region_mask,
+                                  const SphereOptions& options) {
     check_sphere_options(options);
     // The values: read and checked by the silhouette's pass, or here when there is none.
     check_linear_image_layout(image);
@@ -107,68 +109,129 @@ SphereResult measure_sphere(const LinearImage& image, const std::vector<std::uin
     struct Counts {
         std::size_t used = 0, flagged = 0;
     };
-    const auto accumulate_row = [&](std::size_t r, Counts& counts) {
+    // Everything the pass reads, as locals (no reload through references in the loop).
+    const double Lx = L.x(), Ly = L.y(), Lz = L.z(), Vx = V.x(), Vy = V.y(), Vz = V.z();
+    const std::uint8_t* flags = image.flags.data();
+    assert(Lz > 0.0 && Vz > 0.0);
+    const auto accumulate_row = [=, &cells](std::size_t r, Counts& counts) {
         const double ny = (cy - (static_cast<double>(r) + 0.5)) * inv_R;
-        if (ny * ny > rho2_max) return;  // ρ² ≥ ny² > ρ_max² on the whole row
-        const double half_chord = R * std::sqrt(rho2_max - ny * ny) + 2.0;
+        const double ny2 = ny * ny;
+        if (ny2 > rho2_max) return;  // ρ² ≥ ny² > ρ_max² on the whole row
+        const double half_chord = R * std::sqrt(rho2_max - ny2) + 2.0;
         const std::size_t c_begin = std::max(
             c_lo, static_cast<std::size_t>(std::max(0.0, std::floor(cx - half_chord - 0.5))));
         const std::size_t c_end =
             std::min(c_hi, static_cast<std::size_t>(std::max(0.0, std::ceil(cx + half_chord))));
+        const double ny_l = ny * Ly, ny_v = ny * Vy, py = ny * R;
+        const float* row0 = p0 + r * w;
+        const float* row1 = p1 ? p1 + r * w : nullptr;
+        const float* row2 = p2 ? p2 + r * w : nullptr;
+        const std::uint8_t* row_flags = flags + r * w;
+        const std::uint8_t* row_reg = reg ? reg + r * w : nullptr;
+        // The lit-and-seen test of the pixel centre in column c (docs/curved-objects.md).
+        const auto lit_and_seen = [&](std::size_t c) {
+            const double nx = (static_cast<double>(c) + 0.5 - cx) * inv_R;
+            const double rho2 = nx * nx + ny2;
+            if (!(rho2 <= rho2_max)) return false;
+            const double nz = std::sqrt(1.0 - rho2);
+            const double nl = nx * Lx + ny_l + nz * Lz;
+            const double nv = nx * Vx + ny_v + nz * Vz;
+            return nl > cos_max && nv > cos_max;
+        };
+        // Along a row ρ² is convex and n·L, n·V are concave (L_z, V_z > 0:
+        // check_unit_direction), so the pixels that pass are the columns between the first and
+        // the last that do: those two are found by the test from each end, the columns between
+        // taken without it.
+        std::size_t first = c_begin, last = c_end;
+        while (first < c_end && !lit_and_seen(first)) ++first;
+        if (first == c_end) return;
+        while (last > first + 1 && !lit_and_seen(last - 1)) --last;
         CellSums* row_cells = cells.data() + (r / k) * gw;
         // The row's pixels of one cell are summed here, then added to the cell.
-        for (std::size_t gx = c_begin / k; gx * k < c_end; ++gx) {
-            CellSums part;
+        for (std::size_t gx = first / k; gx * k < last; ++gx) {
+            const std::size_t c0 = std::max(first, gx * k), c1 = std::min(last, gx * k + k);
+            double sum = 0, sum2 = 0, diff2 = 0;
+            double skipped_x = 0, skipped_xx = 0;  // Σ px, Σ px² of the pixels left out
+            std::uint32_t count = 0, diffs = 0;
+            std::size_t flagged = 0;
             bool left_used = false;  // the pixel on the left is used (and in this cell)
             float left_value = 0.0F;
-            for (std::size_t c = std::max(c_begin, gx * k); c < std::min(c_end, gx * k + k); ++c) {
-                const double nx = (static_cast<double>(c) + 0.5 - cx) * inv_R;
-                const double rho2 = nx * nx + ny * ny;
-                const std::size_t i = r * w + c;
-                bool used = false;
-                if (rho2 <= rho2_max && (!reg || reg[i])) {
-                    const double nz = std::sqrt(1.0 - rho2);
-                    const double nl = nx * L.x() + ny * L.y() + nz * L.z();
-                    const double nv = nx * V.x() + ny * V.y() + nz * V.z();
-                    if (nl > cos_max && nv > cos_max) {
-                        if (image.flags[i] != 0) {
-                            ++counts.flagged;
-                        } else {
-                            float v = p0[i];
-                            if (p1) v = (v + p1[i] + p2[i]) * (1.0F / 3.0F);
-                            const double vd = v;
-                            part.sum += vd;
-                            part.sum2 += vd * vd;
-                            const double px = nx * R, py = ny * R;
-                            part.sx += px;
-                            part.sy += py;
-                            part.sxx += px * px;
-                            part.syy += py * py;
-                            ++part.count;
-                            if (left_used) {
-                                const double diff = vd - left_value;
-                                part.diff2 += diff * diff;
-                                ++part.diffs;
-                            }
-                            left_value = v;
-                            used = true;
-                        }
+            // A grey segment with every pixel used (the common case): the sums without the
+            // per-pixel tests, in two interleaved lanes.
+            std::uint8_t any_flag = 0;
+            if (!row_reg && !row1)
+                for (std::size_t c = c0; c < c1; ++c) any_flag |= row_flags[c];
+            if (!row_reg && !row1 && any_flag == 0) {
+                const float* a = row0 + c0;
+                const std::size_t n = c1 - c0;
+                double s0 = 0, s1 = 0, q0 = 0, q1 = 0, d0 = 0, d1 = 0;
+                std::size_t i = 0;
+                for (; i + 2 <= n; i += 2) {
+                    const double v0 = a[i], v1 = a[i + 1];
+                    s0 += v0;
+                    s1 += v1;
+                    q0 += v0 * v0;
+                    q1 += v1 * v1;
+                    const double e1 = v1 - v0;
+                    d1 += e1 * e1;
+                    if (i + 2 < n) {
+                        const double e2 = static_cast<double>(a[i + 2]) - v1;
+                        d0 += e2 * e2;
                     }
                 }
-                left_used = used;
+                if (i < n) {
+                    const double v = a[i];
+                    s0 += v;
+                    q0 += v * v;
+                }
+                sum = s0 + s1;
+                sum2 = q0 + q1;
+                diff2 = d0 + d1;
+                count = static_cast<std::uint32_t>(n);
+                diffs = static_cast<std::uint32_t>(n - 1);
+            } else {
+                for (std::size_t c = c0; c < c1; ++c) {
+                    const bool out_of_region = row_reg && !row_reg[c];
+                    if (out_of_region || row_flags[c] != 0) {
+                        flagged += out_of_region ? 0 : 1;
+                        const double px = static_cast<double>(c) + 0.5 - cx;
+                        skipped_x += px;
+                        skipped_xx += px * px;
+                        left_used = false;
+                        continue;
+                    }
+                    float v = row0[c];
+                    if (row1) v = (v + row1[c] + row2[c]) * (1.0F / 3.0F);
+                    const double vd = v;
+                    sum += vd;
+                    sum2 += vd * vd;
+                    ++count;
+                    if (left_used) {
+                        const double diff = vd - left_value;
+                        diff2 += diff * diff;
+                        ++diffs;
+                    }
+                    left_value = v;
+                    left_used = true;
+                }
             }
-            if (part.count == 0) continue;
+            counts.flagged += flagged;
+            if (count == 0) continue;
             CellSums& cs = row_cells[gx];
-            cs.sum += part.sum;
-            cs.sum2 += part.sum2;
-            cs.diff2 += part.diff2;
-            cs.sx += part.sx;
-            cs.sy += part.sy;
-            cs.sxx += part.sxx;
-            cs.syy += part.syy;
-            cs.count += part.count;
-            cs.diffs += part.diffs;
-            counts.used += part.count;
+            cs.sum += sum;
+            cs.sum2 += sum2;
+            cs.diff2 += diff2;
+            // Σ px, Σ px² over [c0, c1): m x̄ and m x̄² + m (m² − 1)/12 with x̄ the columns' mean
+            // px; then less the pixels left out. py is the same for the row's pixels.
+            const auto m = static_cast<double>(c1 - c0);
+            const double mean_x = 0.5 * static_cast<double>(c0 + c1) - cx;
+            cs.sx += m * mean_x - skipped_x;
+            cs.sxx += m * mean_x * mean_x + m * (m * m - 1.0) / 12.0 - skipped_xx;
+            cs.sy += static_cast<double>(count) * py;
+            cs.syy += static_cast<double>(count) * (py * py);
+            cs.count += count;
+            cs.diffs += diffs;
+            counts.used += count;
         }
     };
     // Bands of whole rows of cells, one thread each: a cell is summed by one band, in the same
@@ -279,7 +342,15 @@ SphereResult measure_sphere(const LinearImage& image, const std::vector<std::uin
     }
     if (!weighted)
         out.warnings.push_back("no pixel-noise estimate in some cells: all cells weighted 1");
-    out.comparison = compare_brdf(out.table, options.comparison);
+    return out;
+}
+
+SphereResult measure_sphere(const LinearImage& image, const std::vector<std::uint8_t>* region_mask,
+                            const SphereOptions& options) {
+    SphereResult out = measure_sphere_table(image, region_mask, options);
+    ComparisonOptions comparison = options.comparison;
+    if (comparison.threads == 0) comparison.threads = options.threads;
+    out.comparison = compare_brdf(out.table, comparison);
     return out;
 }
 

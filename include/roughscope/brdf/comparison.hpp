@@ -197,6 +197,8 @@ struct ComparisonOptions {
     // Keep ModelResult::prediction (N values per model); false leaves it empty once the errors
     // are computed (a large table whose predictions are not output).
     bool keep_predictions = true;
+    // Worker threads of the Lafortune search (0 = all cores); the result does not depend on it.
+    std::size_t threads = 0;
 };
 
 struct Comparison {

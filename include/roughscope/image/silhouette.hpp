@@ -24,7 +24,7 @@ namespace roughscope::image {
 
 struct SilhouetteOptions {
     // Level (linear scale, channel average) separating object from background. None: automatic
-    // — every statistic from a regular subsample of at most 2^20 pixels — Otsu's threshold t_O on
+    // — every statistic from a regular subsample of about 2^18 pixels (every ⌊n/2^18⌋-th) — Otsu's threshold t_O on
     // the channel average (OpenCV), then the edge level
     // t = min(t_O, μ_b + max(6 s_b, edge_fraction · (μ_o − μ_b))) with μ_b, s_b the median and
     // 1.4826 · MAD of the pixels below t_O (robust to the object's dark limb, which is below t_O
@@ -70,7 +70,7 @@ struct Silhouette {
 
 // Finds the object: the largest 8-connected component above the level (cv::connectedComponents-
 // WithStats on the mask reduced by f × f blocks, a block on when any of its pixels is,
-// f = ⌊√(n / 2^20)⌋ — 1, the exact mask, below 2^21 pixels; the object is then its pixels above
+// f = ⌊√(n / 2^18)⌋ — 1, the exact mask, below 2^20 pixels; the object is then its pixels above
 // the level in that component's blocks), with the gaps along each row between its first and last
 // pixel filled (dark texture, a flagged pixel: the objects here,
 // cylinders and spheres seen whole, are convex along image rows). Throws InvalidArgument for an

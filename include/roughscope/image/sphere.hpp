@@ -46,8 +46,9 @@ struct SphereOptions {
     std::size_t max_cells = 16384;  // ≥ 1
     // Cells with fewer used pixels than this fraction of cell_px² are dropped, [0, 1].
     double min_cell_fraction = 0.5;
-    // Worker threads of the pass over the pixels (0 = all cores); the result does not depend on
-    // it (each cell is summed by one thread, in the same order).
+    // Worker threads of the pass over the pixels and, unless comparison.threads is set, of the
+    // comparison (0 = all cores); the result does not depend on it (each cell is summed by one
+    // thread, in the same order).
     std::size_t threads = 0;
     ComparisonOptions comparison;
 };
@@ -64,7 +65,8 @@ struct SphereResult {
     // 1/σ_f² scaled to a mean of 1 (σ_f: the cell's standard error of Ē from pixel noise, / cos
     // θi).
     BrdfTable table;
-    Comparison comparison;  // compare_brdf(table, options.comparison)
+    Comparison
+        comparison;  // compare_brdf(table, options.comparison); empty from measure_sphere_table
     std::size_t pixels_used = 0;
     std::size_t pixels_flagged = 0;  // inside the used disc, lit and seen, never used
     std::vector<std::string> warnings;
@@ -75,5 +77,11 @@ struct SphereResult {
 // DataError when the sphere cannot be found (silhouette.hpp) or fewer than 3 cells are usable.
 SphereResult measure_sphere(const LinearImage& image, const std::vector<std::uint8_t>* region_mask,
                             const SphereOptions& options = {});
+
+// measure_sphere without the model comparison: the circle, the cells and the BRDF table (the
+// sphere's profile), `comparison` left empty. The same errors, except none from the comparison.
+SphereResult measure_sphere_table(const LinearImage& image,
+                                  const std::vector<std::uint8_t>* region_mask,
+                                  const SphereOptions& options = {});
 
 }  // namespace roughscope::image

@@ -643,3 +643,33 @@ TEST(Comparison, LafortuneSearchOnRepeatedGeometriesIsTheDirectSearch) {
     EXPECT_NEAR(laf.errors.paper_sse, best_err, 1e-12 * best_err);
     EXPECT_NEAR(best_n, 2.3, 0.5);  // an interior minimum near the exponent of the data
 }
+
+TEST(Comparison, LafortuneSearchDoesNotDependOnTheNumberOfThreads) {
+    // Distinct geometries (a sphere-like table): the grid's bands on 1, 2 and 3 threads give the
+    // same n, errors and flags, bit for bit.
+    BrdfTable t;
+    t.name = "threads";
+    int index = 0;
+    for (double ti_deg = 2.0; ti_deg < 80.0; ti_deg += 3.7)
+        for (double pv_deg : {10.0, 100.0, 200.0}) {
+            const double ti = deg_to_rad(ti_deg), tv = deg_to_rad(0.6 * ti_deg + 1.0);
+            const double E = std::pow(std::cos(ti) * std::cos(tv), 1.7) * std::cos(ti) *
+                             (1.0 + 0.05 * std::sin(++index));
+            t.measurements.push_back(
+                make_brdf_measurement(index, ti, kPi, tv, deg_to_rad(pv_deg), E / std::cos(ti)));
+        }
+    ComparisonOptions o;
+    o.fits = false;
+    o.threads = 1;
+    const ModelResult one = compare_brdf(t, o).result(ComparisonModel::Lafortune);
+    ASSERT_TRUE(one.parameter("n").has_value());
+    EXPECT_EQ(one.fit_status, SolverStatus::Converged);
+    for (const std::size_t threads : {2U, 3U, 0U}) {
+        o.threads = threads;
+        const ModelResult many = compare_brdf(t, o).result(ComparisonModel::Lafortune);
+        EXPECT_EQ(*many.parameter("n"), *one.parameter("n")) << threads;
+        EXPECT_EQ(many.errors.paper_sse, one.errors.paper_sse);
+        EXPECT_EQ(many.errors.gain_sse, one.errors.gain_sse);
+        EXPECT_EQ(many.fit_status, one.fit_status);
+    }
+}

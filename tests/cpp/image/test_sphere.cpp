@@ -4,7 +4,9 @@
 #include <cstddef>
 #include <cstdint>
 #include <cstdio>
+#include <exception>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -183,9 +185,9 @@ TEST(SphereTable, BadInputIsAnError) {
     EXPECT_THROW(measure_sphere(cut, nullptr, {}), DataError);
 }
 
-TEST(SphereTable, ResultDoesNotDependOnTheNumberOfThreads) {
-    // A textured Lambert sphere lit from the camera, a few flagged pixels, a region mask: cells
-    // of several pixels, several bands of rows.
+// A textured Lambert sphere (centre (261.3, 238.6), R = 190 px) in a 520 × 480 image, with a
+// saturated pixel every 997th (in a pattern) when `flagged`.
+LinearImage textured_sphere(bool flagged) {
     const std::size_t w = 520, h = 480;
     LinearImage img;
     img.width = w;
@@ -201,8 +203,23 @@ TEST(SphereTable, ResultDoesNotDependOnTheNumberOfThreads) {
             const double texture = 0.02 * static_cast<double>((r * 7 + c * 13) % 17) / 17.0;
             img.values[r * w + c] = static_cast<float>(
                 0.01 + (rho2 < 1.0 ? 0.8 * std::sqrt(1.0 - rho2) : 0.0) + texture);
-            if ((r * 31 + c * 17) % 997 == 0) img.flags[r * w + c] = kPixelSaturated;
+            if (flagged && (r * 31 + c * 17) % 997 == 0) img.flags[r * w + c] = kPixelSaturated;
         }
+    return img;
+}
+
+CircleFit textured_sphere_circle() {
+    CircleFit c;
+    c.centre_x_px = 261.3;
+    c.centre_y_px = 238.6;
+    c.radius_px = 190.0;
+    return c;
+}
+
+TEST(SphereTable, ResultDoesNotDependOnTheNumberOfThreads) {
+    // A textured Lambert sphere lit from the camera, a few flagged pixels, a region mask: cells
+    // of several pixels, several bands of rows.
+    const LinearImage img = textured_sphere(true);
     std::vector<std::uint8_t> region(img.pixel_count(), 1);
     for (std::size_t i = 0; i < region.size(); i += 11) region[i] = 0;
     SphereOptions o;
@@ -228,6 +245,88 @@ TEST(SphereTable, ResultDoesNotDependOnTheNumberOfThreads) {
             EXPECT_EQ(x.weight, y.weight);
         }
     }
+}
+
+TEST(SphereTable, PixelsUsedAreThoseOfTheDocumentedRule) {
+    // Each pixel tested as docs/curved-objects.md states it (inside the limb, n·L and n·V above
+    // cos θ_max, in the region, no flag) against the pass, which tests only the ends of each
+    // row's interval: for lights and views that cut the disc on either side, with and without
+    // a region.
+    const LinearImage img = textured_sphere(true);
+    const CircleFit circle = textured_sphere_circle();
+    std::vector<std::uint8_t> region(img.pixel_count(), 1);
+    for (std::size_t i = 0; i < region.size(); i += 7) region[i] = 0;
+    const std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>> directions = {
+        {{0, 0, 1}, {0, 0, 1}},
+        {sim::direction_from_angles(deg_to_rad(40.0), 0.0), {0, 0, 1}},
+        {sim::direction_from_angles(deg_to_rad(70.0), 2.0),
+         sim::direction_from_angles(deg_to_rad(30.0), 4.0)},
+        {sim::direction_from_angles(deg_to_rad(89.0), 1.0),
+         sim::direction_from_angles(deg_to_rad(60.0), 3.5)},
+    };
+    for (const auto& [L, V] : directions)
+        for (const bool with_region : {false, true}) {
+            SphereOptions o;
+            o.light = L;
+            o.view = V;
+            o.circle = circle;
+            o.cell_px = 5;
+            o.min_cell_fraction = 0.0;
+            std::size_t used = 0, flagged = 0;
+            const double cos_max = std::cos(deg_to_rad(o.max_angle_deg));
+            const double inv_R = 1.0 / circle.radius_px;
+            for (std::size_t r = 0; r < img.height; ++r)
+                for (std::size_t c = 0; c < img.width; ++c) {
+                    const double nx = (static_cast<double>(c) + 0.5 - circle.centre_x_px) * inv_R;
+                    const double ny = (circle.centre_y_px - (static_cast<double>(r) + 0.5)) * inv_R;
+                    const double rho2 = nx * nx + ny * ny;
+                    if (rho2 > o.limb_fraction * o.limb_fraction) continue;
+                    const Eigen::Vector3d n(nx, ny, std::sqrt(1.0 - rho2));
+                    if (!(n.dot(L) > cos_max && n.dot(V) > cos_max)) continue;
+                    const std::size_t i = r * img.width + c;
+                    if (with_region && !region[i]) continue;
+                    ++(img.flags[i] ? flagged : used);
+                }
+            ASSERT_GT(used, 1000U);
+            try {
+                const SphereResult got =
+                    measure_sphere_table(img, with_region ? &region : nullptr, o);
+                EXPECT_EQ(got.pixels_used, used) << L.transpose() << " / " << V.transpose();
+                EXPECT_EQ(got.pixels_flagged, flagged) << L.transpose() << " / " << V.transpose();
+                EXPECT_TRUE(got.comparison.models.empty());
+            } catch (const std::exception& e) {
+                ADD_FAILURE() << e.what();
+            }
+        }
+}
+
+TEST(SphereTable, CellsSummedWithoutPerPixelTestsAgreeWithThePerPixelPath) {
+    // No flag, no region: every row's cells are summed in the pass's fast path. A region of all
+    // ones sends the same pixels through the per-pixel path; the cells must agree to rounding.
+    const LinearImage img = textured_sphere(false);
+    std::vector<std::uint8_t> everywhere(img.pixel_count(), 1);
+    SphereOptions o;
+    o.circle = textured_sphere_circle();
+    o.cell_px = 6;
+    const SphereResult fast = measure_sphere_table(img, nullptr, o);
+    const SphereResult each = measure_sphere_table(img, &everywhere, o);
+    EXPECT_EQ(fast.pixels_used, each.pixels_used);
+    ASSERT_EQ(fast.table.measurements.size(), each.table.measurements.size());
+    ASSERT_GT(fast.table.measurements.size(), 1000U);
+    for (std::size_t k = 0; k < fast.table.measurements.size(); ++k) {
+        const BrdfMeasurement &x = fast.table.measurements[k], &y = each.table.measurements[k];
+        EXPECT_NEAR(x.theta_i_rad, y.theta_i_rad, 1e-12);
+        EXPECT_NEAR(x.theta_v_rad, y.theta_v_rad, 1e-12);
+        EXPECT_NEAR(x.value, y.value, 1e-12 * std::abs(y.value));
+        EXPECT_NEAR(x.weight, y.weight, 1e-9 * y.weight);
+    }
+    // measure_sphere is the table and the comparison.
+    SphereOptions no_fits = o;
+    no_fits.comparison.fits = false;
+    const SphereResult whole = measure_sphere(img, nullptr, no_fits);
+    ASSERT_EQ(whole.table.measurements.size(), fast.table.measurements.size());
+    EXPECT_EQ(whole.table.measurements.back().value, fast.table.measurements.back().value);
+    EXPECT_FALSE(whole.comparison.models.empty());
 }
 
 }  // namespace
