@@ -23,13 +23,13 @@
 namespace roughscope::image {
 
 struct SilhouetteOptions {
-    // Level (linear scale, channel average) separating object from background. None: automatic
-    // — every statistic from a regular subsample of about 2^18 pixels (every ⌊n/2^18⌋-th) — Otsu's threshold t_O on
-    // the channel average (OpenCV), then the edge level
-    // t = min(t_O, μ_b + max(6 s_b, edge_fraction · (μ_o − μ_b))) with μ_b, s_b the median and
-    // 1.4826 · MAD of the pixels below t_O (robust to the object's dark limb, which is below t_O
-    // too) and μ_o the mean of those above: low enough to follow a limb that darkens towards the
-    // edge, high enough to stay out of the background noise.
+    // Level (linear scale, channel average) separating object from background. None: automatic,
+    // every statistic from a regular subsample of about 2^18 pixels (every ⌊n/2^18⌋-th):
+    // Otsu's threshold t_O on the channel average (OpenCV), then the edge level
+    //   t = min(t_O, μ_b + max(6 s_b, edge_fraction · (μ_o − μ_b)))
+    // with μ_b, s_b the median and 1.4826 · MAD of the pixels below t_O (robust to the object's
+    // dark limb, which is below t_O too) and μ_o the mean of those above: low enough to follow a
+    // limb that darkens towards the edge, high enough to stay out of the background noise.
     std::optional<double> threshold;
     double edge_fraction = 0.01;  // (0, 1)
     // The largest connected bright component must cover at least this fraction of the image.
