@@ -354,6 +354,20 @@ HeightMap decode_tiff(std::string_view bytes, const std::string& name,
     tab::check_grid_size(name, width, height, "TIFF header");
     const tmsize_t line_bytes = TIFFScanlineSize(tif);
     const std::size_t sample_bytes = bits / 8U;
+    // Strips may share their compressed data, so a file of a few hundred bytes can claim
+    // gigabytes of rows. No codec of libtiff packs real samples beyond 4096:1 (deflate ≤ 1032:1,
+    // an LZW code < 4096 bytes), so more than 4096 × the file (+ 1 MiB) is refused before any
+    // row is decoded.
+    const double decoded_bytes = static_cast<double>(width) * static_cast<double>(height) *
+                                 static_cast<double>(sample_bytes);
+    const double most_bytes = 4096.0 * static_cast<double>(bytes.size()) + 1048576.0;
+    if (decoded_bytes > most_bytes)
+        throw DataError(name + ": the TIFF header's " + std::to_string(width) + " x " +
+                        std::to_string(height) + " samples of " + std::to_string(bits) +
+                        " bits are more than 4096 times the file's " +
+                        std::to_string(bytes.size()) +
+                        " bytes: no compression packs real heights that far (a damaged or "
+                        "crafted file)");
     if (line_bytes < 0 || static_cast<std::size_t>(line_bytes) < width * sample_bytes) {
         throw DataError(name + ": TIFF scanline size does not match its width");
     }

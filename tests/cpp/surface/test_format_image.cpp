@@ -269,13 +269,21 @@ TEST(FormatTiff, MalformedAndUnsupportedFilesGiveDataErrors) {
     expect_data_error(
         [&] { formats::decode_tiff(minimal_tiff(false, 1, 2, 32, 1, pixels), "h.tif", o); },
         {"32 bits in sample format 1"});
-    // Dimensions larger than the data: the strip holds 8 bytes, the header asks for 1000 x 1000.
+    // Dimensions larger than the data: the strip holds 8 bytes, the header asks for 200 x 200.
+    expect_data_error(
+        [&] {
+            formats::decode_tiff(minimal_tiff(false, 200, 200, 16, 1, pixels, 1, 80000), "h.tif",
+                                 o);
+        },
+        {"h.tif: TIFF row"});
+    // ... or for more than 4096 times the file (a strip shared by every row could decode it):
+    // refused before any row is decoded.
     expect_data_error(
         [&] {
             formats::decode_tiff(minimal_tiff(false, 1000, 1000, 16, 1, pixels, 1, 2000000),
                                  "h.tif", o);
         },
-        {"h.tif: TIFF row"});
+        {"h.tif: the TIFF header's 1000 x 1000 samples of 16 bits are more than 4096 times"});
     expect_data_error(
         [&] {
             formats::decode_tiff(minimal_tiff(false, 100000, 100000, 16, 1, pixels), "h.tif", o);
