@@ -1036,9 +1036,13 @@ std::vector<Comparison> compare_curet_all(const CuretDatabase& db, const Compari
     std::size_t workers = threads > 0 ? static_cast<std::size_t>(threads)
                                       : std::max(1u, std::thread::hardware_concurrency());
     workers = std::max<std::size_t>(1, std::min(workers, n));
-    // Samples in parallel, each comparison on one thread (unless one worker).
+    // Samples in parallel, each comparison on one thread; one worker: `threads` for the
+    // comparison itself unless its options set their own.
     ComparisonOptions sample_options = options;
-    if (workers > 1) sample_options.threads = 1;
+    if (workers > 1)
+        sample_options.threads = 1;
+    else if (threads > 0 && sample_options.threads == 0)
+        sample_options.threads = static_cast<std::size_t>(threads);
     std::atomic<std::size_t> next{0};
     std::exception_ptr error;
     std::mutex error_mutex;
