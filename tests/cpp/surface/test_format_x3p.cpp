@@ -38,8 +38,10 @@ std::string md5(const std::string& data) {
     return out;
 }
 
-// An independent minimal zip writer: plain libzip calls, entries in the order given.
-std::string make_zip(const std::vector<std::pair<std::string, std::string>>& entries) {
+// An independent minimal zip writer: plain libzip calls, entries in the order given (deflated,
+// or stored when `stored`).
+std::string make_zip(const std::vector<std::pair<std::string, std::string>>& entries,
+                     bool stored = false) {
     zip_error_t error;
     zip_error_init(&error);
     zip_source_t* buffer = zip_source_buffer_create(nullptr, 0, 0, &error);
@@ -47,7 +49,8 @@ std::string make_zip(const std::vector<std::pair<std::string, std::string>>& ent
     zip_t* z = zip_open_from_source(buffer, ZIP_TRUNCATE, &error);
     for (const auto& [entry, data] : entries) {
         zip_source_t* s = zip_source_buffer(z, data.data(), data.size(), 0);
-        zip_file_add(z, entry.c_str(), s, 0);
+        const zip_int64_t index = zip_file_add(z, entry.c_str(), s, 0);
+        if (stored) zip_set_file_compression(z, static_cast<zip_uint64_t>(index), ZIP_CM_STORE, 0);
     }
     zip_close(z);
     zip_stat_t st;
@@ -294,6 +297,51 @@ TEST(X3pFormat, ChecksumMismatchesAreDataErrors) {
     lax.x3p_verify_checksums = false;
     EXPECT_EQ(formats::decode_x3p(spec_x3p(spec_main_xml(std::string(32, '0')), data), "x", lax).nx,
               3U);
+}
+
+// A stored data.bin edited in place (its zip CRC-32 and its MD5 both stale): a verified read is a
+// DataError; a read that does not verify checksums takes the edited values, in each chunk of
+// 65536 points at its place (it reads the stored member in windows of the archive).
+TEST(X3pFormat, UnverifiedReadTakesAStoredMemberWithAStaleCrc) {
+    const HeightMap map = sample_map(300, 300);  // 90000 points: two chunks
+    std::string bytes = formats::encode_x3p(map, {});
+    for (const std::size_t point : {std::size_t{5}, std::size_t{70000}}) {
+        const std::string old_bits(reinterpret_cast<const char*>(&map.heights_um[point]), 8);
+        const std::size_t at = bytes.find(old_bits);
+        ASSERT_NE(at, std::string::npos);
+        ASSERT_EQ(bytes.find(old_bits, at + 1), std::string::npos);  // the point, nothing else
+        const double edited = 42.0 + static_cast<double>(point);
+        bytes.replace(at, 8, reinterpret_cast<const char*>(&edited), 8);
+    }
+    EXPECT_NE(decode_error(bytes), "no DataError");
+    HeightReadOptions lax;
+    lax.x3p_verify_checksums = false;
+    const HeightMap back = formats::decode_x3p(bytes, "edited.x3p", lax);
+    EXPECT_EQ(back.heights_um[5], 47.0);
+    EXPECT_EQ(back.heights_um[70000], 70042.0);
+    EXPECT_EQ(back.heights_um[4], map.heights_um[4]);
+    EXPECT_EQ(back.heights_um[89999], map.heights_um[89999]);
+}
+
+// The zip's CRC-32 is a checksum too: a stored data.bin edited in place in a file that states no
+// MD5 is a DataError naming the member when checksums are verified, and reads without.
+TEST(X3pFormat, VerifiedReadChecksTheZipCrcOfThePointData) {
+    const std::string xml = spec_main_xml("");
+    std::string bytes = make_zip({{"main.xml", xml},
+                                  {"md5checksum.hex", md5(xml) + " *main.xml\n"},
+                                  {"bindata/data.bin", spec_data()}},
+                                 /*stored=*/true);
+    const float old_z = 4e-6F, new_z = 8e-6F;
+    const std::size_t at = bytes.find(std::string(reinterpret_cast<const char*>(&old_z), 4));
+    ASSERT_NE(at, std::string::npos);
+    bytes.replace(at, 4, reinterpret_cast<const char*>(&new_z), 4);
+    const std::string message = decode_error(bytes);
+    EXPECT_NE(message.find("bad.x3p"), std::string::npos) << message;
+    EXPECT_NE(message.find("bindata/data.bin"), std::string::npos) << message;
+    EXPECT_NE(message.find("CRC"), std::string::npos) << message;
+    HeightReadOptions lax;
+    lax.x3p_verify_checksums = false;
+    EXPECT_NEAR(formats::decode_x3p(bytes, "x", lax).at(0, 1), 8.0, 1e-6);
 }
 
 TEST(X3pFormat, AbsentChecksumsAreAccepted) {
