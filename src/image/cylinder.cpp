@@ -509,9 +509,265 @@ CylinderProfile measure_cylinder_profile(const LinearImage& image,
             end_slice_run();
         }
     };
+    // The same sums along a steep axis without a region mask, with the per-pixel work cut down
+    // (scan_band is its reference: they agree to rounding). A row is cut into segments of one bin
+    // and one slice: the classification (pixel_bin, the slice) is evaluated at the segment's ends
+    // only, found from the next edge between bins and the next slice boundary and then checked
+    // (d and t are linear along the row, the bins and slices contiguous in d and t). A segment
+    // without a flagged pixel is summed without further tests. A pixel's half-sub-bin is kept per
+    // column: the column's d moves by u_y a row, so its half-sub-bin is recomputed only at the
+    // rows where it can have changed (scheduled from the distance to the half-sub-bin's edges),
+    // and the column's count and Σd are added to the half-sub-bin when it changes.
+    // Edges in d between the classes of consecutive half-sub-bins (and the table's ends).
+    std::vector<double> class_edges;
+    class_edges.push_back(-R);
+    for (std::size_t hs = 0; hs + 1 < 2 * n_sub; ++hs) {
+        if (sub_bin[hs] == sub_bin[hs + 1]) continue;
+        const std::size_t k = hs / 2;
+        class_edges.push_back(hs % 2 == 0 ? split[k]
+                                          : static_cast<double>(k + 1) / kSubBinsPerPx - R);
+    }
+    class_edges.push_back(static_cast<double>(n_sub) / kSubBinsPerPx - R);
+    const auto scan_band_steep = [&](Band& band) {
+        constexpr std::uint32_t kNone = std::numeric_limits<std::uint32_t>::max();
+        const std::uint8_t* const flags = image.flags.data();
+        const float *const v0 = p0, *const v1 = p1, *const v2 = p2;
+        const std::size_t last_slice = n_slices - 1, sub_lo = band.sub_lo, bin_lo = band.bin_lo;
+        const std::size_t band_slices = band.n_band_slices, slice_lo = band.slice_lo;
+        BinSums* const band_bins = band.bins.data();
+        std::uint32_t* const sub_count = band.sub_count.data();
+        double* const sub_d = band.sub_d.data();
+        double* const slice_sum = band.slice_sum.data();
+        std::uint32_t* const slice_count = band.slice_count.data();
+        const double* const split_of = split.data();
+        const double xc0 = 0.5 - axis.point_x_px;
+        const auto row_d0 = [&](std::size_t r) {
+            return xc0 * ux + (static_cast<double>(r) + 0.5 - axis.point_y_px) * uy;
+        };
+        const auto row_t0 = [&](std::size_t r) {
+            return xc0 * ax + (static_cast<double>(r) + 0.5 - axis.point_y_px) * ay - t_min;
+        };
+        const auto slice_at = [=](double t0, std::size_t c) {
+            return std::min(
+                static_cast<std::size_t>(std::max(0.0, t0 + static_cast<double>(c) * ax)),
+                last_slice);
+        };
+        // Row values (RGB averaged as the per-pixel path does) over [begin, end).
+        std::vector<float> rgb(v1 ? 2 * w : 0);
+        const auto values_of = [&](std::size_t r, std::size_t begin, std::size_t end,
+                                   float* buffer) -> const float* {
+            const std::size_t o = r * w;
+            if (!v1) return v0 + o;
+            for (std::size_t c = begin; c < end; ++c)
+                buffer[c] = (v0[o + c] + v1[o + c] + v2[o + c]) * (1.0F / 3.0F);
+            return buffer;
+        };
+        // The half-sub-bin of (row with d0, column c), kNone outside the table, and the
+        // distance in d to its nearest edge.
+        const auto half_sub_bin = [&](double d, double& room) -> std::uint32_t {
+            const double sf = d * kSubBinsPerPx + sub_offset;
+            if (!(sf >= 0.0 && sf < static_cast<double>(n_sub))) {
+                room = sf < 0.0 ? -R - d : d - (static_cast<double>(n_sub) / kSubBinsPerPx - R);
+                return kNone;
+            }
+            const auto k = static_cast<std::size_t>(sf);
+            const double lo = static_cast<double>(k) / kSubBinsPerPx - R;
+            const double hi = lo + 1.0 / kSubBinsPerPx;
+            const bool upper = d >= split_of[k];
+            room = upper ? std::min(d - split_of[k], hi - d)
+                         : std::min(d - lo, std::min(split_of[k], hi) - d);
+            return static_cast<std::uint32_t>(2 * k + (upper ? 1 : 0));
+        };
+        const std::size_t rows = band.r1 - band.r0;
+        std::vector<std::uint32_t> col_hs(w, kNone), col_n(w, 0);
+        std::vector<double> col_d0(w, 0.0);
+        std::vector<std::vector<std::uint32_t>> recheck(rows);
+        const double abs_uy = std::abs(uy);
+        // Rows a column keeps its half-sub-bin: its d moves by |u_y| a row (less 1e-6 px for
+        // rounding); at the returned row it is computed again.
+        const auto schedule = [&](std::size_t r, std::size_t c, double room) {
+            if (abs_uy == 0.0) return;
+            const double rows_left = std::floor((room - 1e-6) / abs_uy);
+            const std::size_t next =
+                r + (rows_left >= 1.0
+                         ? static_cast<std::size_t>(std::min(rows_left, static_cast<double>(rows)))
+                         : 1);
+            if (next < band.r1) recheck[next - band.r0].push_back(static_cast<std::uint32_t>(c));
+        };
+        const auto flush = [&](std::size_t c) {
+            if (col_n[c] == 0) return;
+            const std::uint32_t hs = col_hs[c];
+            assert(hs != kNone && hs >= sub_lo && hs < sub_lo + band.n_subs);
+            sub_count[hs - sub_lo] += col_n[c];
+            sub_d[hs - sub_lo] +=
+                col_d0[c] + static_cast<double>(col_n[c]) * (static_cast<double>(c) * ux);
+            col_n[c] = 0;
+            col_d0[c] = 0.0;
+        };
+        const auto set_column = [&](std::size_t r, std::size_t c) {
+            double room = 0.0;
+            const std::uint32_t hs = half_sub_bin(row_d0(r) + static_cast<double>(c) * ux, room);
+            if (hs != col_hs[c]) {
+                flush(c);
+                col_hs[c] = hs;
+            }
+            schedule(r, c, room);
+        };
+        for (std::size_t c = 0; c < w; ++c) set_column(band.r0, c);
+
+        std::vector<std::int32_t> prev_bin(w, -1);
+        std::int32_t* const prev_b = prev_bin.data();
+        std::size_t prev_begin = 0, prev_end = 0;
+        std::vector<float> above_buffer(v1 ? w : 0), row_buffer(v1 ? w : 0);
+        const float* above = nullptr;
+        if (band.r0 > 0) {  // the row before the band: bins only (summed by the band above)
+            const std::size_t r = band.r0 - 1;
+            const detail::RowRun run = row_run(r);
+            const double d0 = row_d0(r);
+            for (std::size_t c = run.begin; c < run.end; ++c) {
+                const std::size_t i = r * w + c;
+                std::int32_t b = pixel_bin(i, d0 + static_cast<double>(c) * ux).bin;
+                if (b >= 0 && flags[i] != 0) b = -1;
+                prev_b[c] = b;
+            }
+            prev_begin = run.begin;
+            prev_end = run.end;
+            above = values_of(r, run.begin, run.end, above_buffer.data());
+        }
+        for (std::size_t r = band.r0; r < band.r1; ++r) {
+            for (const std::uint32_t c : recheck[r - band.r0]) set_column(r, c);
+            const detail::RowRun run = row_run(r);
+            std::fill(prev_b + prev_begin,
+                      prev_b + std::max(prev_begin, std::min(prev_end, run.begin)), -1);
+            std::fill(prev_b + std::min(prev_end, std::max(prev_begin, run.end)), prev_b + prev_end,
+                      -1);
+            prev_begin = run.begin;
+            prev_end = run.end;
+            const double d0 = row_d0(r), t0 = row_t0(r);
+            const float* const vals = values_of(r, run.begin, run.end, row_buffer.data());
+            const std::uint8_t* const row_flags = flags + r * w;
+            const auto class_at = [&](std::size_t c) {
+                return std::pair(pixel_bin(0, d0 + static_cast<double>(c) * ux).bin,
+                                 slice_at(t0, c));
+            };
+            // First column past an edge at `at` of a quantity at0 + c·step (rising: the first at
+            // or above it; falling: the first below it).
+            const auto column_past = [](double at, double at0, double step) {
+                const double x = (at - at0) / step;
+                return step > 0 ? std::ceil(x) : std::floor(x) + 1.0;
+            };
+            // The first edge above d at the segment's start (it moves one way along the row).
+            auto above_d = std::upper_bound(class_edges.begin(), class_edges.end(),
+                                            d0 + static_cast<double>(run.begin) * ux);
+            auto next_key = run.begin < run.end ? class_at(run.begin) : std::pair(-1, 0UL);
+            for (std::size_t c = run.begin; c < run.end;) {
+                const auto key = next_key;
+                // The segment's end: the next edge between bins (in d) and the next slice
+                // boundary (in t), whichever comes first along the row, then checked.
+                const double d = d0 + static_cast<double>(c) * ux;
+                double end_estimate = static_cast<double>(run.end);
+                if (ux > 0) {
+                    while (above_d != class_edges.end() && *above_d <= d) ++above_d;
+                    if (above_d != class_edges.end())
+                        end_estimate = std::min(end_estimate, column_past(*above_d, d0, ux));
+                } else {
+                    while (above_d != class_edges.begin() && *(above_d - 1) > d) --above_d;
+                    if (above_d != class_edges.begin())
+                        end_estimate = std::min(end_estimate, column_past(*(above_d - 1), d0, ux));
+                }
+                if (ax != 0.0) {
+                    const double t = t0 + static_cast<double>(c) * ax;
+                    end_estimate =
+                        std::min(end_estimate,
+                                 column_past(ax > 0 ? std::floor(t) + 1.0 : std::floor(t), t0, ax));
+                }
+                std::size_t e = static_cast<std::size_t>(std::clamp(
+                    end_estimate, static_cast<double>(c + 1), static_cast<double>(run.end)));
+                while (e > c + 1 && class_at(e - 1) != key) --e;
+                while (e < run.end && (next_key = class_at(e)) == key) ++e;
+                const std::int32_t b = key.first;
+                if (b < 0) {
+                    std::fill(prev_b + c, prev_b + e, -1);
+                    c = e;
+                    continue;
+                }
+                assert(key.second >= slice_lo && key.second < slice_lo + band_slices);
+                const std::size_t si =
+                    (static_cast<std::size_t>(b) - bin_lo) * band_slices + (key.second - slice_lo);
+                BinSums& bs = band_bins[static_cast<std::size_t>(b)];
+                double sum_a = 0, sum_b = 0, sum2_a = 0, sum2_b = 0, diff2 = 0;
+                std::size_t count = 0, diffs = 0;
+                unsigned flag_bits = 0;
+                for (std::size_t j = c; j < e; ++j) flag_bits |= row_flags[j];
+                const bool any_flag = flag_bits != 0;
+                if (!any_flag) {
+                    std::size_t j = c;
+                    for (; j + 1 < e; j += 2) {
+                        const double va = vals[j], vb = vals[j + 1];
+                        sum_a += va;
+                        sum_b += vb;
+                        sum2_a += va * va;
+                        sum2_b += vb * vb;
+                    }
+                    if (j < e) {
+                        const double va = vals[j];
+                        sum_a += va;
+                        sum2_a += va * va;
+                    }
+                    for (j = c; j < e; ++j) {
+                        if (prev_b[j] == b) {
+                            const double diff = static_cast<double>(vals[j]) - above[j];
+                            diff2 += diff * diff;
+                            ++diffs;
+                        }
+                        prev_b[j] = b;
+                        ++col_n[j];
+                        col_d0[j] += d0;
+                    }
+                    count = e - c;
+                } else {
+                    for (std::size_t j = c; j < e; ++j) {
+                        if (row_flags[j] != 0) {
+                            ++band.flagged;
+                            ++bs.flagged;
+                            prev_b[j] = -1;
+                            continue;
+                        }
+                        const double v = vals[j];
+                        sum_a += v;
+                        sum2_a += v * v;
+                        ++count;
+                        if (prev_b[j] == b) {
+                            const double diff = v - above[j];
+                            diff2 += diff * diff;
+                            ++diffs;
+                        }
+                        prev_b[j] = b;
+                        ++col_n[j];
+                        col_d0[j] += d0;
+                    }
+                }
+                const double sum = sum_a + sum_b;
+                bs.sum += sum;
+                bs.sum2 += sum2_a + sum2_b;
+                bs.diff2 += diff2;
+                bs.count += count;
+                bs.diffs += diffs;
+                slice_sum[si] += sum;
+                slice_count[si] += static_cast<std::uint32_t>(count);
+                c = e;
+            }
+            if (v1) std::swap(above_buffer, row_buffer);
+            above = v1 ? above_buffer.data() : vals;
+        }
+        for (std::size_t c = 0; c < w; ++c) flush(c);
+    };
     detail::run_bands(n_bands, options.threads, [&](std::size_t k) {
         prepare_band(bands[k], h * k / n_bands, h * (k + 1) / n_bands);
-        scan_band(bands[k]);
+        if (rows_along_axis && !reg)
+            scan_band_steep(bands[k]);
+        else
+            scan_band(bands[k]);
     });
 
     // The bands' sums, in band order.
@@ -552,6 +808,11 @@ CylinderProfile measure_cylinder_profile(const LinearImage& image,
     };
     std::vector<Work> kept;
     std::size_t dropped_small = 0, dropped_dark = 0;
+    // Each bin's used half-sub-bins, in order.
+    std::vector<std::vector<std::size_t>> subs_of_bin(n_bins);
+    for (std::size_t k = 0; k < 2 * n_sub; ++k)
+        if (sub_bin[k] >= 0 && sub_count[k] > 0)
+            subs_of_bin[static_cast<std::size_t>(sub_bin[k])].push_back(k);
     for (std::size_t b = 0; b < n_bins; ++b) {
         const BinSums& bs = bins[b];
         out.pixels_used += bs.count;
@@ -585,9 +846,7 @@ CylinderProfile measure_cylinder_profile(const LinearImage& image,
         pb.stderr_slices =
             J >= 2 ? std::sqrt(s2 * static_cast<double>(J) / static_cast<double>(J - 1)) / n : 0.0;
         // Nodes: the bin's sub-bins grouped into at most kNodesPerBin runs (count, mean d).
-        std::vector<std::size_t> subs;
-        for (std::size_t k = 0; k < 2 * n_sub; ++k)
-            if (sub_bin[k] == static_cast<std::int32_t>(b) && sub_count[k] > 0) subs.push_back(k);
+        const std::vector<std::size_t>& subs = subs_of_bin[b];
         const std::size_t group = (subs.size() + kNodesPerBin - 1) / kNodesPerBin;
         double dsum = 0;
         for (std::size_t g = 0; g < subs.size(); g += group) {
@@ -658,11 +917,13 @@ CylinderProfile measure_cylinder_profile(const LinearImage& image,
         nodes.push_back(std::move(wk.nodes));
     }
 
-    // Fits.
-    out.gaussian_fit = detail::fit_profile(out.bins, nodes, Correlation::Gaussian, options.factor,
-                                           options.radiometry);
-    out.exponential_fit = detail::fit_profile(out.bins, nodes, Correlation::Exponential,
-                                              options.factor, options.radiometry);
+    // Fits: the two correlations side by side (independent problems; the same result whatever
+    // the number of threads).
+    detail::run_bands(2, options.threads, [&](std::size_t k) {
+        (k == 0 ? out.gaussian_fit : out.exponential_fit) = detail::fit_profile(
+            out.bins, nodes, k == 0 ? Correlation::Gaussian : Correlation::Exponential,
+            options.factor, options.radiometry);
+    });
     if (out.gaussian_fit.sigma_over_T && out.exponential_fit.sigma_over_T)
         out.preferred = out.exponential_fit.aic < out.gaussian_fit.aic ? Correlation::Exponential
                                                                        : Correlation::Gaussian;

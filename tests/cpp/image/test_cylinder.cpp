@@ -382,4 +382,69 @@ TEST(CylinderProfile, ResultDoesNotDependOnTheNumberOfThreads) {
         }
 }
 
+// No region and a steep axis: each row's segments of one bin and one slice are summed in the
+// pass's fast path (classification at the segments' ends only, half-sub-bins kept per column).
+// A region of all ones sends the same pixels through the per-pixel path: the profiles must agree
+// to rounding, for tilted axes (slices change along a row, columns change half-sub-bin), both
+// signs of the tilt, grey and RGB, every half, detected and given axes, with flagged pixels.
+TEST(CylinderProfile, SegmentsSummedWithoutPerPixelTestsAgreeWithThePerPixelPath) {
+    for (const double tilt_deg : {0.0, 3.0, 30.0, -41.0})
+        for (const bool rgb : {false, true}) {
+            LinearImage img = tilted_cylinder(640, 800, deg_to_rad(tilt_deg), 180.0);
+            if (rgb) {
+                const std::vector<float> grey(img.values.begin(), img.values.end());
+                img.channels = 3;
+                img.values.resize(3 * grey.size());
+                for (std::size_t i = 0; i < grey.size(); ++i) {
+                    img.values[grey.size() + i] = 1.25F * grey[i];
+                    img.values[2 * grey.size() + i] = 0.5F * grey[i] + 0.01F;
+                }
+            }
+            const std::vector<std::uint8_t> everywhere(img.pixel_count(), 1);
+            for (const bool detected : {true, false})
+                for (const CylinderHalf half :
+                     {CylinderHalf::Right, CylinderHalf::Left, CylinderHalf::Both}) {
+                    SCOPED_TRACE(::testing::Message()
+                                 << "tilt " << tilt_deg << " rgb " << rgb << " detected "
+                                 << detected << " half " << to_string(half));
+                    CylinderOptions o;
+                    o.half = half;
+                    if (!detected)
+                        o.axis =
+                            cylinder_axis_from_line(320.0, 400.0, std::sin(deg_to_rad(tilt_deg)),
+                                                    std::cos(deg_to_rad(tilt_deg)), 180.0);
+                    const CylinderProfile fast = measure_cylinder_profile(img, nullptr, o);
+                    const CylinderProfile each = measure_cylinder_profile(img, &everywhere, o);
+                    EXPECT_EQ(fast.pixels_used, each.pixels_used);
+                    EXPECT_EQ(fast.pixels_flagged, each.pixels_flagged);
+                    EXPECT_GT(fast.pixels_flagged, 0U);
+                    ASSERT_EQ(fast.bins.size(), each.bins.size());
+                    ASSERT_GE(fast.bins.size(), 20U);
+                    for (std::size_t b = 0; b < fast.bins.size(); ++b) {
+                        const ProfileBin &x = fast.bins[b], &y = each.bins[b];
+                        EXPECT_EQ(x.count, y.count);
+                        EXPECT_EQ(x.flagged, y.flagged);
+                        EXPECT_EQ(x.slices, y.slices);
+                        EXPECT_NEAR(x.across_px, y.across_px, 1e-12 * std::abs(y.across_px));
+                        EXPECT_NEAR(x.brightness, y.brightness, 1e-12);
+                        EXPECT_NEAR(x.stderr_slices, y.stderr_slices, 1e-9 * y.stderr_slices);
+                        EXPECT_NEAR(x.stderr_pixel, y.stderr_pixel, 1e-9 * y.stderr_pixel);
+                        EXPECT_NEAR(x.theta_i_rad, y.theta_i_rad, 1e-12);
+                    }
+                    ASSERT_TRUE(fast.gaussian_fit.sigma_over_T && each.gaussian_fit.sigma_over_T);
+                    EXPECT_NEAR(*fast.gaussian_fit.sigma_over_T, *each.gaussian_fit.sigma_over_T,
+                                1e-7 * *each.gaussian_fit.sigma_over_T);
+                    // The fast path's sums do not depend on the number of threads either.
+                    o.threads = 3;
+                    const CylinderProfile three = measure_cylinder_profile(img, nullptr, o);
+                    ASSERT_EQ(three.bins.size(), fast.bins.size());
+                    for (std::size_t b = 0; b < fast.bins.size(); ++b) {
+                        EXPECT_EQ(three.bins[b].brightness, fast.bins[b].brightness);
+                        EXPECT_EQ(three.bins[b].across_px, fast.bins[b].across_px);
+                        EXPECT_EQ(three.bins[b].stderr_pixel, fast.bins[b].stderr_pixel);
+                    }
+                }
+        }
+}
+
 }  // namespace
