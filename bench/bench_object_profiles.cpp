@@ -7,7 +7,9 @@
 //                                            (uncompressed) of a Lambert cylinder or sphere lit
 //                                            from the camera
 //        objects/cylinder_profile/<rows>     read_image + measure_cylinder_profile (silhouette,
-//                                            axis, bins, models, fits, departures)
+//                                            axis, bins, models, fits, departures); the axis
+//                                            along the image's columns
+//        objects/cylinder_profile_horizontal/<rows>  the same, the axis along the image's rows
 //        objects/sphere_table/<rows>         read_image + measure_sphere_table (no model
 //                                            comparison: silhouette, circle, cells → BrdfTable)
 //        objects/sphere_compare/<rows>       read_image + measure_sphere with compare_brdf
@@ -41,7 +43,9 @@ std::size_t width_for(std::size_t rows) { return (24'000'000 / 4096) * rows / 40
 
 // Lambert object (L = V) on a dark background with a little deterministic texture:
 // 16-bit codes 60000 · cos θi + 400 on the object, 400 off it.
-void write_object_tiff(const std::filesystem::path& path, bool sphere, std::size_t width,
+enum class Shape { CylinderVertical, CylinderHorizontal, Sphere };
+
+void write_object_tiff(const std::filesystem::path& path, Shape shape, std::size_t width,
                        std::size_t height) {
     TIFF* tif = TIFFOpen(path.c_str(), "w");
     if (tif == nullptr) throw std::runtime_error("cannot write " + path.string());
@@ -60,7 +64,9 @@ void write_object_tiff(const std::filesystem::path& path, bool sphere, std::size
         const double y = (static_cast<double>(r) + 0.5 - cy) / R;
         for (std::size_t c = 0; c < width; ++c) {
             const double x = (static_cast<double>(c) + 0.5 - cx) / R;
-            const double rho2 = sphere ? x * x + y * y : x * x;
+            const double rho2 = shape == Shape::Sphere             ? x * x + y * y
+                                : shape == Shape::CylinderVertical ? x * x
+                                                                   : y * y;
             const double texture = 1.0 + 0.01 * static_cast<double>(((r * 7 + c * 13) % 17)) / 17;
             row[c] = static_cast<std::uint16_t>(
                 rho2 < 1.0 ? 400.0 + 60000.0 * std::sqrt(1.0 - rho2) / 1.01 * texture : 400.0);
@@ -78,14 +84,17 @@ struct BenchFile {
     }
 };
 
-const std::filesystem::path& object_file(bool sphere, std::size_t rows) {
-    static BenchFile files[2][2];
-    BenchFile& f = files[sphere ? 1 : 0][rows == 4096 ? 1 : 0];
+const std::filesystem::path& object_file(Shape shape, std::size_t rows) {
+    static BenchFile files[3][2];
+    BenchFile& f = files[static_cast<int>(shape)][rows == 4096 ? 1 : 0];
     if (f.path.empty()) {
+        const char* name = shape == Shape::Sphere             ? "sphere"
+                           : shape == Shape::CylinderVertical ? "cylinder"
+                                                              : "cylinder_horizontal";
         f.path = std::filesystem::temp_directory_path() /
-                 (std::string("roughscope_bench_") + (sphere ? "sphere" : "cylinder") + "_" +
-                  std::to_string(rows) + "_" + std::to_string(::getpid()) + ".tif");
-        write_object_tiff(f.path, sphere, width_for(rows), rows);
+                 (std::string("roughscope_bench_") + name + "_" + std::to_string(rows) + "_" +
+                  std::to_string(::getpid()) + ".tif");
+        write_object_tiff(f.path, shape, width_for(rows), rows);
     }
     return f.path;
 }
@@ -120,17 +129,18 @@ void set_counters(benchmark::State& state, std::size_t rows, double t, double t_
 }
 
 void BM_read_cylinder(benchmark::State& state) {
-    const auto& path = object_file(false, static_cast<std::size_t>(state.range(0)));
+    const auto& path =
+        object_file(Shape::CylinderVertical, static_cast<std::size_t>(state.range(0)));
     for (auto _ : state) benchmark::DoNotOptimize(read(path).values.data());
 }
 void BM_read_sphere(benchmark::State& state) {
-    const auto& path = object_file(true, static_cast<std::size_t>(state.range(0)));
+    const auto& path = object_file(Shape::Sphere, static_cast<std::size_t>(state.range(0)));
     for (auto _ : state) benchmark::DoNotOptimize(read(path).values.data());
 }
 
-void BM_cylinder_profile(benchmark::State& state) {
+void BM_cylinder_profile(benchmark::State& state, Shape shape) {
     const auto rows = static_cast<std::size_t>(state.range(0));
-    const auto& path = object_file(false, rows);
+    const auto& path = object_file(shape, rows);
     for (auto _ : state) cylinder(path);
     const double t = seconds_of([&] { cylinder(path); }, 3);
     const double t_read =
@@ -140,7 +150,7 @@ void BM_cylinder_profile(benchmark::State& state) {
 
 void BM_sphere_table(benchmark::State& state) {
     const auto rows = static_cast<std::size_t>(state.range(0));
-    const auto& path = object_file(true, rows);
+    const auto& path = object_file(Shape::Sphere, rows);
     for (auto _ : state) sphere(path, false);
     const double t = seconds_of([&] { sphere(path, false); }, 3);
     const double t_read =
@@ -150,7 +160,7 @@ void BM_sphere_table(benchmark::State& state) {
 
 void BM_sphere_compare(benchmark::State& state) {
     const auto rows = static_cast<std::size_t>(state.range(0));
-    const auto& path = object_file(true, rows);
+    const auto& path = object_file(Shape::Sphere, rows);
     for (auto _ : state) sphere(path, true);
     const double t = seconds_of([&] { sphere(path, true); }, 3);
     const double t_read =
@@ -163,8 +173,13 @@ BENCHMARK(BM_read_cylinder)
     ->Arg(256)
     ->Arg(4096)
     ->Unit(benchmark::kMillisecond);
-BENCHMARK(BM_cylinder_profile)
+BENCHMARK_CAPTURE(BM_cylinder_profile, vertical, Shape::CylinderVertical)
     ->Name("objects/cylinder_profile")
+    ->Arg(256)
+    ->Arg(4096)
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_cylinder_profile, horizontal, Shape::CylinderHorizontal)
+    ->Name("objects/cylinder_profile_horizontal")
     ->Arg(256)
     ->Arg(4096)
     ->Unit(benchmark::kMillisecond);

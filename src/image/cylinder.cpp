@@ -41,6 +41,37 @@ struct BinSums {
     std::size_t count = 0, diffs = 0, flagged = 0;
 };
 
+// Σv, Σv² and Σ(v_{j+1} − v_j)² of n values, each in four interleaved lanes (vectorised).
+struct RunMoments {
+    double sum = 0, sum2 = 0, neighbour_diff2 = 0;
+};
+RunMoments run_moments(const float* v, std::size_t n) {
+    double s[4] = {}, q[4] = {}, d[4] = {};
+    std::size_t j = 0;
+    for (; j + 4 <= n; j += 4)
+        for (std::size_t k = 0; k < 4; ++k) {
+            const double x = v[j + k];
+            s[k] += x;
+            q[k] += x * x;
+        }
+    for (; j < n; ++j) {
+        const double x = v[j];
+        s[0] += x;
+        q[0] += x * x;
+    }
+    for (j = 0; j + 5 <= n; j += 4)
+        for (std::size_t k = 0; k < 4; ++k) {
+            const double dx = static_cast<double>(v[j + k + 1]) - static_cast<double>(v[j + k]);
+            d[k] += dx * dx;
+        }
+    for (; j + 1 < n; ++j) {
+        const double dx = static_cast<double>(v[j + 1]) - static_cast<double>(v[j]);
+        d[0] += dx * dx;
+    }
+    return {(s[0] + s[1]) + (s[2] + s[3]), (q[0] + q[1]) + (q[2] + q[3]),
+            (d[0] + d[1]) + (d[2] + d[3])};
+}
+
 }  // namespace
 
 std::string_view to_string(CylinderHalf half) {
@@ -528,11 +559,89 @@ CylinderProfile measure_cylinder_profile(const LinearImage& image,
                                           : static_cast<double>(k + 1) / kSubBinsPerPx - R);
     }
     class_edges.push_back(static_cast<double>(n_sub) / kSubBinsPerPx - R);
+    // Helpers of the two segment passes (below): a row's d and t at column 0 (as the per-pixel
+    // path computes them), a column's slice, a row's values (RGB averaged as the per-pixel path
+    // does) over [begin, end), the first column past an edge at `at` of a quantity at0 + c·step
+    // (rising: the first at or above it; falling: the first below it), and the row at which a
+    // column whose quantity moves by `per_row` a row and is `room` from its nearest edge must be
+    // classified again (less 1e-6 for rounding; none when it does not move).
+    const double xc0 = 0.5 - axis.point_x_px;
+    const auto row_d0 = [&](std::size_t r) {
+        return xc0 * ux + (static_cast<double>(r) + 0.5 - axis.point_y_px) * uy;
+    };
+    const auto row_t0 = [&](std::size_t r) {
+        return xc0 * ax + (static_cast<double>(r) + 0.5 - axis.point_y_px) * ay - t_min;
+    };
+    const auto slice_at = [&](double t0, std::size_t c) {
+        return std::min(static_cast<std::size_t>(std::max(0.0, t0 + static_cast<double>(c) * ax)),
+                        n_slices - 1);
+    };
+    const auto values_of = [&](std::size_t r, std::size_t begin, std::size_t end,
+                               float* buffer) -> const float* {
+        const std::size_t o = r * w;
+        if (!p1) return p0 + o;
+        for (std::size_t c = begin; c < end; ++c)
+            buffer[c] = (p0[o + c] + p1[o + c] + p2[o + c]) * (1.0F / 3.0F);
+        return buffer;
+    };
+    const auto column_past = [](double at, double at0, double step) {
+        const double x = (at - at0) / step;
+        return step > 0 ? std::ceil(x) : std::floor(x) + 1.0;
+    };
+    const auto recheck_row = [](std::size_t r, double room, double per_row,
+                                std::size_t r_end) -> std::size_t {
+        if (per_row == 0.0) return r_end;
+        const double rows_left = std::floor((room - 1e-6) / per_row);
+        return rows_left >= 1.0 ? r + static_cast<std::size_t>(
+                                          std::min(rows_left, static_cast<double>(r_end - r)))
+                                : r + 1;
+    };
+    // A pixel's bin, or for an unused pixel the side of the used bins it is on (−1 below the
+    // middle of their range of d, −2 above). The unused pixels of a row are then contiguous runs
+    // like the bins' (the bins are one interval of d, the unused pixels the rest).
+    double used_lo = std::numeric_limits<double>::infinity(), used_hi = -used_lo;
+    for (std::size_t hs = 0; hs < 2 * n_sub; ++hs)
+        if (sub_bin[hs] >= 0) {
+            const double lo = static_cast<double>(hs / 2) / kSubBinsPerPx - R;
+            used_lo = std::min(used_lo, lo);
+            used_hi = std::max(used_hi, lo + 1.0 / kSubBinsPerPx);
+        }
+    const double used_middle = 0.5 * (used_lo + used_hi);
+    const auto unused_side = [used_middle](std::int32_t bin, double d) -> std::int32_t {
+        return bin >= 0 ? bin : (d < used_middle ? -1 : -2);
+    };
+    // The end of the segment of `key` that starts at column c of a row (the first column in
+    // (c, end) whose key differs, else end), from an estimate `e`: checked next to it (the usual
+    // case: two evaluations), else found by an exponential and a binary search (the keys of a
+    // row are contiguous runs).
+    const auto segment_end = [](const auto& key_at, const auto& key, std::size_t c, std::size_t e,
+                                std::size_t end) {
+        e = std::clamp(e, c + 1, end);
+        const bool same_before = key_at(e - 1) == key;
+        if (same_before && (e == end || key_at(e) != key)) return e;
+        // key_at(lo) == key; hi is end or a column whose key differs.
+        std::size_t lo = c, hi = end;
+        if (same_before)
+            lo = e;  // key_at(e) == key
+        else
+            hi = e - 1;
+        std::size_t step = 1;
+        while (lo + step < hi && key_at(lo + step) == key) {
+            lo += step;
+            step *= 2;
+        }
+        hi = std::min(hi, lo + step);
+        while (hi - lo > 1) {
+            const std::size_t mid = lo + (hi - lo) / 2;
+            (key_at(mid) == key ? lo : hi) = mid;
+        }
+        return hi;
+    };
     const auto scan_band_steep = [&](Band& band) {
         constexpr std::uint32_t kNone = std::numeric_limits<std::uint32_t>::max();
         const std::uint8_t* const flags = image.flags.data();
-        const float *const v0 = p0, *const v1 = p1, *const v2 = p2;
-        const std::size_t last_slice = n_slices - 1, sub_lo = band.sub_lo, bin_lo = band.bin_lo;
+        const float* const v1 = p1;
+        const std::size_t sub_lo = band.sub_lo, bin_lo = band.bin_lo;
         const std::size_t band_slices = band.n_band_slices, slice_lo = band.slice_lo;
         BinSums* const band_bins = band.bins.data();
         std::uint32_t* const sub_count = band.sub_count.data();
@@ -540,28 +649,6 @@ CylinderProfile measure_cylinder_profile(const LinearImage& image,
         double* const slice_sum = band.slice_sum.data();
         std::uint32_t* const slice_count = band.slice_count.data();
         const double* const split_of = split.data();
-        const double xc0 = 0.5 - axis.point_x_px;
-        const auto row_d0 = [&](std::size_t r) {
-            return xc0 * ux + (static_cast<double>(r) + 0.5 - axis.point_y_px) * uy;
-        };
-        const auto row_t0 = [&](std::size_t r) {
-            return xc0 * ax + (static_cast<double>(r) + 0.5 - axis.point_y_px) * ay - t_min;
-        };
-        const auto slice_at = [=](double t0, std::size_t c) {
-            return std::min(
-                static_cast<std::size_t>(std::max(0.0, t0 + static_cast<double>(c) * ax)),
-                last_slice);
-        };
-        // Row values (RGB averaged as the per-pixel path does) over [begin, end).
-        std::vector<float> rgb(v1 ? 2 * w : 0);
-        const auto values_of = [&](std::size_t r, std::size_t begin, std::size_t end,
-                                   float* buffer) -> const float* {
-            const std::size_t o = r * w;
-            if (!v1) return v0 + o;
-            for (std::size_t c = begin; c < end; ++c)
-                buffer[c] = (v0[o + c] + v1[o + c] + v2[o + c]) * (1.0F / 3.0F);
-            return buffer;
-        };
         // The half-sub-bin of (row with d0, column c), kNone outside the table, and the
         // distance in d to its nearest edge.
         const auto half_sub_bin = [&](double d, double& room) -> std::uint32_t {
@@ -582,16 +669,9 @@ CylinderProfile measure_cylinder_profile(const LinearImage& image,
         std::vector<std::uint32_t> col_hs(w, kNone), col_n(w, 0);
         std::vector<double> col_d0(w, 0.0);
         std::vector<std::vector<std::uint32_t>> recheck(rows);
-        const double abs_uy = std::abs(uy);
-        // Rows a column keeps its half-sub-bin: its d moves by |u_y| a row (less 1e-6 px for
-        // rounding); at the returned row it is computed again.
+        // A column keeps its half-sub-bin while its d, moving by |u_y| a row, stays inside it.
         const auto schedule = [&](std::size_t r, std::size_t c, double room) {
-            if (abs_uy == 0.0) return;
-            const double rows_left = std::floor((room - 1e-6) / abs_uy);
-            const std::size_t next =
-                r + (rows_left >= 1.0
-                         ? static_cast<std::size_t>(std::min(rows_left, static_cast<double>(rows)))
-                         : 1);
+            const std::size_t next = recheck_row(r, room, std::abs(uy), band.r1);
             if (next < band.r1) recheck[next - band.r0].push_back(static_cast<std::uint32_t>(c));
         };
         const auto flush = [&](std::size_t c) {
@@ -647,14 +727,8 @@ CylinderProfile measure_cylinder_profile(const LinearImage& image,
             const float* const vals = values_of(r, run.begin, run.end, row_buffer.data());
             const std::uint8_t* const row_flags = flags + r * w;
             const auto class_at = [&](std::size_t c) {
-                return std::pair(pixel_bin(0, d0 + static_cast<double>(c) * ux).bin,
-                                 slice_at(t0, c));
-            };
-            // First column past an edge at `at` of a quantity at0 + c·step (rising: the first at
-            // or above it; falling: the first below it).
-            const auto column_past = [](double at, double at0, double step) {
-                const double x = (at - at0) / step;
-                return step > 0 ? std::ceil(x) : std::floor(x) + 1.0;
+                const double d = d0 + static_cast<double>(c) * ux;
+                return std::pair(unused_side(pixel_bin(0, d).bin, d), slice_at(t0, c));
             };
             // The first edge above d at the segment's start (it moves one way along the row).
             auto above_d = std::upper_bound(class_edges.begin(), class_edges.end(),
@@ -683,8 +757,8 @@ CylinderProfile measure_cylinder_profile(const LinearImage& image,
                 }
                 std::size_t e = static_cast<std::size_t>(std::clamp(
                     end_estimate, static_cast<double>(c + 1), static_cast<double>(run.end)));
-                while (e > c + 1 && class_at(e - 1) != key) --e;
-                while (e < run.end && (next_key = class_at(e)) == key) ++e;
+                e = segment_end(class_at, key, c, e, run.end);
+                if (e < run.end) next_key = class_at(e);
                 const std::int32_t b = key.first;
                 if (b < 0) {
                     std::fill(prev_b + c, prev_b + e, -1);
@@ -762,12 +836,197 @@ CylinderProfile measure_cylinder_profile(const LinearImage& image,
         }
         for (std::size_t c = 0; c < w; ++c) flush(c);
     };
+    // The same along an axis closer to the image's rows (scan_band is its reference too). Along a
+    // row d moves by u_x a pixel (|u_x| < 0.71) and t by a_x: a row is cut into segments of one
+    // bin and one half-sub-bin (their pixels' count and Σd in closed form), and each column keeps
+    // the slice its sums belong to until the rows at which its t, moving by a_y a row, can have
+    // crossed a slice boundary (or its bin changes); noise from differences with the left
+    // neighbour, inside a flag-free segment without per-pixel tests.
+    const auto scan_band_shallow = [&](Band& band) {
+        const std::uint8_t* const flags = image.flags.data();
+        const std::size_t sub_lo = band.sub_lo, bin_lo = band.bin_lo;
+        const std::size_t band_slices = band.n_band_slices, slice_lo = band.slice_lo;
+        const std::size_t last_slice = n_slices - 1;
+        BinSums* const band_bins = band.bins.data();
+        std::uint32_t* const sub_count = band.sub_count.data();
+        double* const sub_d = band.sub_d.data();
+        double* const slice_sum = band.slice_sum.data();
+        std::uint32_t* const slice_count = band.slice_count.data();
+        const double* const split_of = split.data();
+        const std::size_t rows = band.r1 - band.r0;
+        std::vector<std::int32_t> col_bin(w, -1);
+        std::vector<std::size_t> col_slice(w, 0);
+        std::vector<std::uint32_t> col_n(w, 0);
+        std::vector<double> col_sum(w, 0.0);
+        std::vector<std::vector<std::uint32_t>> recheck(rows);
+        const auto flush = [&](std::size_t c) {
+            if (col_n[c] == 0) return;
+            assert(col_bin[c] >= 0);
+            const std::size_t b = static_cast<std::size_t>(col_bin[c]);
+            assert(col_slice[c] >= slice_lo && col_slice[c] < slice_lo + band_slices);
+            const std::size_t si = (b - bin_lo) * band_slices + (col_slice[c] - slice_lo);
+            slice_sum[si] += col_sum[c];
+            slice_count[si] += col_n[c];
+            col_n[c] = 0;
+            col_sum[c] = 0.0;
+        };
+        // A column's slice, and when it must be found again: t moves by |a_y| a row.
+        const auto set_slice = [&](std::size_t r, std::size_t c) {
+            const double t0 = row_t0(r);
+            const double t = t0 + static_cast<double>(c) * ax;
+            const std::size_t sl = slice_at(t0, c);
+            const double below =
+                sl == 0 ? -std::numeric_limits<double>::infinity() : static_cast<double>(sl);
+            const double above = sl == last_slice ? std::numeric_limits<double>::infinity()
+                                                  : static_cast<double>(sl + 1);
+            if (sl != col_slice[c]) {
+                flush(c);
+                col_slice[c] = sl;
+            }
+            const std::size_t next =
+                recheck_row(r, std::min(t - below, above - t), std::abs(ay), band.r1);
+            if (next < band.r1) recheck[next - band.r0].push_back(static_cast<std::uint32_t>(c));
+        };
+        for (std::size_t c = 0; c < w; ++c) set_slice(band.r0, c);
+        std::vector<float> row_buffer(p1 ? w : 0);
+        for (std::size_t r = band.r0; r < band.r1; ++r) {
+            for (const std::uint32_t c : recheck[r - band.r0]) set_slice(r, c);
+            const detail::RowRun run = row_run(r);
+            const double d0 = row_d0(r);
+            const float* const vals = values_of(r, run.begin, run.end, row_buffer.data());
+            const std::uint8_t* const row_flags = flags + r * w;
+            // The key of a pixel: its bin and (for a used bin) its half-sub-bin.
+            const auto key_at = [&](std::size_t c) {
+                const double d = d0 + static_cast<double>(c) * ux;
+                const PixelBin pb = pixel_bin(0, d);
+                return std::pair(unused_side(pb.bin, d), pb.bin >= 0 ? pb.sub : std::size_t{0});
+            };
+            auto above_d = std::upper_bound(class_edges.begin(), class_edges.end(),
+                                            d0 + static_cast<double>(run.begin) * ux);
+            float left_value = 0.0F;
+            std::int32_t left_bin = -1;
+            auto next_key = run.begin < run.end ? key_at(run.begin) : std::pair(-1, std::size_t{0});
+            for (std::size_t c = run.begin; c < run.end;) {
+                const auto key = next_key;
+                const std::int32_t b = key.first;
+                // The segment's end: the next edge of its half-sub-bin (a used bin) or between
+                // bins (the class edges) along the row, then checked.
+                const double d = d0 + static_cast<double>(c) * ux;
+                double end_estimate = static_cast<double>(run.end);
+                if (ux != 0.0) {
+                    if (ux > 0)
+                        while (above_d != class_edges.end() && *above_d <= d) ++above_d;
+                    else
+                        while (above_d != class_edges.begin() && *(above_d - 1) > d) --above_d;
+                    if (b >= 0) {
+                        const std::size_t k = key.second / 2;
+                        const double lo = static_cast<double>(k) / kSubBinsPerPx - R;
+                        const double hi = lo + 1.0 / kSubBinsPerPx;
+                        const bool upper = key.second % 2 == 1;
+                        const double edge = ux > 0 ? (upper ? hi : std::min(split_of[k], hi))
+                                                   : (upper ? split_of[k] : lo);
+                        end_estimate = std::min(end_estimate, column_past(edge, d0, ux));
+                    } else if (ux > 0 && above_d != class_edges.end()) {
+                        end_estimate = std::min(end_estimate, column_past(*above_d, d0, ux));
+                    } else if (ux < 0 && above_d != class_edges.begin()) {
+                        end_estimate = std::min(end_estimate, column_past(*(above_d - 1), d0, ux));
+                    }
+                }
+                std::size_t e = static_cast<std::size_t>(std::clamp(
+                    end_estimate, static_cast<double>(c + 1), static_cast<double>(run.end)));
+                e = segment_end(key_at, key, c, e, run.end);
+                if (e < run.end) next_key = key_at(e);
+                if (b < 0) {
+                    left_bin = -1;
+                    c = e;
+                    continue;
+                }
+                const std::size_t sub = key.second;
+                assert(sub >= sub_lo && sub < sub_lo + band.n_subs);
+                BinSums& bs = band_bins[static_cast<std::size_t>(b)];
+                unsigned flag_bits = 0;
+                for (std::size_t j = c; j < e; ++j) flag_bits |= row_flags[j];
+                double sum = 0, sum2 = 0, diff2 = 0, column_sum = 0;
+                std::size_t count = 0, diffs = 0;
+                if (flag_bits == 0) {
+                    // Every pixel used: the moments and the differences of neighbours inside the
+                    // segment in lanes, the difference with the pixel on its left, Σ column in
+                    // closed form; the columns' slice sums (a column whose bin changes first
+                    // hands its sums over).
+                    if (left_bin == b) {
+                        const double diff = static_cast<double>(vals[c]) - left_value;
+                        diff2 += diff * diff;
+                        ++diffs;
+                    }
+                    const RunMoments m = run_moments(vals + c, e - c);
+                    sum = m.sum;
+                    sum2 = m.sum2;
+                    diff2 += m.neighbour_diff2;
+                    count = e - c;
+                    diffs += count - 1;
+                    column_sum = 0.5 * static_cast<double>(c + e - 1) * static_cast<double>(count);
+                    unsigned other_bin = 0;
+                    for (std::size_t j = c; j < e; ++j) other_bin |= col_bin[j] != b ? 1U : 0U;
+                    if (other_bin != 0)
+                        for (std::size_t j = c; j < e; ++j)
+                            if (col_bin[j] != b) {
+                                flush(j);
+                                col_bin[j] = b;
+                            }
+                    for (std::size_t j = c; j < e; ++j) {
+                        col_sum[j] += static_cast<double>(vals[j]);
+                        ++col_n[j];
+                    }
+                    left_bin = b;
+                    left_value = vals[e - 1];
+                } else {
+                    for (std::size_t j = c; j < e; ++j) {
+                        if (row_flags[j] != 0) {
+                            ++band.flagged;
+                            ++bs.flagged;
+                            left_bin = -1;
+                            continue;
+                        }
+                        const double v = vals[j];
+                        sum += v;
+                        sum2 += v * v;
+                        ++count;
+                        column_sum += static_cast<double>(j);
+                        if (left_bin == b) {
+                            const double diff = v - static_cast<double>(left_value);
+                            diff2 += diff * diff;
+                            ++diffs;
+                        }
+                        left_bin = b;
+                        left_value = vals[j];
+                        if (col_bin[j] != b) {
+                            flush(j);
+                            col_bin[j] = b;
+                        }
+                        col_sum[j] += v;
+                        ++col_n[j];
+                    }
+                }
+                bs.sum += sum;
+                bs.sum2 += sum2;
+                bs.diff2 += diff2;
+                bs.count += count;
+                bs.diffs += diffs;
+                sub_count[sub - sub_lo] += static_cast<std::uint32_t>(count);
+                sub_d[sub - sub_lo] += static_cast<double>(count) * d0 + column_sum * ux;
+                c = e;
+            }
+        }
+        for (std::size_t c = 0; c < w; ++c) flush(c);
+    };
     detail::run_bands(n_bands, options.threads, [&](std::size_t k) {
         prepare_band(bands[k], h * k / n_bands, h * (k + 1) / n_bands);
-        if (rows_along_axis && !reg)
+        if (reg)
+            scan_band(bands[k]);
+        else if (rows_along_axis)
             scan_band_steep(bands[k]);
         else
-            scan_band(bands[k]);
+            scan_band_shallow(bands[k]);
     });
 
     // The bands' sums, in band order.

@@ -382,13 +382,14 @@ TEST(CylinderProfile, ResultDoesNotDependOnTheNumberOfThreads) {
         }
 }
 
-// No region and a steep axis: each row's segments of one bin and one slice are summed in the
-// pass's fast path (classification at the segments' ends only, half-sub-bins kept per column).
-// A region of all ones sends the same pixels through the per-pixel path: the profiles must agree
-// to rounding, for tilted axes (slices change along a row, columns change half-sub-bin), both
-// signs of the tilt, grey and RGB, every half, detected and given axes, with flagged pixels.
+// No region: each row's segments are summed in the pass's segment paths (classification at the
+// segments' ends only; along a steep axis half-sub-bins kept per column, along a shallow one
+// slices kept per column). A region of all ones sends the same pixels through the per-pixel
+// path: the profiles must agree to rounding, for axes near the columns and near the rows, tilted
+// (slices and half-sub-bins change along a row and down a column), both signs of the tilt, grey
+// and RGB, every half, detected and given axes, with flagged pixels.
 TEST(CylinderProfile, SegmentsSummedWithoutPerPixelTestsAgreeWithThePerPixelPath) {
-    for (const double tilt_deg : {0.0, 3.0, 30.0, -41.0})
+    for (const double tilt_deg : {0.0, 3.0, 30.0, -41.0, 90.0, 87.0, 60.0, -50.0})
         for (const bool rgb : {false, true}) {
             LinearImage img = tilted_cylinder(640, 800, deg_to_rad(tilt_deg), 180.0);
             if (rgb) {
@@ -420,8 +421,19 @@ TEST(CylinderProfile, SegmentsSummedWithoutPerPixelTestsAgreeWithThePerPixelPath
                     EXPECT_GT(fast.pixels_flagged, 0U);
                     ASSERT_EQ(fast.bins.size(), each.bins.size());
                     ASSERT_GE(fast.bins.size(), 20U);
+                    // Bins in order of α (bins at ±α of both halves have the same θi to rounding,
+                    // and the profile's order of such a pair follows that rounding).
+                    const auto by_alpha = [](std::vector<ProfileBin> bins) {
+                        std::sort(bins.begin(), bins.end(),
+                                  [](const ProfileBin& p, const ProfileBin& q) {
+                                      return p.alpha_rad < q.alpha_rad;
+                                  });
+                        return bins;
+                    };
+                    const std::vector<ProfileBin> fast_bins = by_alpha(fast.bins),
+                                                  each_bins = by_alpha(each.bins);
                     for (std::size_t b = 0; b < fast.bins.size(); ++b) {
-                        const ProfileBin &x = fast.bins[b], &y = each.bins[b];
+                        const ProfileBin &x = fast_bins[b], &y = each_bins[b];
                         EXPECT_EQ(x.count, y.count);
                         EXPECT_EQ(x.flagged, y.flagged);
                         EXPECT_EQ(x.slices, y.slices);
