@@ -602,7 +602,8 @@ CylinderProfile measure_cylinder_profile(const LinearImage& image,
     double used_lo = std::numeric_limits<double>::infinity(), used_hi = -used_lo;
     for (std::size_t hs = 0; hs < 2 * n_sub; ++hs)
         if (sub_bin[hs] >= 0) {
-            const double lo = static_cast<double>(hs / 2) / kSubBinsPerPx - R;
+            const std::size_t k = hs / 2;  // the sub-bin
+            const double lo = static_cast<double>(k) / kSubBinsPerPx - R;
             used_lo = std::min(used_lo, lo);
             used_hi = std::max(used_hi, lo + 1.0 / kSubBinsPerPx);
         }
