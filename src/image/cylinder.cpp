@@ -306,6 +306,20 @@ CylinderProfile measure_cylinder_profile(const LinearImage& image,
         std::vector<double> slice_sum;  // (b − bin_lo) · n_band_slices + (j − slice_lo)
         std::vector<std::uint32_t> slice_count;
         std::size_t flagged = 0;
+        // The accumulators as raw pointers and their ranges' offsets (for the passes' locals).
+        struct Outputs {
+            BinSums* bins;
+            std::uint32_t* sub_count;
+            double* sub_d;
+            double* slice_sum;
+            std::uint32_t* slice_count;
+            std::size_t sub_lo, bin_lo, band_slices, slice_lo;
+        };
+        Outputs outputs() {
+            return {bins.data(),      sub_count.data(),   sub_d.data(),
+                    slice_sum.data(), slice_count.data(), sub_lo,
+                    bin_lo,           n_band_slices,      slice_lo};
+        }
     };
     const std::size_t n_bands = std::clamp<std::size_t>(h / kRowsPerBand, 1, kMaxBands);
     std::vector<Band> bands(n_bands);
@@ -375,9 +389,50 @@ CylinderProfile measure_cylinder_profile(const LinearImage& image,
     const auto row_run = [&](std::size_t r) -> detail::RowRun {
         return object_rows.empty() ? detail::RowRun{0, w} : object_rows[r];
     };
+    // Helpers of the two segment passes (below): a row's d and t at column 0 (as the per-pixel
+    // path computes them), a column's slice, a row's values (RGB averaged as the per-pixel path
+    // does) over [begin, end), the first column past an edge at `at` of a quantity at0 + c·step
+    // (rising: the first at or above it; falling: the first below it), and the row at which a
+    // column whose quantity moves by `per_row` a row and is `room` from its nearest edge must be
+    // classified again (less 1e-6 for rounding; none when it does not move).
+    const double xc0 = 0.5 - axis.point_x_px;
+    const auto row_d0 = [&](std::size_t r) {
+        return xc0 * ux + (static_cast<double>(r) + 0.5 - axis.point_y_px) * uy;
+    };
+    const auto row_t0 = [&](std::size_t r) {
+        return xc0 * ax + (static_cast<double>(r) + 0.5 - axis.point_y_px) * ay - t_min;
+    };
+    const auto slice_at = [&](double t0, std::size_t c) {
+        return std::min(static_cast<std::size_t>(std::max(0.0, t0 + static_cast<double>(c) * ax)),
+                        n_slices - 1);
+    };
+    const auto values_of = [&](std::size_t r, std::size_t begin, std::size_t end,
+                               float* buffer) -> const float* {
+        const std::size_t o = r * w;
+        if (!p1) return p0 + o;
+        for (std::size_t c = begin; c < end; ++c)
+            buffer[c] = (p0[o + c] + p1[o + c] + p2[o + c]) * (1.0F / 3.0F);
+        return buffer;
+    };
+    // The bins of row r's pixels into bins[c] (−1: unused or flagged) over its run, returned.
+    const auto mark_row_bins = [&](std::size_t r, std::int32_t* bins) {
+        const detail::RowRun run = row_run(r);
+        const double d0 = row_d0(r);
+        for (std::size_t c = run.begin; c < run.end; ++c) {
+            const std::size_t i = r * w + c;
+            const std::int32_t b = pixel_bin(i, d0 + static_cast<double>(c) * ux).bin;
+            bins[c] = b >= 0 && image.flags[i] != 0 ? -1 : b;
+        }
+        return run;
+    };
+    // The previous row's bins outside this row's run: no pixel above.
+    const auto clear_outside = [](std::int32_t* bins, std::size_t begin, std::size_t end,
+                                  detail::RowRun run) {
+        std::fill(bins + begin, bins + std::max(begin, std::min(end, run.begin)), -1);
+        std::fill(bins + std::min(end, std::max(begin, run.end)), bins + end, -1);
+    };
     const auto scan_band = [&](Band& band) {
         // Local copies (kept in registers: the stores below cannot alias them).
-        const auto bin_at = pixel_bin;
         // The previous row's entry of the sub-bin table per column: along a steep axis a column
         // keeps its sub-bin from row to row, and the table (one entry per 1/8 px, one cache line
         // a pixel) is read only where it changes.
@@ -399,56 +454,30 @@ CylinderProfile measure_cylinder_profile(const LinearImage& image,
         };
         const std::uint8_t* const flags = image.flags.data();
         const float *const v0 = p0, *const v1 = p1, *const v2 = p2;
-        const double step_d = ux, step_t = ax, t_origin = t_min;
+        const double step_d = ux, step_t = ax;
         const bool steep = rows_along_axis;
-        const std::size_t last_slice = n_slices - 1, sub_lo = band.sub_lo, bin_lo = band.bin_lo;
-        const std::size_t band_slices = band.n_band_slices, slice_lo = band.slice_lo;
-        BinSums* const band_bins = band.bins.data();
-        std::uint32_t* const sub_count = band.sub_count.data();
-        double* const sub_d = band.sub_d.data();
-        double* const slice_sum = band.slice_sum.data();
-        std::uint32_t* const slice_count = band.slice_count.data();
+        const std::size_t last_slice = n_slices - 1;
+        const Band::Outputs acc = band.outputs();
         std::vector<float> prev_value(w, 0.0F);
         std::vector<std::int32_t> prev_bin(w, -1);
         float* const prev_v = prev_value.data();
         std::int32_t* const prev_b = prev_bin.data();
         std::size_t prev_begin = 0, prev_end = 0;  // columns of the previous row visited
         // The row before the band: bins and values only (it is summed by the band above).
-        const auto row_d0 = [&](std::size_t r) {
-            const double yc = static_cast<double>(r) + 0.5 - axis.point_y_px;
-            return (0.5 - axis.point_x_px) * ux + yc * uy;
-        };
         if (band.r0 > 0 && rows_along_axis) {
-            const std::size_t r = band.r0 - 1;
-            const detail::RowRun run = row_run(r);
-            const double d0 = row_d0(r);
-            for (std::size_t c = run.begin; c < run.end; ++c) {
-                const std::size_t i = r * w + c;
-                std::int32_t b = bin_at(i, d0 + static_cast<double>(c) * ux).bin;
-                if (b >= 0 && flags[i] != 0) b = -1;
-                if (b >= 0) {
-                    float v = v0[i];
-                    if (v1) v = (v + v1[i] + v2[i]) * (1.0F / 3.0F);
-                    prev_v[c] = v;
-                }
-                prev_b[c] = b;
-            }
+            const detail::RowRun run = mark_row_bins(band.r0 - 1, prev_b);
+            const float* const above = values_of(band.r0 - 1, run.begin, run.end, prev_v);
+            for (std::size_t c = run.begin; c < run.end; ++c)
+                if (prev_b[c] >= 0) prev_v[c] = above[c];
             prev_begin = run.begin;
             prev_end = run.end;
         }
         for (std::size_t r = band.r0; r < band.r1; ++r) {
             const detail::RowRun run = row_run(r);
-            // Columns of the previous row's run outside this one: no pixel above.
-            std::fill(prev_b + prev_begin,
-                      prev_b + std::max(prev_begin, std::min(prev_end, run.begin)), -1);
-            std::fill(prev_b + std::min(prev_end, std::max(prev_begin, run.end)), prev_b + prev_end,
-                      -1);
+            clear_outside(prev_b, prev_begin, prev_end, run);
             prev_begin = run.begin;
             prev_end = run.end;
-            const double yc = static_cast<double>(r) + 0.5 - axis.point_y_px;
-            const double xc0 = 0.5 - axis.point_x_px;
-            const double d0 = row_d0(r);
-            const double t0 = xc0 * ax + yc * ay - t_origin;
+            const double d0 = row_d0(r), t0 = row_t0(r);
             float left_value = 0.0F;
             std::int32_t left_bin = -1;
             // Runs of one bin, one half-sub-bin and one slice along the row are summed here and
@@ -461,7 +490,7 @@ CylinderProfile measure_cylinder_profile(const LinearImage& image,
             double slice_run_sum = 0.0;
             const auto end_bin_run = [&] {
                 if (bin_run_of < 0) return;
-                BinSums& bs = band_bins[static_cast<std::size_t>(bin_run_of)];
+                BinSums& bs = acc.bins[static_cast<std::size_t>(bin_run_of)];
                 bs.sum += bin_run.sum;
                 bs.sum2 += bin_run.sum2;
                 bs.diff2 += bin_run.diff2;
@@ -471,15 +500,15 @@ CylinderProfile measure_cylinder_profile(const LinearImage& image,
             };
             const auto end_sub_run = [&] {
                 if (sub_run_count == 0) return;
-                sub_count[sub_run_of] += static_cast<std::uint32_t>(sub_run_count);
-                sub_d[sub_run_of] += sub_run_d;
+                acc.sub_count[sub_run_of] += static_cast<std::uint32_t>(sub_run_count);
+                acc.sub_d[sub_run_of] += sub_run_d;
                 sub_run_count = 0;
                 sub_run_d = 0.0;
             };
             const auto end_slice_run = [&] {
                 if (slice_run_count == 0) return;
-                slice_sum[slice_run_of] += slice_run_sum;
-                slice_count[slice_run_of] += static_cast<std::uint32_t>(slice_run_count);
+                acc.slice_sum[slice_run_of] += slice_run_sum;
+                acc.slice_count[slice_run_of] += static_cast<std::uint32_t>(slice_run_count);
                 slice_run_count = 0;
                 slice_run_sum = 0.0;
             };
@@ -490,7 +519,7 @@ CylinderProfile measure_cylinder_profile(const LinearImage& image,
                 std::int32_t b = pbin.bin;
                 if (b >= 0 && flags[i] != 0) {
                     ++band.flagged;
-                    ++band_bins[static_cast<std::size_t>(b)].flagged;
+                    ++acc.bins[static_cast<std::size_t>(b)].flagged;
                     b = -1;
                 }
                 if (b >= 0) {
@@ -505,9 +534,9 @@ CylinderProfile measure_cylinder_profile(const LinearImage& image,
                     bin_run.sum2 += vd * vd;
                     ++bin_run.count;
                     assert(pbin.sub >= band.sub_lo && pbin.sub < band.sub_lo + band.n_subs);
-                    if (pbin.sub - sub_lo != sub_run_of) {
+                    if (pbin.sub - acc.sub_lo != sub_run_of) {
                         end_sub_run();
-                        sub_run_of = pbin.sub - sub_lo;
+                        sub_run_of = pbin.sub - acc.sub_lo;
                     }
                     ++sub_run_count;
                     sub_run_d += d;
@@ -516,7 +545,8 @@ CylinderProfile measure_cylinder_profile(const LinearImage& image,
                                                     last_slice);
                     assert(sl >= band.slice_lo && sl < band.slice_lo + band.n_band_slices);
                     const std::size_t si =
-                        (static_cast<std::size_t>(b) - bin_lo) * band_slices + (sl - slice_lo);
+                        (static_cast<std::size_t>(b) - acc.bin_lo) * acc.band_slices +
+                        (sl - acc.slice_lo);
                     if (si != slice_run_of) {
                         end_slice_run();
                         slice_run_of = si;
@@ -559,31 +589,6 @@ CylinderProfile measure_cylinder_profile(const LinearImage& image,
                                           : static_cast<double>(k + 1) / kSubBinsPerPx - R);
     }
     class_edges.push_back(static_cast<double>(n_sub) / kSubBinsPerPx - R);
-    // Helpers of the two segment passes (below): a row's d and t at column 0 (as the per-pixel
-    // path computes them), a column's slice, a row's values (RGB averaged as the per-pixel path
-    // does) over [begin, end), the first column past an edge at `at` of a quantity at0 + c·step
-    // (rising: the first at or above it; falling: the first below it), and the row at which a
-    // column whose quantity moves by `per_row` a row and is `room` from its nearest edge must be
-    // classified again (less 1e-6 for rounding; none when it does not move).
-    const double xc0 = 0.5 - axis.point_x_px;
-    const auto row_d0 = [&](std::size_t r) {
-        return xc0 * ux + (static_cast<double>(r) + 0.5 - axis.point_y_px) * uy;
-    };
-    const auto row_t0 = [&](std::size_t r) {
-        return xc0 * ax + (static_cast<double>(r) + 0.5 - axis.point_y_px) * ay - t_min;
-    };
-    const auto slice_at = [&](double t0, std::size_t c) {
-        return std::min(static_cast<std::size_t>(std::max(0.0, t0 + static_cast<double>(c) * ax)),
-                        n_slices - 1);
-    };
-    const auto values_of = [&](std::size_t r, std::size_t begin, std::size_t end,
-                               float* buffer) -> const float* {
-        const std::size_t o = r * w;
-        if (!p1) return p0 + o;
-        for (std::size_t c = begin; c < end; ++c)
-            buffer[c] = (p0[o + c] + p1[o + c] + p2[o + c]) * (1.0F / 3.0F);
-        return buffer;
-    };
     const auto column_past = [](double at, double at0, double step) {
         const double x = (at - at0) / step;
         return step > 0 ? std::ceil(x) : std::floor(x) + 1.0;
@@ -642,13 +647,7 @@ CylinderProfile measure_cylinder_profile(const LinearImage& image,
         constexpr std::uint32_t kNone = std::numeric_limits<std::uint32_t>::max();
         const std::uint8_t* const flags = image.flags.data();
         const float* const v1 = p1;
-        const std::size_t sub_lo = band.sub_lo, bin_lo = band.bin_lo;
-        const std::size_t band_slices = band.n_band_slices, slice_lo = band.slice_lo;
-        BinSums* const band_bins = band.bins.data();
-        std::uint32_t* const sub_count = band.sub_count.data();
-        double* const sub_d = band.sub_d.data();
-        double* const slice_sum = band.slice_sum.data();
-        std::uint32_t* const slice_count = band.slice_count.data();
+        const Band::Outputs acc = band.outputs();
         const double* const split_of = split.data();
         // The half-sub-bin of (row with d0, column c), kNone outside the table, and the
         // distance in d to its nearest edge.
@@ -678,9 +677,9 @@ CylinderProfile measure_cylinder_profile(const LinearImage& image,
         const auto flush = [&](std::size_t c) {
             if (col_n[c] == 0) return;
             const std::uint32_t hs = col_hs[c];
-            assert(hs != kNone && hs >= sub_lo && hs < sub_lo + band.n_subs);
-            sub_count[hs - sub_lo] += col_n[c];
-            sub_d[hs - sub_lo] +=
+            assert(hs != kNone && hs >= acc.sub_lo && hs < acc.sub_lo + band.n_subs);
+            acc.sub_count[hs - acc.sub_lo] += col_n[c];
+            acc.sub_d[hs - acc.sub_lo] +=
                 col_d0[c] + static_cast<double>(col_n[c]) * (static_cast<double>(c) * ux);
             col_n[c] = 0;
             col_d0[c] = 0.0;
@@ -702,26 +701,15 @@ CylinderProfile measure_cylinder_profile(const LinearImage& image,
         std::vector<float> above_buffer(v1 ? w : 0), row_buffer(v1 ? w : 0);
         const float* above = nullptr;
         if (band.r0 > 0) {  // the row before the band: bins only (summed by the band above)
-            const std::size_t r = band.r0 - 1;
-            const detail::RowRun run = row_run(r);
-            const double d0 = row_d0(r);
-            for (std::size_t c = run.begin; c < run.end; ++c) {
-                const std::size_t i = r * w + c;
-                std::int32_t b = pixel_bin(i, d0 + static_cast<double>(c) * ux).bin;
-                if (b >= 0 && flags[i] != 0) b = -1;
-                prev_b[c] = b;
-            }
+            const detail::RowRun run = mark_row_bins(band.r0 - 1, prev_b);
             prev_begin = run.begin;
             prev_end = run.end;
-            above = values_of(r, run.begin, run.end, above_buffer.data());
+            above = values_of(band.r0 - 1, run.begin, run.end, above_buffer.data());
         }
         for (std::size_t r = band.r0; r < band.r1; ++r) {
             for (const std::uint32_t c : recheck[r - band.r0]) set_column(r, c);
             const detail::RowRun run = row_run(r);
-            std::fill(prev_b + prev_begin,
-                      prev_b + std::max(prev_begin, std::min(prev_end, run.begin)), -1);
-            std::fill(prev_b + std::min(prev_end, std::max(prev_begin, run.end)), prev_b + prev_end,
-                      -1);
+            clear_outside(prev_b, prev_begin, prev_end, run);
             prev_begin = run.begin;
             prev_end = run.end;
             const double d0 = row_d0(r), t0 = row_t0(r);
@@ -766,10 +754,11 @@ CylinderProfile measure_cylinder_profile(const LinearImage& image,
                     c = e;
                     continue;
                 }
-                assert(key.second >= slice_lo && key.second < slice_lo + band_slices);
+                assert(key.second >= acc.slice_lo && key.second < acc.slice_lo + acc.band_slices);
                 const std::size_t si =
-                    (static_cast<std::size_t>(b) - bin_lo) * band_slices + (key.second - slice_lo);
-                BinSums& bs = band_bins[static_cast<std::size_t>(b)];
+                    (static_cast<std::size_t>(b) - acc.bin_lo) * acc.band_slices +
+                    (key.second - acc.slice_lo);
+                BinSums& bs = acc.bins[static_cast<std::size_t>(b)];
                 double sum_a = 0, sum_b = 0, sum2_a = 0, sum2_b = 0, diff2 = 0;
                 std::size_t count = 0, diffs = 0;
                 unsigned flag_bits = 0;
@@ -828,8 +817,8 @@ CylinderProfile measure_cylinder_profile(const LinearImage& image,
                 bs.diff2 += diff2;
                 bs.count += count;
                 bs.diffs += diffs;
-                slice_sum[si] += sum;
-                slice_count[si] += static_cast<std::uint32_t>(count);
+                acc.slice_sum[si] += sum;
+                acc.slice_count[si] += static_cast<std::uint32_t>(count);
                 c = e;
             }
             if (v1) std::swap(above_buffer, row_buffer);
@@ -845,14 +834,8 @@ CylinderProfile measure_cylinder_profile(const LinearImage& image,
     // neighbour, inside a flag-free segment without per-pixel tests.
     const auto scan_band_shallow = [&](Band& band) {
         const std::uint8_t* const flags = image.flags.data();
-        const std::size_t sub_lo = band.sub_lo, bin_lo = band.bin_lo;
-        const std::size_t band_slices = band.n_band_slices, slice_lo = band.slice_lo;
         const std::size_t last_slice = n_slices - 1;
-        BinSums* const band_bins = band.bins.data();
-        std::uint32_t* const sub_count = band.sub_count.data();
-        double* const sub_d = band.sub_d.data();
-        double* const slice_sum = band.slice_sum.data();
-        std::uint32_t* const slice_count = band.slice_count.data();
+        const Band::Outputs acc = band.outputs();
         const double* const split_of = split.data();
         const std::size_t rows = band.r1 - band.r0;
         std::vector<std::int32_t> col_bin(w, -1);
@@ -864,10 +847,11 @@ CylinderProfile measure_cylinder_profile(const LinearImage& image,
             if (col_n[c] == 0) return;
             assert(col_bin[c] >= 0);
             const std::size_t b = static_cast<std::size_t>(col_bin[c]);
-            assert(col_slice[c] >= slice_lo && col_slice[c] < slice_lo + band_slices);
-            const std::size_t si = (b - bin_lo) * band_slices + (col_slice[c] - slice_lo);
-            slice_sum[si] += col_sum[c];
-            slice_count[si] += col_n[c];
+            assert(col_slice[c] >= acc.slice_lo && col_slice[c] < acc.slice_lo + acc.band_slices);
+            const std::size_t si =
+                (b - acc.bin_lo) * acc.band_slices + (col_slice[c] - acc.slice_lo);
+            acc.slice_sum[si] += col_sum[c];
+            acc.slice_count[si] += col_n[c];
             col_n[c] = 0;
             col_sum[c] = 0.0;
         };
@@ -943,8 +927,8 @@ CylinderProfile measure_cylinder_profile(const LinearImage& image,
                     continue;
                 }
                 const std::size_t sub = key.second;
-                assert(sub >= sub_lo && sub < sub_lo + band.n_subs);
-                BinSums& bs = band_bins[static_cast<std::size_t>(b)];
+                assert(sub >= acc.sub_lo && sub < acc.sub_lo + band.n_subs);
+                BinSums& bs = acc.bins[static_cast<std::size_t>(b)];
                 unsigned flag_bits = 0;
                 for (std::size_t j = c; j < e; ++j) flag_bits |= row_flags[j];
                 double sum = 0, sum2 = 0, diff2 = 0, column_sum = 0;
@@ -1013,8 +997,8 @@ CylinderProfile measure_cylinder_profile(const LinearImage& image,
                 bs.diff2 += diff2;
                 bs.count += count;
                 bs.diffs += diffs;
-                sub_count[sub - sub_lo] += static_cast<std::uint32_t>(count);
-                sub_d[sub - sub_lo] += static_cast<double>(count) * d0 + column_sum * ux;
+                acc.sub_count[sub - acc.sub_lo] += static_cast<std::uint32_t>(count);
+                acc.sub_d[sub - acc.sub_lo] += static_cast<double>(count) * d0 + column_sum * ux;
                 c = e;
             }
         }
