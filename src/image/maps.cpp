@@ -237,39 +237,18 @@ std::optional<RatioInverseTable::Value> RatioInverseTable::lookup(double log_rat
                                                                   std::size_t& hint) const {
     const std::size_t n = y_.size();
     if (!(log_ratio >= y_.front() && log_ratio <= y_.back())) return std::nullopt;
-    // Galloping search from the last interval: nearby ratios cost a few comparisons.
-    std::size_t j = std::min(hint, n - 2);
-    if (log_ratio < y_[j]) {
-        std::size_t step = 1, hi = j;
-        while (true) {
-            const std::size_t lo = hi >= step ? hi - step : 0;
-            if (y_[lo] <= log_ratio) {
-                // y_[lo] ≤ log_ratio < y_[hi]
-                const auto it =
-                    std::upper_bound(y_.begin() + static_cast<std::ptrdiff_t>(lo),
-                                     y_.begin() + static_cast<std::ptrdiff_t>(hi), log_ratio);
-                j = static_cast<std::size_t>(it - y_.begin()) - 1;
-                break;
-            }
-            hi = lo;
-            step *= 2;
-        }
-    } else if (log_ratio > y_[j + 1]) {
-        std::size_t step = 1, lo = j + 1;
-        while (true) {
-            const std::size_t hi = std::min(n - 1, lo + step);
-            if (log_ratio <= y_[hi]) {
-                // y_[lo] < log_ratio ≤ y_[hi]
-                const auto it =
-                    std::lower_bound(y_.begin() + static_cast<std::ptrdiff_t>(lo),
-                                     y_.begin() + static_cast<std::ptrdiff_t>(hi), log_ratio);
-                j = std::min(n - 2, static_cast<std::size_t>(it - y_.begin()) - 1);
-                break;
-            }
-            lo = hi;
-            step *= 2;
-        }
-    }
+    // The intervals of the value's bucket: from the one holding its start to the one holding
+    // its end.
+    const std::size_t buckets = bucket_interval_.size() - 1;
+    const auto b =
+        std::min(buckets - 1, static_cast<std::size_t>((log_ratio - y_.front()) * bucket_scale_));
+    std::size_t first = bucket_interval_[b], last = bucket_interval_[b + 1];
+    // (The bucket's value and its ends are rounded: one more interval either side if need be.)
+    while (first > 0 && y_[first] > log_ratio) --first;
+    while (last + 2 < n && y_[last + 1] <= log_ratio) ++last;
+    const auto it = std::upper_bound(y_.begin() + static_cast<std::ptrdiff_t>(first) + 1,
+                                     y_.begin() + static_cast<std::ptrdiff_t>(last) + 1, log_ratio);
+    std::size_t j = std::min(n - 2, static_cast<std::size_t>(it - y_.begin()) - 1);
     hint = j;
     // The cubic Hermite interpolant in y between nodes j and j + 1.
     const std::array<double, 5>& c = coefficients_[j];
@@ -282,7 +261,17 @@ std::optional<RatioInverseTable::Value> RatioInverseTable::lookup(double log_rat
 }
 
 void RatioInverseTable::build_coefficients() {
-    coefficients_.resize(y_.size() - 1);
+    const std::size_t intervals = y_.size() - 1;
+    const std::size_t buckets = 4 * intervals;
+    bucket_scale_ = static_cast<double>(buckets) / (y_.back() - y_.front());
+    bucket_interval_.resize(buckets + 1);
+    std::size_t at = 0;
+    for (std::size_t b = 0; b <= buckets; ++b) {
+        const double y = y_.front() + static_cast<double>(b) / bucket_scale_;
+        while (at + 1 < intervals && y_[at + 1] <= y) ++at;
+        bucket_interval_[b] = static_cast<std::uint32_t>(at);
+    }
+    coefficients_.resize(intervals);
     for (std::size_t j = 0; j + 1 < y_.size(); ++j) {
         const double dy = y_[j + 1] - y_[j];
         const double x0 = x_[j], x1 = x_[j + 1], d0 = dxdy_[j] * dy, d1 = dxdy_[j + 1] * dy;

@@ -93,8 +93,9 @@ class RatioInverseTable {
         double x = 0.0;              // the unknown
         double dx_dlog_ratio = 0.0;  // d x / d ln(E1/E2)
     };
-    // x at ln(E1/E2); nullopt when outside the table. `hint` (any start value) speeds up
-    // look-ups of nearby ratios (a galloping search from the last interval).
+    // x at ln(E1/E2); nullopt when outside the table. The interval is found through an index of
+    // 4 buckets per interval, uniform in y (the few intervals of the value's bucket searched);
+    // `hint` receives it.
     std::optional<Value> lookup(double log_ratio, std::size_t& hint) const;
     std::optional<Value> lookup(double log_ratio) const {
         std::size_t hint = 0;
@@ -109,6 +110,9 @@ class RatioInverseTable {
     std::vector<double> y_, x_, dxdy_;  // y increasing
     // Per interval j: x = c0 + c1 t + c2 t² + c3 t³, t = (y − y_j)·c4 (the Hermite cubic).
     std::vector<std::array<double, 5>> coefficients_;
+    // bucket_interval_[b]: the interval holding y_0 + b / bucket_scale_ (b = 0 … buckets).
+    std::vector<std::uint32_t> bucket_interval_;
+    double bucket_scale_ = 0.0;
 };
 
 // ---------------------------------------------------------------------------------------------

@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <limits>
 #include <numeric>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -202,6 +203,34 @@ TEST(RatioInverseTable, MatchesTheClosedFormsAndTheSolver) {
         }
         std::printf("%s oblique: table vs solver %.2e\n", std::string(to_string(c)).c_str(), worst);
         EXPECT_LT(worst, 1e-6);
+    }
+}
+
+// The look-up's interval comes from an index of buckets uniform in ln(E1/E2): ratios in random
+// order over six decades of σ/T (dense and sparse parts of the table) and the table's own nodes
+// give back σ/T, whatever the previous look-up.
+TEST(RatioInverseTable, LookUpsInAnyOrderFindTheirInterval) {
+    const Geometry g1 = normal_view_geometry(kTheta1), g2 = normal_view_geometry(kTheta2);
+    std::mt19937_64 rng(7);
+    std::uniform_real_distribution<double> u(std::log(1e-3), std::log(1e3));
+    for (const Correlation c : {Correlation::Gaussian, Correlation::Exponential}) {
+        const RatioInverseTable table = RatioInverseTable::sigma_over_T(g1, g2, c);
+        std::size_t hint = 0, looked_up = 0;
+        double worst = 0.0;
+        for (int k = 0; k < 20000; ++k) {
+            // Every fourth a node of the table (x_j = 1e-4 · 1e8^(j/4096)).
+            const double s =
+                k % 4 == 0 ? 1e-4 * std::pow(1e8, static_cast<double>(1024 + rng() % 2049) / 4096.0)
+                           : std::exp(u(rng));
+            const double ratio = model_ratio_very_rough(g1, g2, s, c);
+            if (!(ratio > 0.0) || !std::isfinite(ratio)) continue;  // beyond double's range
+            const auto v = table.lookup(std::log(ratio), hint);
+            ASSERT_TRUE(v.has_value()) << s;
+            worst = std::max(worst, std::abs(v->x - s) / s);
+            ++looked_up;
+        }
+        EXPECT_GT(looked_up, 15000U);
+        EXPECT_LT(worst, 1e-7) << to_string(c);
     }
 }
 
