@@ -12,6 +12,7 @@
 #include <charconv>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <filesystem>
 #include <iostream>
 #include <memory>
@@ -630,45 +631,17 @@ std::string csv_text(const json& record) {
 }
 
 // A string that JSON and CSV output write as its bytes: printable ASCII without quote, backslash
-// or CSV separator (every key and word of a record).
+// or CSV separator (every key and word of a record). One table look-up per character.
 bool plain_text(std::string_view text) {
-    return std::all_of(text.begin(), text.end(), [](char c) {
-        return c >= 0x20 && c < 0x7f && c != '"' && c != '\\' && c != ',';
-    });
-}
-
-// Appends a value as dump() writes it (outside an array or object); false (nothing appended) for
-// a nested value or a string that needs escaping.
-bool append_json_scalar(std::string& out, const Record::Value& v) {
-    using Kind = Record::Value::Kind;
-    switch (v.kind) {
-        case Kind::Null:
-            out += "null";
-            return true;
-        case Kind::Boolean:
-            out += v.boolean ? "true" : "false";
-            return true;
-        case Kind::Number: {
-            if (!std::isfinite(v.number)) {
-                out += "null";
-                return true;
-            }
-            // nlohmann's own shortest round-trip formatter, as its serializer calls it.
-            out += v.number_text(Record::Value::Style::Json, [&](char* buf) {
-                return nlohmann::detail::to_chars(buf, buf + 64, v.number);
-            });
-            return true;
-        }
-        case Kind::Text:
-            if (!plain_text(v.text)) return false;
-            out += '"';
-            out += v.text;
-            out += '"';
-            return true;
-        case Kind::Nested:
-            break;
-    }
-    return false;
+    static constexpr auto kPlain = [] {
+        std::array<bool, 256> plain{};
+        for (int c = 0x20; c < 0x7f; ++c) plain[static_cast<std::size_t>(c)] = true;
+        for (char c : {'"', '\\', ','}) plain[static_cast<unsigned char>(c)] = false;
+        return plain;
+    }();
+    for (char c : text)
+        if (!kPlain[static_cast<unsigned char>(c)]) return false;
+    return true;
 }
 
 // Appends the CSV cell of a value (cell_text, quoted by csv_field when needed).
@@ -701,18 +674,18 @@ void append_csv_cell(std::string& out, const Record::Value& v) {
 
 // Writes the records of `model --csv` one at a time: CSV (header from the first record) or a JSON
 // array byte-identical to serialize::dump of the whole array, without holding the records. Each
-// record is formatted straight into the output buffer.
+// record is formatted straight into the chunk of rows that goes to the output once it holds
+// kChunkBytes.
 class RecordWriter {
   public:
     RecordWriter(io::OutputFile& out, bool json_output) : out_(out), json_(json_output) {}
 
     void add(const Record& record) {
-        chunk_.clear();
         if (json_) {
             chunk_.append(count_ == 0 ? "[\n" : ",\n");
             if (!append_json_element(record)) {
-                // Nested values (Lafortune lobes): the element as the whole array's dump indents
-                // it: "[\n" + element + "\n]\n".
+                // Nested values (Lafortune lobes) or strings to escape: the element as the whole
+                // array's dump indents it: "[\n" + element + "\n]\n".
                 json one = json::array();
                 one.push_back(serialize::versioned(record.to_json()));
                 const std::string text = serialize::dump(one);
@@ -736,46 +709,154 @@ class RecordWriter {
             }
             chunk_ += '\n';
         }
-        out_.write(chunk_);
         ++count_;
+        if (chunk_.size() >= kChunkBytes) {
+            out_.write(chunk_);
+            chunk_.clear();
+        }
     }
 
-    // Closes the array (JSON); the caller commits the output.
+    // Closes the array (JSON) and writes what is pending; the caller commits the output.
     void finish() {
-        if (json_ && count_ > 0) out_.write("\n]\n");
+        if (json_ && count_ > 0) chunk_ += "\n]\n";
+        out_.write(chunk_);
+        chunk_.clear();
     }
 
     std::size_t count() const { return count_; }
 
   private:
+    // Rows are written out in chunks of this size: large enough that the output file writes
+    // them through without copying (io::OutputFile), small enough to stay in the cache.
+    static constexpr std::size_t kChunkBytes = std::size_t{64} << 10;
+
+    // The text before a record's value at one position: ",\n    \"key\": ". Copied as one block
+    // of kBlock bytes (a few vector moves instead of a call per piece); `usable` is false for a
+    // key that needs escaping or does not fit (the element then goes the slow way).
+    static constexpr std::size_t kBlock = 64;
+    static constexpr std::size_t kShortText = 16;  // std::string's own (short string) buffer
+    struct KeyText {
+        std::string_view key;
+        bool usable = false;
+        std::uint8_t size = 0;
+        std::array<char, kBlock> text{};
+    };
+
+    // A number formatted for an earlier slot of this or the previous record: the B-K records'
+    // brightness, diffuse and total are often the same double.
+    struct RecentNumber {
+        std::uint64_t bits = 0;
+        std::uint8_t size = 0;  // 0: empty
+        std::array<char, serialize::kNumberBufferSize> text{};
+    };
+
+    // serialize::dump's own number formatter (the same bytes by construction), unless the same
+    // double was formatted a moment ago.
+    char* write_number(char* out, double value) {
+        const auto bits = std::bit_cast<std::uint64_t>(value);
+        for (const RecentNumber& r : recent_)
+            if (r.size != 0 && r.bits == bits) return std::copy_n(r.text.data(), r.size, out);
+        char* const end = serialize::write_number(out, value);
+        RecentNumber& r = recent_[next_recent_];
+        next_recent_ = (next_recent_ + 1) % recent_.size();
+        r.bits = bits;
+        r.size = static_cast<std::uint8_t>(end - out);
+        std::copy(out, end, r.text.data());
+        return end;
+    }
+
+    // The key texts of the record's positions, made when a position's key is new: keys are
+    // literals, so the same address and size is the same key.
+    void update_keys(std::span<const Record::Item> items) {
+        if (keys_.size() < items.size()) keys_.resize(items.size());
+        for (std::size_t k = 0; k < items.size(); ++k) {
+            const std::string_view key = items[k].key;
+            KeyText& slot = keys_[k];
+            if (slot.key.data() == key.data() && slot.key.size() == key.size()) continue;
+            slot.key = key;
+            constexpr std::string_view kBefore = ",\n    \"", kAfter = "\": ";
+            const std::size_t size = kBefore.size() + key.size() + kAfter.size();
+            slot.usable = plain_text(key) && size <= kBlock;
+            if (!slot.usable) continue;
+            char* p = std::copy(kBefore.begin(), kBefore.end(), slot.text.data());
+            p = std::copy(key.begin(), key.end(), p);
+            std::copy(kAfter.begin(), kAfter.end(), p);
+            slot.size = static_cast<std::uint8_t>(size);
+        }
+    }
+
     // The element "  {\n    \"key\": value,\n ...\n  }" as dump(2) indents it inside the array;
-    // false (chunk_ unchanged) when a value is nested or needs escaping.
+    // false (chunk_ unchanged) when a value is nested or a key or string needs escaping.
     bool append_json_element(const Record& record) {
+        using Kind = Record::Value::Kind;
+        static constexpr std::string_view kTail = "\n  }";
+        const std::string_view head = head_;
+        const std::span<const Record::Item> items = record.items();
+        update_keys(items);
+        // Pass 1: whether every value is written as is, and room for the text (whole blocks).
+        std::size_t room = head.size() + kTail.size();
+        for (std::size_t k = 0; k < items.size(); ++k) {
+            const Record::Value& v = items[k].value;
+            if (!keys_[k].usable || v.kind == Kind::Nested) return false;
+            if (v.kind == Kind::Text && !plain_text(v.text)) return false;
+            room += kBlock + (v.kind == Kind::Text ? v.text.size() + kShortText + 2
+                                                   : serialize::kNumberBufferSize);
+        }
+        // Pass 2: the text, straight into the chunk.
         const std::size_t mark = chunk_.size();
-        // serialize::versioned: the version first in every element.
-        chunk_ += "  {\n    \"";
-        chunk_ += serialize::kVersionKey;
-        chunk_ += "\": \"" ROUGHSCOPE_VERSION_STRING "\"";
-        bool first = false;
-        for (const Record::Item& item : record.items()) {
-            if (!first) chunk_ += ",\n";
-            first = false;
-            chunk_ += "    \"";
-            chunk_ += item.key;
-            chunk_ += "\": ";
-            if (!plain_text(item.key) || !append_json_scalar(chunk_, item.value)) {
-                chunk_.resize(mark);
-                return false;
+        chunk_.resize(mark + room);
+        char* p = std::copy(head.begin(), head.end(), chunk_.data() + mark);
+        for (std::size_t k = 0; k < items.size(); ++k) {
+            const KeyText& key = keys_[k];
+            std::memcpy(p, key.text.data(), kBlock);
+            p += key.size;
+            const Record::Value& v = items[k].value;
+            switch (v.kind) {
+                case Kind::Null:
+                    p = std::copy_n("null", 4, p);
+                    break;
+                case Kind::Boolean:
+                    p = v.boolean ? std::copy_n("true", 4, p) : std::copy_n("false", 5, p);
+                    break;
+                case Kind::Number: {
+                    // The text lies in the value's formatted buffer: a whole block is readable.
+                    static_assert(serialize::kNumberBufferSize <= sizeof(Record::Value::formatted));
+                    const std::string_view text =
+                        v.number_text(Record::Value::Style::Json,
+                                      [&](char* buffer) { return write_number(buffer, v.number); });
+                    std::memcpy(p, text.data(), serialize::kNumberBufferSize);
+                    p += text.size();
+                    break;
+                }
+                case Kind::Text:
+                    *p++ = '"';
+                    if (v.text.size() < kShortText) {  // a string's buffer holds 16 bytes or more
+                        std::memcpy(p, v.text.data(), kShortText);
+                        p += v.text.size();
+                    } else {
+                        p = std::copy(v.text.begin(), v.text.end(), p);
+                    }
+                    *p++ = '"';
+                    break;
+                case Kind::Nested:
+                    break;  // refused in pass 1
             }
         }
-        chunk_ += "\n  }";
+        p = std::copy(kTail.begin(), kTail.end(), p);
+        chunk_.resize(static_cast<std::size_t>(p - chunk_.data()));
         return true;
     }
 
     io::OutputFile& out_;
     bool json_;
+    // serialize::versioned: the version first in every element.
+    const std::string head_ = std::string("  {\n    \"") + serialize::kVersionKey +
+                              "\": \"" ROUGHSCOPE_VERSION_STRING "\"";
     std::size_t count_ = 0;
     std::string chunk_;
+    std::vector<KeyText> keys_;  // by position in the record
+    std::array<RecentNumber, 4> recent_{};
+    std::size_t next_recent_ = 0;
 };
 
 Roughness roughness_from_flags(const Args& a) {

@@ -24,7 +24,9 @@ namespace {
 namespace fs = std::filesystem;
 
 constexpr std::size_t kFlushBytes = std::size_t{1} << 20;  // write out once 1 MiB is pending
-constexpr int kMaxSymlinks = 40;                           // as the kernel's ELOOP limit
+// A chunk of at least this size arriving with nothing pending is written out as it is.
+constexpr std::size_t kWriteThroughBytes = std::size_t{64} << 10;
+constexpr int kMaxSymlinks = 40;  // as the kernel's ELOOP limit
 
 // ---------------------------------------------------------------------------------------------
 // Pending temporary files, removed by the signal handler. Each slot holds a malloc'ed C string
@@ -241,19 +243,27 @@ void OutputFile::fail(const std::string& reason) {
     throw DataError("cannot write " + name_ + ": " + reason);
 }
 
-void OutputFile::flush_buffer() {
-    if (buffer_.empty()) return;
+void OutputFile::write_out(std::string_view bytes) {
     if (*mode_ == Mode::Stdout) {
-        std::cout.write(buffer_.data(), static_cast<std::streamsize>(buffer_.size()));
+        std::cout.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
         if (!std::cout) fail("write error");
-    } else if (const int error = write_all(fd_, buffer_); error != 0) {
+    } else if (const int error = write_all(fd_, bytes); error != 0) {
         fail(errno_text(error));
     }
+}
+
+void OutputFile::flush_buffer() {
+    if (buffer_.empty()) return;
+    write_out(buffer_);
     buffer_.clear();
 }
 
 void OutputFile::write(std::string_view chunk) {
     if (!mode_) throw DataError("cannot write " + name_ + ": the output is not open");
+    if (buffer_.empty() && chunk.size() >= kWriteThroughBytes) {
+        write_out(chunk);  // nothing gained by copying it into the buffer first
+        return;
+    }
     buffer_.append(chunk);
     if (buffer_.size() >= kFlushBytes) flush_buffer();
 }

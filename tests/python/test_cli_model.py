@@ -386,6 +386,26 @@ def test_csv_round_trip_with_per_row_overrides(tmp_path):
     assert all(rel_close(a["brightness"], float(r["brightness"]), 1e-9) for a, r in zip(arr, rows))
 
 
+@pytest.mark.parametrize("model", [
+    ("--sigma", "1", "--T", "2"),
+    ("--sigma-over-T", "0.5"),
+    ("--model", "lafortune", "--lobe", "-1,-1,1,10,0.5"),  # nested lobes: the slow path
+])
+def test_csv_json_stream_is_each_rows_dump(tmp_path, model):
+    """`model --csv --json` streams its array without the records in memory; each element has
+    the bytes the single-geometry command's `--json` document has (serialize::dump), indented
+    one level: numbers as the same shortest text, keys in the same order."""
+    geometries = [("30", "40", "180"), ("12.5", "33.3", "90"), ("0.1", "89.9", "359.9"),
+                  ("1e-5", "45", "0"), ("0", "0", "0"), ("89.99999999999999", "1.5e-7", "271.25")]
+    src = write(tmp_path / "in.csv",
+                "theta_i,theta_s,phi_s\n" + "".join(",".join(g) + "\n" for g in geometries))
+    streamed = run("model", "--csv", src, *model, "--json").stdout
+    singles = [run("model", "--theta-i", ti, "--theta-s", ts, "--phi-s", ps, *model,
+                   "--json").stdout for ti, ts, ps in geometries]
+    elements = ["\n".join("  " + line for line in s.rstrip("\n").split("\n")) for s in singles]
+    assert streamed == "[\n" + ",\n".join(elements) + "\n]\n"
+
+
 def test_csv_per_row_sigma_and_T(tmp_path):
     src = write(tmp_path / "in.csv", "theta_i,theta_s,phi_s,sigma_um,T_um\n14,14,0,0.02,1\n")
     arr = json.loads(run("model", "--csv", src, "--json").stdout)

@@ -50,8 +50,9 @@ class OutputFile {
     OutputFile(const OutputFile&) = delete;
     OutputFile& operator=(const OutputFile&) = delete;
 
-    // Appends `chunk` (buffered; large outputs are written out as they grow). Throws DataError on
-    // a write error (the output is then aborted).
+    // Appends `chunk` (buffered; large outputs are written out as they grow, and a chunk of
+    // 64 KiB or more with nothing pending goes out without a copy). Throws DataError on a write
+    // error (the output is then aborted).
     void write(std::string_view chunk);
     // Writes out everything and makes the output visible (rename for Mode::Replace). Throws
     // DataError on failure, after removing the temporary file.
@@ -67,6 +68,7 @@ class OutputFile {
 
   private:
     void flush_buffer();
+    void write_out(std::string_view bytes);  // to the destination, unbuffered
     [[noreturn]] void fail(const std::string& reason);
 
     std::optional<Mode> mode_;

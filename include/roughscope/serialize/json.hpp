@@ -5,10 +5,11 @@
 // module converts them to dicts and lists; neither re-derives a key. Conventions:
 //  * Unknown or undefined quantities (std::nullopt, NaN, ±inf) are null, never NaN.
 //  * Numbers are not rounded: dump() writes each double with the shortest text that parses back
-//    to the same double (round-trip precision).
+//    to the same double (round-trip precision), laid out by write_number().
 //  * Angles are degrees (`_deg`), lengths micrometres (`_um`), as at every front end.
 #pragma once
 
+#include <cstddef>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -42,6 +43,19 @@ inline constexpr const char* kVersionKey = "roughscope_version";
 Json versioned(Json document);
 
 // The document as text: 2-space indentation and a trailing newline (indent < 0: one line).
+// Laid out as nlohmann's dump(indent) lays it out (": " and ",\n" inside an indented document,
+// ":" and "," on one line, empty arrays and objects as [] and {}), strings escaped by nlohmann
+// (invalid UTF-8 replaced by U+FFFD), every double through write_number().
 std::string dump(const Json& value, int indent = 2);
+
+// The one JSON number formatter, of dump() and of every writer that must give dump()'s bytes
+// (the streamed `model --csv --json`). A finite double gets its shortest round-trip digits
+// (std::to_chars: the fewest significant digits that parse back to the same double, the closest
+// of them when several qualify) in nlohmann's layout: with the decimal point n digits after the
+// first digit, 1234.5, 1200.0 (an integral value keeps ".0") and 0.00012 for -4 < n <= 15, else
+// 1.2345e+16, 1e-05 (at least two exponent digits); 0.0 and -0.0 for zeros. NaN and ±inf are
+// written as null. `out` needs room for kNumberBufferSize characters; returns the end.
+inline constexpr std::size_t kNumberBufferSize = 32;
+char* write_number(char* out, double value);
 
 }  // namespace roughscope::serialize
