@@ -12,7 +12,6 @@
 #include <charconv>
 #include <cmath>
 #include <cstdint>
-#include <cstring>
 #include <filesystem>
 #include <iostream>
 #include <memory>
@@ -730,11 +729,9 @@ class RecordWriter {
     // them through without copying (io::OutputFile), small enough to stay in the cache.
     static constexpr std::size_t kChunkBytes = std::size_t{64} << 10;
 
-    // The text before a record's value at one position: ",\n    \"key\": ". Copied as one block
-    // of kBlock bytes (a few vector moves instead of a call per piece); `usable` is false for a
-    // key that needs escaping or does not fit (the element then goes the slow way).
+    // The text before a record's value at one position: ",\n    \"key\": ", made once; `usable` is
+    // false for a key that needs escaping or does not fit (the element then goes the slow way).
     static constexpr std::size_t kBlock = 64;
-    static constexpr std::size_t kShortText = 16;  // std::string's own (short string) buffer
     struct KeyText {
         std::string_view key;
         bool usable = false;
@@ -799,8 +796,8 @@ class RecordWriter {
             const Record::Value& v = items[k].value;
             if (!keys_[k].usable || v.kind == Kind::Nested) return false;
             if (v.kind == Kind::Text && !plain_text(v.text)) return false;
-            room += kBlock + (v.kind == Kind::Text ? v.text.size() + kShortText + 2
-                                                   : serialize::kNumberBufferSize);
+            room += keys_[k].size +
+                    (v.kind == Kind::Text ? v.text.size() + 2 : serialize::kNumberBufferSize);
         }
         // Pass 2: the text, straight into the chunk.
         const std::size_t mark = chunk_.size();
@@ -808,8 +805,7 @@ class RecordWriter {
         char* p = std::copy(head.begin(), head.end(), chunk_.data() + mark);
         for (std::size_t k = 0; k < items.size(); ++k) {
             const KeyText& key = keys_[k];
-            std::memcpy(p, key.text.data(), kBlock);
-            p += key.size;
+            p = std::copy_n(key.text.data(), key.size, p);
             const Record::Value& v = items[k].value;
             switch (v.kind) {
                 case Kind::Null:
@@ -819,23 +815,15 @@ class RecordWriter {
                     p = v.boolean ? std::copy_n("true", 4, p) : std::copy_n("false", 5, p);
                     break;
                 case Kind::Number: {
-                    // The text lies in the value's formatted buffer: a whole block is readable.
-                    static_assert(serialize::kNumberBufferSize <= sizeof(Record::Value::formatted));
                     const std::string_view text =
                         v.number_text(Record::Value::Style::Json,
                                       [&](char* buffer) { return write_number(buffer, v.number); });
-                    std::memcpy(p, text.data(), serialize::kNumberBufferSize);
-                    p += text.size();
+                    p = std::copy(text.begin(), text.end(), p);
                     break;
                 }
                 case Kind::Text:
                     *p++ = '"';
-                    if (v.text.size() < kShortText) {  // a string's buffer holds 16 bytes or more
-                        std::memcpy(p, v.text.data(), kShortText);
-                        p += v.text.size();
-                    } else {
-                        p = std::copy(v.text.begin(), v.text.end(), p);
-                    }
+                    p = std::copy(v.text.begin(), v.text.end(), p);
                     *p++ = '"';
                     break;
                 case Kind::Nested:

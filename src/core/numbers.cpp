@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <bit>
+#include <cassert>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
@@ -262,26 +263,57 @@ SignificantDigits::SignificantDigits(double value) : value_(value) {
     *this = SignificantDigits(value, Shortest{});
 }
 
-SignificantDigits::SignificantDigits(double value, Shortest) : value_(value) {
-    const double magnitude = std::abs(value);
-    if (!(magnitude >= std::numeric_limits<double>::min()) || !std::isfinite(value)) return;
+namespace {
+// std::to_chars's shortest digits, from its scientific text "[-]d[.ddd]e(+|-)XX[X]".
+ShortestDigits shortest_digits_by_to_chars(double value) {
+    ShortestDigits out;
     char sci[kSignificantBufferSize];
     const auto printed = std::to_chars(sci, sci + sizeof sci, value, std::chars_format::scientific);
-    if (printed.ec != std::errc()) return;
+    if (printed.ec != std::errc()) return out;
     const char* p = sci;
-    negative_ = *p == '-';
-    if (negative_) ++p;
+    if (*p == '-') ++p;
     int k = 0;
     for (; p < printed.ptr && *p != 'e'; ++p)
-        if (*p != '.') digits_[k++] = *p;
-    if (p == printed.ptr) return;
+        if (*p != '.') out.digits[k++] = *p;
+    if (p == printed.ptr) return out;
     ++p;  // 'e'
     const bool negative_exponent = *p == '-';
     if (*p == '-' || *p == '+') ++p;
     int exponent = 0;
     for (; p < printed.ptr; ++p) exponent = exponent * 10 + (*p - '0');
-    count_ = k;
-    exponent_ = negative_exponent ? -exponent : exponent;
+    out.count = k;
+    out.exponent = negative_exponent ? -exponent : exponent;
+    return out;
+}
+}  // namespace
+
+ShortestDigits shortest_digits(double value) {
+    assert(std::isfinite(value) && value != 0.0);
+    if (const auto r = round_by_scaling(value, 15)) {
+        const int q = r->exponent - 14;
+        if (q >= -kMaxExactPow10 && q <= kMaxExactPow10 &&
+            scale_by_pow10(static_cast<double>(r->m), q) == std::abs(value)) {
+            ShortestDigits out;
+            const char* const end =
+                std::to_chars(out.digits, out.digits + sizeof out.digits, r->m).ptr;
+            out.count = static_cast<int>(end - out.digits);
+            while (out.count > 1 && out.digits[out.count - 1] == '0') --out.count;
+            out.exponent = r->exponent;
+            return out;
+        }
+    }
+    return shortest_digits_by_to_chars(value);
+}
+
+SignificantDigits::SignificantDigits(double value, Shortest) : value_(value) {
+    const double magnitude = std::abs(value);
+    if (!(magnitude >= std::numeric_limits<double>::min()) || !std::isfinite(value)) return;
+    const ShortestDigits d = shortest_digits_by_to_chars(value);
+    if (d.count == 0) return;
+    std::copy(d.digits, d.digits + d.count, digits_);
+    count_ = d.count;
+    exponent_ = d.exponent;
+    negative_ = std::signbit(value);
     decomposed_ = true;
 }
 

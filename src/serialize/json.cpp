@@ -110,40 +110,27 @@ void append_value(std::string& out, const Json& value, int indent, int depth) {
         case Json::value_t::string:
             append_string(out, value.get_ref<const std::string&>());
             return;
-        case Json::value_t::array: {
-            if (value.empty()) {
-                out += "[]";
-                return;
-            }
-            out += '[';
-            bool first = true;
-            for (const Json& element : value) {
-                if (!first) out += ',';
-                first = false;
-                if (pretty) newline_and_indent(depth + 1);
-                append_value(out, element, indent, depth + 1);
-            }
-            if (pretty) newline_and_indent(depth);
-            out += ']';
-            return;
-        }
+        case Json::value_t::array:
         case Json::value_t::object: {
+            const bool object = value.is_object();
             if (value.empty()) {
-                out += "{}";
+                out += object ? "{}" : "[]";
                 return;
             }
-            out += '{';
+            out += object ? '{' : '[';
             bool first = true;
-            for (const auto& [key, element] : value.items()) {
+            for (const auto& item : value.items()) {
                 if (!first) out += ',';
                 first = false;
                 if (pretty) newline_and_indent(depth + 1);
-                append_string(out, key);
-                out += pretty ? ": " : ":";
-                append_value(out, element, indent, depth + 1);
+                if (object) {
+                    append_string(out, item.key());
+                    out += pretty ? ": " : ":";
+                }
+                append_value(out, item.value(), indent, depth + 1);
             }
             if (pretty) newline_and_indent(depth);
-            out += '}';
+            out += object ? '}' : ']';
             return;
         }
         case Json::value_t::binary:
@@ -163,74 +150,6 @@ void append_value(std::string& out, const Json& value, int indent, int depth) {
 
 }  // namespace
 
-namespace {
-
-constexpr double kExactPow10[] = {1e0,  1e1,  1e2,  1e3,  1e4,  1e5,  1e6,  1e7,
-                                  1e8,  1e9,  1e10, 1e11, 1e12, 1e13, 1e14, 1e15,
-                                  1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22};
-constexpr int kMaxExactPow10 = 22;
-
-// Significant digits d1 d2 ... d_count of a positive number, d1 != 0: value = 0.d1d2... * 10^point.
-struct Digits {
-    char digits[kNumberBufferSize];
-    int count = 0;
-    int point = 0;
-};
-
-// The shortest round-trip digits when some decimal of at most 15 significant digits reads back as
-// `value` (> 0): then it is the only one — two such decimals are at least 10^-15 of the value
-// apart, more than the width 2^-52 of the interval of reals that read as one normal double — so
-// it is the text std::to_chars gives. One scaling by an exact power of ten (|s| <= 22) finds the
-// candidate m * 10^-s, m < 10^15 + 1; the exact quotient (or product) tells whether it reads
-// back. False when it does not (16 or 17 digits needed) or the scaling is not exact.
-bool few_digits(double value, Digits& out) {
-    if (!(value >= std::numeric_limits<double>::min())) return false;
-    // value in [2^b, 2^(b+1)): floor(b log10 2) is its decimal exponent or one less
-    // (b * 78913 / 2^18 rounded down, exact for |b| < 1650).
-    const int b = static_cast<int>((std::bit_cast<std::uint64_t>(value) >> 52) & 0x7ff) - 1023;
-    int s = 14 - ((b * 78913) >> 18);
-    if (s > kMaxExactPow10 || s <= -kMaxExactPow10) return false;
-    const auto scale = [](double a, int by) {
-        return by >= 0 ? a * kExactPow10[by] : a / kExactPow10[-by];
-    };
-    double t = scale(value, s);  // in [10^14, 10^16)
-    if (t >= 1e15) t = scale(value, --s);
-    // t rounded to an integer (t < 2^51: its fraction is exact).
-    const auto whole = static_cast<std::uint64_t>(t);
-    const std::uint64_t m = whole + (t - static_cast<double>(whole) >= 0.5 ? 1 : 0);
-    const double back =
-        s >= 0 ? static_cast<double>(m) / kExactPow10[s] : static_cast<double>(m) * kExactPow10[-s];
-    if (back != value) return false;
-    const char* const end = std::to_chars(out.digits, out.digits + sizeof out.digits, m).ptr;
-    int count = static_cast<int>(end - out.digits);
-    out.point = count - s;
-    while (out.digits[count - 1] == '0') --count;  // m > 0
-    out.count = count;
-    return true;
-}
-
-// The shortest round-trip digits of a positive finite `value` from std::to_chars's scientific
-// text "d[.ddd]e(+|-)XX[X]".
-void shortest_digits(double value, Digits& out) {
-    char text[kNumberBufferSize];
-    const char* const begin = text;
-    const char* const end =
-        std::to_chars(text, text + sizeof text, value, std::chars_format::scientific).ptr;
-    const char* const e = std::find(begin, end, 'e');
-    int exponent = 0;
-    for (const char* p = e + 2; p < end; ++p) exponent = exponent * 10 + (*p - '0');
-    out.point = (e[1] == '-' ? -exponent : exponent) + 1;
-    out.digits[0] = text[0];
-    int count = 1;
-    if (e - begin > 1) {  // "d.ddd"
-        count = static_cast<int>(e - begin) - 1;
-        std::copy(begin + 2, e, out.digits + 1);
-    }
-    out.count = count;
-}
-
-}  // namespace
-
 char* write_number(char* out, double value) {
     if (!std::isfinite(value)) return std::copy_n("null", 4, out);
     if (std::signbit(value)) {
@@ -238,10 +157,9 @@ char* write_number(char* out, double value) {
         value = -value;
     }
     if (value == 0.0) return std::copy_n("0.0", 3, out);
-    Digits d;
-    if (!few_digits(value, d)) shortest_digits(value, d);
-    const int n = d.point;   // digits before the decimal point
-    if (n > -4 && n <= 0) {  // 0.[000]digits
+    const ShortestDigits d = shortest_digits(value);
+    const int n = d.exponent + 1;  // digits before the decimal point
+    if (n > -4 && n <= 0) {        // 0.[000]digits
         *out++ = '0';
         *out++ = '.';
         out = std::fill_n(out, -n, '0');

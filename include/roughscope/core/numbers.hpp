@@ -82,6 +82,19 @@ double parse_significant(double value, int digits);
 // write_significant at several precisions of one value: its digits are found once — rounded to
 // 12 digits by one exact scaling where write_significant's fast path applies, else the shortest
 // round-trip digits — and each write() rounds them (same bytes as write_significant).
+// The shortest round-trip decimal digits of a finite |value| > 0 (normal or subnormal): the
+// fewest significant digits that parse back to the same double, the closest of them when several
+// qualify — std::to_chars's digits. digits[0 .. count) with digits[0] != '0' and no trailing
+// zero; value = ±d1.d2d3… × 10^exponent. A cheap exact path serves values that some decimal of at
+// most 15 digits reads back as (it is then the only one: two such decimals are at least 10^-15 of
+// the value apart, more than the 2^-52 interval of reals that read as one normal double).
+struct ShortestDigits {
+    char digits[24] = {};
+    int count = 0;
+    int exponent = 0;
+};
+ShortestDigits shortest_digits(double value);
+
 class SignificantDigits {
   public:
     explicit SignificantDigits(double value);

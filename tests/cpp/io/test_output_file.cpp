@@ -54,6 +54,26 @@ TEST(OutputSink, ReplacesARegularFileKeepingItsMode) {
     fs::remove_all(d);
 }
 
+// Chunks of 64 KiB or more with nothing pending go out without the buffer; mixed with small
+// ones (pending, then flushed first) the bytes stay in order.
+TEST(OutputSink, LargeAndSmallChunksKeepTheirOrder) {
+    const fs::path d = fresh_dir("order");
+    const fs::path f = d / "mixed.txt";
+    std::string expected;
+    {
+        io::OutputFile out(f);
+        char letter = 'a';
+        for (const std::size_t size : {10U, 70000U, 70000U, 5U, 200000U, 65536U, 3U, 2000000U}) {
+            const std::string chunk(size, letter++);
+            out.write(chunk);
+            expected += chunk;
+        }
+        out.commit();
+    }
+    EXPECT_EQ(slurp(f), expected);
+    fs::remove_all(d);
+}
+
 TEST(OutputSink, NewFileGetsTheUmaskMode) {
     const fs::path d = fresh_dir("umask");
     const mode_t mask = ::umask(022);
