@@ -206,7 +206,10 @@ HeightMoments height_moments(const HeightMap& map) {
     const double* h = map.heights_um.data();
     const std::size_t n = map.heights_um.size();
     std::size_t i = 0;
-    for (; i + 4 <= n; i += 4)
+    for (; i + 4 <= n; i += 4) {
+        // 2 KiB ahead: without it this loop ran at a quarter of a plain read's speed on a 4096²
+        // map (56 against 16 ms, surface_stats/moments vs memory_read; 13 ms with it).
+        __builtin_prefetch(h + i + 256);
         for (std::size_t l = 0; l < 2; ++l) {
             v2d z;
             std::memcpy(&z, h + i + 2 * l, sizeof z);
@@ -221,6 +224,7 @@ HeightMoments height_moments(const HeightMap& map) {
             hi[l] = z > hi[l] ? z : hi[l];  // NaN compares false: kept out
             lo[l] = z < lo[l] ? z : lo[l];
         }
+    }
     double cnt = 0, s1 = 0, s2 = 0, s3 = 0, s4 = 0, top = -inf, bottom = inf;
     for (std::size_t l = 0; l < 2; ++l)
         for (int k = 0; k < 2; ++k) {
