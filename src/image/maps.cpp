@@ -2,6 +2,7 @@
 #include "roughscope/image/maps.hpp"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstdint>
 #include <exception>
@@ -235,42 +236,39 @@ RatioInverseTable RatioInverseTable::correlation_length(const Geometry& geom1,
 
 std::optional<RatioInverseTable::Value> RatioInverseTable::lookup(double log_ratio,
                                                                   std::size_t& hint) const {
-    const std::size_t n = y_.size();
-    if (!(log_ratio >= y_.front() && log_ratio <= y_.back())) return std::nullopt;
-    // The intervals of the value's bucket: from the one holding its start to the one holding
-    // its end.
-    const std::size_t buckets = bucket_interval_.size() - 1;
-    const auto b =
-        std::min(buckets - 1, static_cast<std::size_t>((log_ratio - y_.front()) * bucket_scale_));
-    std::size_t first = bucket_interval_[b], last = bucket_interval_[b + 1];
-    // (The bucket's value and its ends are rounded: one more interval either side if need be.)
-    while (first > 0 && y_[first] > log_ratio) --first;
-    while (last + 2 < n && y_[last + 1] <= log_ratio) ++last;
-    const auto it = std::upper_bound(y_.begin() + static_cast<std::ptrdiff_t>(first) + 1,
-                                     y_.begin() + static_cast<std::ptrdiff_t>(last) + 1, log_ratio);
-    std::size_t j = std::min(n - 2, static_cast<std::size_t>(it - y_.begin()) - 1);
-    hint = j;
-    // The cubic Hermite interpolant in y between nodes j and j + 1.
-    const std::array<double, 5>& c = coefficients_[j];
-    const double t = (log_ratio - y_[j]) * c[4];
     Value v;
-    v.x = c[0] + t * (c[1] + t * (c[2] + t * c[3]));
-    v.dx_dlog_ratio = (c[1] + t * (2.0 * c[2] + t * 3.0 * c[3])) * c[4];
-    if (!(v.x > 0.0) || !std::isfinite(v.x)) return std::nullopt;
+    if (!find(log_ratio, v, hint)) return std::nullopt;
     return v;
 }
 
+std::size_t RatioInverseTable::max_intervals_per_bucket() const {
+    std::size_t worst = 0;
+    for (std::size_t b = 0; b + 1 < bucket_first_interval_.size(); ++b)
+        worst = std::max<std::size_t>(
+            worst, bucket_first_interval_[b + 1] - bucket_first_interval_[b] + 1);
+    return worst;
+}
+
 void RatioInverseTable::build_coefficients() {
-    const std::size_t intervals = y_.size() - 1;
+    const std::size_t n = y_.size(), intervals = n - 1;
+    // The bucket index: 4 buckets per interval, uniform in bucket_key (logarithmic towards both
+    // ends of the table, where the nodes crowd: y − y_0 ∝ (σ/T)^−2 at large σ/T, Eq. 16).
+    key_floor_front_ = 0.5 * (y_[1] - y_[0]);
+    key_floor_back_ = 0.5 * (y_[n - 1] - y_[n - 2]);
+    key_min_ = bucket_key(y_.front());
+    const std::int64_t key_max = bucket_key(y_.back());
     const std::size_t buckets = 4 * intervals;
-    bucket_scale_ = static_cast<double>(buckets) / (y_.back() - y_.front());
-    bucket_interval_.resize(buckets + 1);
-    std::size_t at = 0;
-    for (std::size_t b = 0; b <= buckets; ++b) {
-        const double y = y_.front() + static_cast<double>(b) / bucket_scale_;
-        while (at + 1 < intervals && y_[at + 1] <= y) ++at;
-        bucket_interval_[b] = static_cast<std::uint32_t>(at);
-    }
+    bucket_scale_ = static_cast<double>(buckets) / static_cast<double>(key_max - key_min_);
+    // bucket_first_interval_[b]: the interval holding the smallest y of bucket b — the one that
+    // starts at the last node of a lower bucket (bucket_of is monotone in y); [b + 1] bounds
+    // bucket b's largest.
+    bucket_first_interval_.assign(buckets + 1, 0);
+    std::vector<std::size_t> below(buckets + 1, 0);  // nodes in buckets < b
+    for (std::size_t j = 0; j < n; ++j) ++below[bucket_of(y_[j]) + 1];
+    for (std::size_t b = 1; b <= buckets; ++b) below[b] += below[b - 1];
+    for (std::size_t b = 0; b <= buckets; ++b)
+        bucket_first_interval_[b] = static_cast<std::uint32_t>(
+            std::min(intervals - 1, below[b] > 0 ? below[b] - 1 : std::size_t{0}));
     coefficients_.resize(intervals);
     for (std::size_t j = 0; j + 1 < y_.size(); ++j) {
         const double dy = y_[j + 1] - y_[j];
@@ -491,6 +489,46 @@ class Evaluator {
             map_.method = "solver per tile (two-geometry model)";
         }
     }
+
+    // A flat sample's pixel (the layers' cells already NaN / no class): the two tables at
+    // ln(E1/E2), the error through their slopes.
+    void evaluate_flat(std::size_t index, double ratio, double var_log_ratio) {
+        const double lr = std::log(ratio);
+        const double sd_lr = std::sqrt(var_log_ratio);
+        map_.E1_over_E2[index] = static_cast<float>(ratio);
+        RatioInverseTable::Value vg, ve;
+        const bool g = table_g_.find(lr, vg, hint_g_);
+        const bool e = table_e_.find(lr, ve, hint_e_);
+        if (g) {
+            map_.sigma_over_T_gaussian[index] = static_cast<float>(vg.x);
+            map_.sigma_over_T_gaussian_stderr[index] =
+                static_cast<float>(std::abs(vg.dx_dlog_ratio) * sd_lr);
+        }
+        if (e) {
+            map_.sigma_over_T_exponential[index] = static_cast<float>(ve.x);
+            map_.sigma_over_T_exponential_stderr[index] =
+                static_cast<float>(std::abs(ve.dx_dlog_ratio) * sd_lr);
+        }
+        const bool gaussian = o_.correlation == Correlation::Gaussian;
+        const bool has_primary = gaussian ? g : e;
+        if (!(gaussian ? e : g)) ++counts_.no_solution_exponential;
+        if (o_.sigma_um) {
+            const RatioInverseTable::Value& vp = gaussian ? vg : ve;
+            std::optional<Estimate> primary;
+            if (has_primary) primary = Estimate{vp.x, std::abs(vp.dx_dlog_ratio) * sd_lr};
+            estimate_T(index, lr, sd_lr, primary, std::nullopt, std::nullopt);
+        }
+        if (!has_primary) {
+            ++counts_.no_solution;
+            return;
+        }
+        ++counts_.valid;
+        const double x = gaussian ? vg.x : ve.x;
+        map_.roughness_class[index] = class_code(roughness_class_of_sigma_over_T(
+            x, o_.slightly_rough_max_sigma_over_T, o_.very_rough_min_sigma_over_T));
+    }
+
+    bool flat() const { return flat_; }
 
     void evaluate(std::size_t index, const Cell& cell) {
         const double lr = cell.log_ratio;
@@ -719,7 +757,25 @@ void tile_map(const std::vector<MapCapture>& captures, const MapOptions& o, Eval
     }
 }
 
-// Per pixel: the pixel's ratio, the noise from the (2R + 1)² neighbourhood (running sums).
+// The first touch of every cell of rows [r_begin, r_end) of the map: NaN, no class (the
+// layers are allocated without a fill; each band's thread writes its own).
+void clear_rows(RoughnessMap& map, std::size_t r_begin, std::size_t r_end) {
+    const std::size_t begin = r_begin * map.width, count = (r_end - r_begin) * map.width;
+    for (auto* layer : {&map.E1_over_E2, &map.sigma_over_T_gaussian,
+                        &map.sigma_over_T_gaussian_stderr, &map.sigma_over_T_exponential,
+                        &map.sigma_over_T_exponential_stderr, &map.T_um, &map.T_um_stderr})
+        if (!layer->empty()) std::fill_n(layer->data() + begin, count, kNaN);
+    for (auto* layer : {&map.roughness_class, &map.roughness_class_g})
+        if (!layer->empty()) std::fill_n(layer->data() + begin, count, kClassNone);
+}
+
+// What decides a pixel's fate before its look-ups.
+enum PixelState : std::uint8_t { kPixelEstimate = 0, kPixelMissing = 1, kPixelNoSolution = 2 };
+
+// Per pixel: the pixel's ratio, the noise from the (2R + 1)² neighbourhood. Row by row, each
+// step a loop over plain arrays of the row: the column sums over rows [r − R, r + R] (running:
+// the new row added, the old one removed), the window's sums over 2R + 1 columns and the
+// pixel's ln-ratio variance, then the look-ups per pixel.
 void pixel_map(const std::vector<MapCapture>& captures, const MapOptions& o, Evaluator& ev,
                RoughnessMap& map, std::vector<std::int32_t>& cell_region, std::size_t r_begin,
                std::size_t r_end) {
@@ -727,10 +783,15 @@ void pixel_map(const std::vector<MapCapture>& captures, const MapOptions& o, Eva
     const MapCapture& c2 = captures[1];
     const std::size_t W = c1.image->width, H = c1.image->height, R = kPixelNoiseRadius;
     const std::size_t ring = 2 * R + 2;
+    // The ring of rows: the two brightnesses and the pixel's weight (1 used, 0 not).
     std::vector<std::vector<double>> x1(ring, std::vector<double>(W)),
-        x2(ring, std::vector<double>(W));
-    std::vector<std::vector<std::uint8_t>> used(ring, std::vector<std::uint8_t>(W));
-    std::vector<Sums> col(W);
+        x2(ring, std::vector<double>(W)), used(ring, std::vector<double>(W));
+    // The column sums n, Σx1, Σx2, Σx1², Σx2², Σx1x2, each padded by R zeros either side.
+    const std::size_t padded = W + 2 * R;
+    std::array<std::vector<double>, 6> col;
+    for (auto& c : col) c.assign(padded, 0.0);
+    std::vector<double> ratio(W), var(W);
+    std::vector<std::uint8_t> state(W);
     auto load = [&](std::size_t r) {
         const std::size_t k = r % ring;
         load_row(c1, r, x1[k]);
@@ -739,16 +800,61 @@ void pixel_map(const std::vector<MapCapture>& captures, const MapOptions& o, Eva
     };
     auto add_row = [&](std::size_t r, double sign) {
         const std::size_t k = r % ring;
+        const double* __restrict a = x1[k].data();
+        const double* __restrict b = x2[k].data();
+        const double* __restrict u = used[k].data();
+        double* __restrict n = col[0].data() + R;
+        double* __restrict s1 = col[1].data() + R;
+        double* __restrict s2 = col[2].data() + R;
+        double* __restrict s11 = col[3].data() + R;
+        double* __restrict s22 = col[4].data() + R;
+        double* __restrict s12 = col[5].data() + R;
         for (std::size_t x = 0; x < W; ++x) {
-            if (!used[k][x]) continue;
-            const double a = x1[k][x], b = x2[k][x];
-            Sums& s = col[x];
-            s.n += sign;
-            s.s1 += sign * a;
-            s.s2 += sign * b;
-            s.s11 += sign * a * a;
-            s.s22 += sign * b * b;
-            s.s12 += sign * a * b;
+            const double w = sign * u[x], wa = w * a[x], wb = w * b[x];
+            n[x] += w;
+            s1[x] += wa;
+            s2[x] += wb;
+            s11[x] += wa * a[x];
+            s22[x] += wb * b[x];
+            s12[x] += wa * b[x];
+        }
+    };
+    // The window's sums at each pixel of row k, then var(ln x1/x2) of one pixel (the delta
+    // method on the window's means, variances and covariance) and the pixel's state.
+    auto row_statistics = [&](std::size_t k) {
+        const double* __restrict a = x1[k].data();
+        const double* __restrict b = x2[k].data();
+        const double* __restrict u = used[k].data();
+        const double* __restrict cn = col[0].data();
+        const double* __restrict cs1 = col[1].data();
+        const double* __restrict cs2 = col[2].data();
+        const double* __restrict cs11 = col[3].data();
+        const double* __restrict cs22 = col[4].data();
+        const double* __restrict cs12 = col[5].data();
+        double* __restrict out_ratio = ratio.data();
+        double* __restrict out_var = var.data();
+        std::uint8_t* __restrict out_state = state.data();
+        for (std::size_t x = 0; x < W; ++x) {
+            double n = 0, s1 = 0, s2 = 0, s11 = 0, s22 = 0, s12 = 0;
+            for (std::size_t d = 0; d <= 2 * R; ++d) {
+                n += cn[x + d];
+                s1 += cs1[x + d];
+                s2 += cs2[x + d];
+                s11 += cs11[x + d];
+                s22 += cs22[x + d];
+                s12 += cs12[x + d];
+            }
+            const double m1 = s1 / n, m2 = s2 / n;
+            const double v1 = std::max(0.0, (s11 - n * m1 * m1) / (n - 1.0));
+            const double v2 = std::max(0.0, (s22 - n * m2 * m2) / (n - 1.0));
+            const double c12 = (s12 - n * m1 * m2) / (n - 1.0);
+            out_var[x] = std::max(0.0, v1 / (m1 * m1) + v2 / (m2 * m2) - 2.0 * c12 / (m1 * m2));
+            out_ratio[x] = a[x] / b[x];
+            // Running sums of ±1 stay exact integers in n.
+            const bool missing = !(u[x] > 0.0) || n < 3.0;
+            const bool no_solution = !(a[x] > 0.0) || !(b[x] > 0.0) || !(m1 > 0.0) || !(m2 > 0.0);
+            out_state[x] =
+                missing ? kPixelMissing : (no_solution ? kPixelNoSolution : kPixelEstimate);
         }
     };
     // The column sums hold rows [removed, added) = [r − R, r + R] ∩ [0, H) at row r.
@@ -761,42 +867,30 @@ void pixel_map(const std::vector<MapCapture>& captures, const MapOptions& o, Eva
         }
         for (; removed + R < r; ++removed) add_row(removed, -1.0);
         const std::size_t k = r % ring;
-        Sums window;
-        auto add_col = [&](const Sums& s, double sign) {
-            window.n += sign * s.n;
-            window.s1 += sign * s.s1;
-            window.s2 += sign * s.s2;
-            window.s11 += sign * s.s11;
-            window.s22 += sign * s.s22;
-            window.s12 += sign * s.s12;
-        };
-        for (std::size_t x = 0; x < std::min(W, R + 1); ++x) add_col(col[x], 1.0);
+        row_statistics(k);
+        clear_rows(map, r, r + 1);
+        const std::size_t row = r * W;
+        if (labels)
+            std::copy_n(o.region_labels.begin() + static_cast<std::ptrdiff_t>(row), W,
+                        cell_region.begin() + static_cast<std::ptrdiff_t>(row));
         for (std::size_t x = 0; x < W; ++x) {
-            if (x >= 1 && x + R < W) add_col(col[x + R], 1.0);
-            if (x >= R + 1) add_col(col[x - R - 1], -1.0);
-            const std::size_t index = r * W + x;
-            if (labels) cell_region[index] = o.region_labels[index];
-            double m1 = 0, m2 = 0, var = 0;
-            // Running sums of ±1 stay exact integers in n.
-            if (!used[k][x] || window.n < 3.0) {
+            const std::size_t index = row + x;
+            if (state[x] == kPixelMissing) {
                 ++ev.counts().missing;
-                mark_no_class(map, index);
-                continue;
+            } else if (state[x] == kPixelNoSolution) {
+                ++ev.counts().no_solution;
+                ++ev.counts().no_solution_exponential;
+            } else if (ev.flat()) {
+                ev.evaluate_flat(index, ratio[x], var[x]);
+            } else {
+                Cell cell;
+                cell.ratio = ratio[x];
+                cell.log_ratio = std::log(ratio[x]);
+                cell.var_log_ratio = var[x];
+                const float* nm = o.normal_map.data() + 3 * index;
+                cell.normal = Eigen::Vector3d(nm[0], nm[1], nm[2]);
+                ev.evaluate(index, cell);
             }
-            const double a = x1[k][x], b = x2[k][x];
-            if (!(a > 0.0) || !(b > 0.0) || !window.pixel_log_variance(m1, m2, var)) {
-                mark_no_solution(ev, map, index);
-                continue;
-            }
-            Cell cell;
-            cell.ratio = a / b;
-            cell.log_ratio = std::log(cell.ratio);
-            cell.var_log_ratio = var;
-            if (!o.normal_map.empty()) {
-                const float* n = o.normal_map.data() + 3 * index;
-                cell.normal = Eigen::Vector3d(n[0], n[1], n[2]);
-            }
-            ev.evaluate(index, cell);
         }
     }
 }
@@ -818,9 +912,9 @@ void summarise(const std::vector<MapCapture>& captures, const MapOptions& o, Rou
                const std::vector<std::int32_t>& cell_region) {
     std::array<Accumulator, 3> classes;
     std::vector<RegionAccumulator> regions(o.region_names.size());
-    const std::vector<float>& primary = o.correlation == Correlation::Gaussian
-                                            ? map.sigma_over_T_gaussian
-                                            : map.sigma_over_T_exponential;
+    const MapLayerValues& primary = o.correlation == Correlation::Gaussian
+                                        ? map.sigma_over_T_gaussian
+                                        : map.sigma_over_T_exponential;
     const std::size_t cells = map.width * map.height;
     for (std::size_t i = 0; i < cells; ++i) {
         const std::uint8_t c = map.roughness_class[i];
@@ -913,15 +1007,16 @@ RoughnessMap roughness_map(const std::vector<MapCapture>& captures, const MapOpt
         });
     const std::size_t registration_warning_at = map.warnings.size();
     const std::size_t cells = map.width * map.height;
+    // The layers without a fill: each band's thread writes every cell of its rows (clear_rows).
     for (auto* layer :
          {&map.E1_over_E2, &map.sigma_over_T_gaussian, &map.sigma_over_T_gaussian_stderr,
           &map.sigma_over_T_exponential, &map.sigma_over_T_exponential_stderr})
-        assign_large(*layer, cells, kNaN);
-    assign_large(map.roughness_class, cells, kClassNone);
+        resize_large_uninitialised(*layer, cells);
+    resize_large_uninitialised(map.roughness_class, cells);
     if (o.sigma_um) {
-        assign_large(map.T_um, cells, kNaN);
-        assign_large(map.T_um_stderr, cells, kNaN);
-        assign_large(map.roughness_class_g, cells, kClassNone);
+        resize_large_uninitialised(map.T_um, cells);
+        resize_large_uninitialised(map.T_um_stderr, cells);
+        resize_large_uninitialised(map.roughness_class_g, cells);
     }
     std::vector<std::int32_t> cell_region;
     if (!o.region_labels.empty()) cell_region.assign(cells, -1);
@@ -938,10 +1033,12 @@ RoughnessMap roughness_map(const std::vector<MapCapture>& captures, const MapOpt
     auto run = [&](std::size_t t) {
         try {
             const std::size_t begin = rows * t / threads, end = rows * (t + 1) / threads;
-            if (o.window_px == 1)
+            if (o.window_px == 1) {
                 pixel_map(captures, o, evaluators[t], map, cell_region, begin, end);
-            else
+            } else {
+                clear_rows(map, begin, end);
                 tile_map(captures, o, evaluators[t], map, cell_region, begin, end);
+            }
         } catch (...) {
             errors[t] = std::current_exception();
         }

@@ -17,9 +17,12 @@
 // normal map. sd(σ/T) = |dσ/T / d ln(E1/E2)| · sd(ln E1/E2).
 #pragma once
 
+#include <algorithm>
 #include <array>
+#include <bit>
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <optional>
 #include <span>
 #include <string>
@@ -27,6 +30,7 @@
 
 #include <Eigen/Core>
 
+#include "roughscope/core/memory.hpp"
 #include "roughscope/estimation/estimation.hpp"
 #include "roughscope/image/image.hpp"
 #include "roughscope/image/registration.hpp"
@@ -94,12 +98,37 @@ class RatioInverseTable {
         double dx_dlog_ratio = 0.0;  // d x / d ln(E1/E2)
     };
     // x at ln(E1/E2); nullopt when outside the table. The interval is found through an index of
-    // 4 buckets per interval, uniform in y (the few intervals of the value's bucket searched);
-    // `hint` receives it.
+    // 4 buckets per interval, uniform in a monotone integer stand-in for ln(y − y_0) − ln(y_n − y)
+    // (the nodes, uniform in ln x, crowd logarithmically towards the ends), and a short scan of the
+    // bucket's intervals; `hint` receives it.
     std::optional<Value> lookup(double log_ratio, std::size_t& hint) const;
     std::optional<Value> lookup(double log_ratio) const {
         std::size_t hint = 0;
         return lookup(log_ratio, hint);
+    }
+    // The most intervals one bucket of the index meets (the look-up's longest scan + 1).
+    std::size_t max_intervals_per_bucket() const;
+    // lookup's arithmetic without the optional: false (v untouched) where lookup gives nullopt.
+    // Inline, for the per-pixel map.
+    bool find(double log_ratio, Value& v, std::size_t& interval) const {
+        if (!(log_ratio >= y_.front() && log_ratio <= y_.back())) return false;
+        const std::size_t b = bucket_of(log_ratio);
+        std::size_t j = bucket_first_interval_[b];
+        const std::size_t last = bucket_first_interval_[b + 1];
+        // Two steps without a branch (the buckets of the tables here meet at most 3 intervals),
+        // then the rest of a longer bucket.
+        j += static_cast<std::size_t>(j < last && y_[j + 1] <= log_ratio);
+        j += static_cast<std::size_t>(j < last && y_[j + 1] <= log_ratio);
+        while (j < last && y_[j + 1] <= log_ratio) ++j;
+        interval = j;
+        // The cubic Hermite interpolant in y between nodes j and j + 1.
+        const std::array<double, 5>& c = coefficients_[j];
+        const double t = (log_ratio - y_[j]) * c[4];
+        const double x = c[0] + t * (c[1] + t * (c[2] + t * c[3]));
+        if (!(x > 0.0) || !(x <= std::numeric_limits<double>::max())) return false;
+        v.x = x;
+        v.dx_dlog_ratio = (c[1] + t * (2.0 * c[2] + t * 3.0 * c[3])) * c[4];
+        return true;
     }
     // The ratios E1/E2 the table inverts (open interval).
     RatioRange ratio_range() const;
@@ -110,8 +139,23 @@ class RatioInverseTable {
     std::vector<double> y_, x_, dxdy_;  // y increasing
     // Per interval j: x = c0 + c1 t + c2 t² + c3 t³, t = (y − y_j)·c4 (the Hermite cubic).
     std::vector<std::array<double, 5>> coefficients_;
-    // bucket_interval_[b]: the interval holding y_0 + b / bucket_scale_ (b = 0 … buckets).
-    std::vector<std::uint32_t> bucket_interval_;
+    // A monotone stand-in for ln(y − y_0) − ln(y_n − y): the bits of a positive double, read as
+    // an integer, grow monotonically and about linearly with its log2.
+    std::int64_t bucket_key(double log_ratio) const {
+        const double front = std::max(log_ratio - y_.front(), key_floor_front_);
+        const double back = std::max(y_.back() - log_ratio, key_floor_back_);
+        return std::bit_cast<std::int64_t>(front) - std::bit_cast<std::int64_t>(back);
+    }
+    std::size_t bucket_of(double log_ratio) const {
+        const std::size_t buckets = bucket_first_interval_.size() - 1;
+        const double at = static_cast<double>(bucket_key(log_ratio) - key_min_) * bucket_scale_;
+        return std::min(buckets - 1, static_cast<std::size_t>(std::max(0.0, at)));
+    }
+    // bucket_first_interval_[b]: the interval holding the smallest y of bucket b (b = 0 …
+    // buckets; [b + 1] bounds the intervals of bucket b).
+    std::vector<std::uint32_t> bucket_first_interval_;
+    double key_floor_front_ = 0.0, key_floor_back_ = 0.0;
+    std::int64_t key_min_ = 0;
     double bucket_scale_ = 0.0;
 };
 
@@ -192,22 +236,26 @@ struct RegionMapStatistics {
     std::array<std::size_t, 3> class_counts{};  // by σ/T (RoughnessClass order)
 };
 
+using MapLayerValues = std::vector<float, DefaultInitAllocator<float>>;
+using MapClassCodes = std::vector<std::uint8_t, DefaultInitAllocator<std::uint8_t>>;
+
 struct RoughnessMap {
     std::size_t width = 0;  // of the map (pixels or tiles): ceil(image width / window_px)
     std::size_t height = 0;
     std::size_t window_px = 1;
     std::size_t image_width = 0, image_height = 0;
-    // Layers, width · height, row-major, NaN where missing.
-    std::vector<float> E1_over_E2;
-    std::vector<float> sigma_over_T_gaussian, sigma_over_T_gaussian_stderr;
-    std::vector<float> sigma_over_T_exponential, sigma_over_T_exponential_stderr;
-    std::vector<float> T_um, T_um_stderr;  // σ known only (else empty)
+    // Layers, width · height, row-major, NaN where missing. (DefaultInitAllocator: the map
+    // writes every cell once, each band of rows from its own thread, instead of a fill first.)
+    MapLayerValues E1_over_E2;
+    MapLayerValues sigma_over_T_gaussian, sigma_over_T_gaussian_stderr;
+    MapLayerValues sigma_over_T_exponential, sigma_over_T_exponential_stderr;
+    MapLayerValues T_um, T_um_stderr;  // σ known only (else empty)
     // Class by σ/T of MapOptions::correlation (kClass* codes), and by g when σ is known.
-    std::vector<std::uint8_t> roughness_class;
-    std::vector<std::uint8_t> roughness_class_g;  // σ known only
-    std::size_t valid = 0;        // pixels/tiles with a σ/T (of MapOptions::correlation)
-    std::size_t missing = 0;      // too few used pixels (flagged, off the object)
-    std::size_t no_solution = 0;  // a ratio the model does not produce
+    MapClassCodes roughness_class;
+    MapClassCodes roughness_class_g;  // σ known only
+    std::size_t valid = 0;            // pixels/tiles with a σ/T (of MapOptions::correlation)
+    std::size_t missing = 0;          // too few used pixels (flagged, off the object)
+    std::size_t no_solution = 0;      // a ratio the model does not produce
     std::size_t no_solution_exponential = 0;  // the same for the other layer
     std::optional<Registration> registration;
     std::array<ClassStatistics, 3> classes;

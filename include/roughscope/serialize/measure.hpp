@@ -37,12 +37,12 @@ Json to_json(const image::RoughnessMap& map);
 // them as arrays, under the same names.
 struct MapLayer {
     std::string name;
-    const std::vector<float>* values;
+    const image::MapLayerValues* values;
 };
 std::vector<MapLayer> map_float_layers(const image::RoughnessMap& map);
 struct MapClassLayer {
     std::string name;
-    const std::vector<std::uint8_t>* values;
+    const image::MapClassCodes* values;
 };
 std::vector<MapClassLayer> map_class_layers(const image::RoughnessMap& map);
 

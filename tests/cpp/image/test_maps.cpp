@@ -231,6 +231,17 @@ TEST(RatioInverseTable, LookUpsInAnyOrderFindTheirInterval) {
         }
         EXPECT_GT(looked_up, 15000U);
         EXPECT_LT(worst, 1e-7) << to_string(c);
+        // The index resolves the crowded ends (y − y_0 ∝ (σ/T)^−2 spans 16 decades over the
+        // table): no bucket meets more than a few intervals (a bucket uniform in y met ~3000).
+        EXPECT_LE(table.max_intervals_per_bucket(), 3U) << to_string(c);
+    }
+    // The same for tables of the two-geometry model and of T given σ.
+    const Geometry o1 = make_geometry(kTheta1, deg_to_rad(20.0), 0.3);
+    const Geometry o2 = make_geometry(kTheta2, deg_to_rad(20.0), 0.3);
+    for (const Correlation c : {Correlation::Gaussian, Correlation::Exponential}) {
+        EXPECT_LE(RatioInverseTable::sigma_over_T(o1, o2, c).max_intervals_per_bucket(), 3U);
+        EXPECT_LE(RatioInverseTable::correlation_length(g1, g2, 0.05, c).max_intervals_per_bucket(),
+                  3U);
     }
 }
 
