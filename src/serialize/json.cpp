@@ -157,6 +157,13 @@ char* write_number(char* out, double value) {
         value = -value;
     }
     if (value == 0.0) return std::copy_n("0.0", 3, out);
+    // Below 1e-4 and from 1e15 up, every decimal that reads back as `value` is on the same side
+    // of 1e-4 and 1e15 as `value` (those two decimals read back as doubles of their own), so the
+    // layout is the exponent form below, which is std::to_chars's own scientific form
+    // ("d[.igits]e±XX[X]"): taken directly, without the scaling attempt and re-reading the text.
+    if (value < 1e-4 || value >= 1e15)
+        return std::to_chars(out, out + kNumberBufferSize - 1, value, std::chars_format::scientific)
+            .ptr;
     const ShortestDigits d = shortest_digits(value);
     const int n = d.exponent + 1;  // digits before the decimal point
     if (n > -4 && n <= 0) {        // 0.[000]digits
