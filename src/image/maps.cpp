@@ -770,7 +770,7 @@ void clear_rows(RoughnessMap& map, std::size_t r_begin, std::size_t r_end) {
 }
 
 // What decides a pixel's fate before its look-ups.
-enum PixelState : std::uint8_t { kPixelEstimate = 0, kPixelMissing = 1, kPixelNoSolution = 2 };
+enum class PixelState : std::uint8_t { Estimate, Missing, NoSolution };
 
 // Per pixel: the pixel's ratio, the noise from the (2R + 1)² neighbourhood. Row by row, each
 // step a loop over plain arrays of the row: the column sums over rows [r − R, r + R] (running:
@@ -791,7 +791,7 @@ void pixel_map(const std::vector<MapCapture>& captures, const MapOptions& o, Eva
     std::array<std::vector<double>, 6> col;
     for (auto& c : col) c.assign(padded, 0.0);
     std::vector<double> ratio(W), var(W);
-    std::vector<std::uint8_t> state(W);
+    std::vector<PixelState> state(W);
     auto load = [&](std::size_t r) {
         const std::size_t k = r % ring;
         load_row(c1, r, x1[k]);
@@ -833,7 +833,7 @@ void pixel_map(const std::vector<MapCapture>& captures, const MapOptions& o, Eva
         const double* __restrict cs12 = col[5].data();
         double* __restrict out_ratio = ratio.data();
         double* __restrict out_var = var.data();
-        std::uint8_t* __restrict out_state = state.data();
+        PixelState* __restrict out_state = state.data();
         for (std::size_t x = 0; x < W; ++x) {
             double n = 0, s1 = 0, s2 = 0, s11 = 0, s22 = 0, s12 = 0;
             for (std::size_t d = 0; d <= 2 * R; ++d) {
@@ -853,8 +853,8 @@ void pixel_map(const std::vector<MapCapture>& captures, const MapOptions& o, Eva
             // Running sums of ±1 stay exact integers in n.
             const bool missing = !(u[x] > 0.0) || n < 3.0;
             const bool no_solution = !(a[x] > 0.0) || !(b[x] > 0.0) || !(m1 > 0.0) || !(m2 > 0.0);
-            out_state[x] =
-                missing ? kPixelMissing : (no_solution ? kPixelNoSolution : kPixelEstimate);
+            out_state[x] = missing ? PixelState::Missing
+                                   : (no_solution ? PixelState::NoSolution : PixelState::Estimate);
         }
     };
     // The column sums hold rows [removed, added) = [r − R, r + R] ∩ [0, H) at row r.
@@ -875,9 +875,9 @@ void pixel_map(const std::vector<MapCapture>& captures, const MapOptions& o, Eva
                         cell_region.begin() + static_cast<std::ptrdiff_t>(row));
         for (std::size_t x = 0; x < W; ++x) {
             const std::size_t index = row + x;
-            if (state[x] == kPixelMissing) {
+            if (state[x] == PixelState::Missing) {
                 ++ev.counts().missing;
-            } else if (state[x] == kPixelNoSolution) {
+            } else if (state[x] == PixelState::NoSolution) {
                 ++ev.counts().no_solution;
                 ++ev.counts().no_solution_exponential;
             } else if (ev.flat()) {
