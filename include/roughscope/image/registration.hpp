@@ -3,14 +3,16 @@
 // A roughness map divides two photographs pixel by pixel (or tile by tile), so a camera that moved
 // between them mixes the brightness of different surface points: at a region border the ratio is
 // then meaningless. estimate_misregistration measures the translation of b relative to a by
-// phase correlation (OpenCV imgproc cv::phaseCorrelate, with a Hanning window, on the average of
-// the channels): the peak of the inverse Fourier transform of the normalised cross-power spectrum,
-// located by its 5 × 5 weighted centroid; that centroid is pulled toward whole pixels (by up to
-// ~0.3 px), so the peak is then located on the surface upsampled around it by the matrix-product
-// DFT of Guizar-Sicairos, Thurman & Fienup (2008): ±0.6 px in steps of 0.1 px, then ±0.1 px in
-// steps of 0.01 px. The images' means are removed before the window is applied. Images larger than
-// RegistrationOptions::max_side_px on a side are correlated on their central crop of at most
-// max_side_px × max_side_px pixels at full resolution (sub-pixel accuracy kept, cost bounded).
+// phase correlation (as cv::phaseCorrelate, with its Hanning window, on the average of the
+// channels; the transforms are FFTW's real-to-complex ones): the peak of the inverse Fourier
+// transform of the normalised cross-power spectrum, located by its 5 × 5 weighted centroid; that
+// centroid is pulled toward whole pixels (by up to ~0.3 px), so the peak is then located on the
+// surface upsampled around it by the matrix-product DFT of Guizar-Sicairos, Thurman & Fienup
+// (2008): ±0.6 px in steps of 0.1 px, then to a fraction of a step by the parabola through the
+// best point and its neighbours. The images' means are removed before the window is applied.
+// Images larger than RegistrationOptions::max_side_px on a side are correlated on their central
+// crop of at most max_side_px × max_side_px pixels at full resolution (sub-pixel accuracy kept,
+// cost bounded).
 //
 // Whether the peak means anything: the peak-to-sidelobe ratio PSR = (peak − mean)/sd of the
 // correlation surface outside the peak's 11 × 11 neighbourhood. Images that share no structure (a

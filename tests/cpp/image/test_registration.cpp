@@ -76,6 +76,11 @@ TEST(Registration, RecoversKnownShifts) {
     const Registration same = estimate_misregistration(a, a);
     EXPECT_NEAR(same.magnitude_px, 0.0, 1e-6);
     EXPECT_GT(same.response, 0.95);
+    // Odd sides (no Nyquist column in the half spectrum the upsampling sums over).
+    const Registration odd =
+        estimate_misregistration(blobs(201, 157, 0.0, 0.0), blobs(201, 157, 1.25, -0.5));
+    EXPECT_NEAR(odd.shift_x_px, 1.25, 0.1);
+    EXPECT_NEAR(odd.shift_y_px, -0.5, 0.1);
     // RGB: the channel average.
     const Registration rgb =
         estimate_misregistration(blobs(200, 160, 0, 0, 3), blobs(200, 160, 2.0, 1.0, 3));
