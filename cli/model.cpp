@@ -95,6 +95,9 @@ struct Point {
     double theta_i_deg = 0.0;
     double theta_s_deg = 0.0;
     std::optional<double> phi_s_deg;
+    // The degrees typed for θi, θs, φs when the geometry was made from them (CSV rows): the echo
+    // of an angle typed with few digits is then that angle (serialize::degrees).
+    std::optional<std::array<double, 3>> typed_deg;
 };
 
 Point point_from(const Geometry& g) {
@@ -300,7 +303,7 @@ class Record {
         json nested;
         // The writer's last formatted number and its text: a record is reused row after row and
         // most of its numbers (the options echoed) repeat, so each is formatted once.
-        enum class Style : std::uint8_t { None, Csv, Json };
+        enum class Style : std::uint8_t { None, Csv };
         mutable Style formatted_style = Style::None;
         mutable std::uint8_t formatted_size = 0;
         mutable std::uint64_t formatted_bits = 0;  // of the number formatted
@@ -453,9 +456,9 @@ double evaluate_bk(const Args& a, const Point& p, const Roughness& r, Record& ou
             out["diffuse"] = Record::NumberOrNull{power.diffuse};
             out["total"] = Record::NumberOrNull{power.total};
             out["g"] = Record::NumberOrNull{power.g};
-            out["regime"] = std::string(to_string(power.regime));
-            out["roughness_class"] = std::string(to_string(power.roughness_class));
-            out["method"] = std::string(to_string(power.method));
+            out["regime"] = to_string(power.regime);
+            out["roughness_class"] = to_string(power.roughness_class);
+            out["method"] = to_string(power.method);
             out["relative_error_bound"] = Record::NumberOrNull{power.relative_error_bound};
         } else {
             coherent = diffuse = total = 0.0;  // light or viewer below the horizon
@@ -491,13 +494,13 @@ double evaluate_bk(const Args& a, const Point& p, const Roughness& r, Record& ou
         out["g"] = Record::NumberOrNull{g};
         out["regime"] = regime ? json(*regime) : json(nullptr);
         out["roughness_class"] = roughness_class ? json(*roughness_class) : json(nullptr);
-        out["method"] = std::string(to_string(DiffuseMethod::ClosedForm));
+        out["method"] = to_string(DiffuseMethod::ClosedForm);
         out["relative_error_bound"] = Record::NumberOrNull{0.0};
     }
     out["scale"] = absolute ? "absolute" : "relative";
-    out["correlation"] = std::string(to_string(a.correlation));
-    out["factor"] = std::string(to_string(a.factor));
-    out["radiometry"] = std::string(to_string(a.radiometry));
+    out["correlation"] = to_string(a.correlation);
+    out["factor"] = to_string(a.factor);
+    out["radiometry"] = to_string(a.radiometry);
     out["wavelength_um"] = Record::NumberOrNull{a.wavelength_um};
     out["patch_x_um"] = Record::NumberOrNull{a.patch_x_um};
     out["patch_y_um"] = Record::NumberOrNull{a.patch_y_um};
@@ -518,14 +521,12 @@ void evaluate(const Args& a, const Point& p, const Roughness& r, Record& out) {
     out.clear();
     out["model"] = model_name(a.model);
     // Angles of a geometry echoed as the shortest degrees that map to the same radians.
-    const auto angle = [&](double deg, const std::optional<double> rad) {
-        return rad ? serialize::degrees(*rad) : serialize::number(deg);
+    const auto echo = [&](double rad, std::size_t k) {
+        return p.typed_deg ? serialize::degrees(rad, (*p.typed_deg)[k]) : serialize::degrees(rad);
     };
-    out["theta_i_deg"] =
-        angle(p.theta_i_deg, p.geom ? std::optional(p.geom->theta_i_rad) : std::nullopt);
-    out["theta_s_deg"] =
-        angle(p.theta_s_deg, p.geom ? std::optional(p.geom->theta_s_rad) : std::nullopt);
-    out["phi_s_deg"] = p.geom ? serialize::degrees(p.geom->phi_s_rad) : json(nullptr);
+    out["theta_i_deg"] = p.geom ? echo(p.geom->theta_i_rad, 0) : serialize::number(p.theta_i_deg);
+    out["theta_s_deg"] = p.geom ? echo(p.geom->theta_s_rad, 1) : serialize::number(p.theta_s_deg);
+    out["phi_s_deg"] = p.geom ? echo(p.geom->phi_s_rad, 2) : json(nullptr);
     out["visible"] = p.geom.has_value();
     out["brightness"] = nullptr;  // placeholder keeps the key order
 
@@ -739,26 +740,26 @@ class RecordWriter {
         std::array<char, kBlock> text{};
     };
 
-    // A number formatted for an earlier slot of this or the previous record: the B-K records'
-    // brightness, diffuse and total are often the same double.
-    struct RecentNumber {
+    // Numbers formatted before, in a direct-mapped cache by their bits: the B-K records'
+    // brightness, diffuse and total are often the same double, and the angles of a table of
+    // measurements repeat from row to row (a grid of geometries).
+    struct CachedNumber {
         std::uint64_t bits = 0;
         std::uint8_t size = 0;  // 0: empty
         std::array<char, serialize::kNumberBufferSize> text{};
     };
+    static constexpr int kCacheBits = 10;
 
     // serialize::dump's own number formatter (the same bytes by construction), unless the same
-    // double was formatted a moment ago.
+    // double is in the cache.
     char* write_number(char* out, double value) {
         const auto bits = std::bit_cast<std::uint64_t>(value);
-        for (const RecentNumber& r : recent_)
-            if (r.size != 0 && r.bits == bits) return std::copy_n(r.text.data(), r.size, out);
+        CachedNumber& c = cache_[(bits * 0x9E3779B97F4A7C15ULL) >> (64 - kCacheBits)];
+        if (c.size != 0 && c.bits == bits) return std::copy_n(c.text.data(), c.size, out);
         char* const end = serialize::write_number(out, value);
-        RecentNumber& r = recent_[next_recent_];
-        next_recent_ = (next_recent_ + 1) % recent_.size();
-        r.bits = bits;
-        r.size = static_cast<std::uint8_t>(end - out);
-        std::copy(out, end, r.text.data());
+        c.bits = bits;
+        c.size = static_cast<std::uint8_t>(end - out);
+        std::copy(out, end, c.text.data());
         return end;
     }
 
@@ -814,13 +815,9 @@ class RecordWriter {
                 case Kind::Boolean:
                     p = v.boolean ? std::copy_n("true", 4, p) : std::copy_n("false", 5, p);
                     break;
-                case Kind::Number: {
-                    const std::string_view text =
-                        v.number_text(Record::Value::Style::Json,
-                                      [&](char* buffer) { return write_number(buffer, v.number); });
-                    p = std::copy(text.begin(), text.end(), p);
+                case Kind::Number:
+                    p = write_number(p, v.number);
                     break;
-                }
                 case Kind::Text:
                     *p++ = '"';
                     p = std::copy(v.text.begin(), v.text.end(), p);
@@ -843,8 +840,7 @@ class RecordWriter {
     std::size_t count_ = 0;
     std::string chunk_;
     std::vector<KeyText> keys_;  // by position in the record
-    std::array<RecentNumber, 4> recent_{};
-    std::size_t next_recent_ = 0;
+    std::vector<CachedNumber> cache_ = std::vector<CachedNumber>(std::size_t{1} << kCacheBits);
 };
 
 Roughness roughness_from_flags(const Args& a) {
@@ -948,8 +944,8 @@ void run_model(const Args& a) {
             check_polar_deg(ts, "column 'theta_s'");
             const Roughness r =
                 a.model == ModelKind::BK ? roughness_for_row(a, row, where) : Roughness{};
-            const Point p =
-                point_from(make_geometry(deg_to_rad(ti), deg_to_rad(ts), deg_to_rad(ps)));
+            Point p = point_from(make_geometry(deg_to_rad(ti), deg_to_rad(ts), deg_to_rad(ps)));
+            p.typed_deg = {ti, ts, ps};
             evaluate(a, p, r, record);
             writer.add(record);
         } catch (const UsageError&) {

@@ -33,6 +33,25 @@ Json degrees(double radians) {
     return deg;
 }
 
+Json degrees(double radians, double given_degrees) {
+    // The argument (docs in json.hpp) needs the few-ulp neighbourhoods of normal doubles on both
+    // sides: radians away from the subnormals, degrees away from overflow.
+    const double magnitude = std::abs(given_degrees);
+    if (!(magnitude >= 1e-280 && magnitude <= 1e300) ||
+        std::bit_cast<std::uint64_t>(deg_to_rad(given_degrees)) !=
+            std::bit_cast<std::uint64_t>(radians))
+        return degrees(radians);
+    // At most 13 significant digits. Typed angles first, without the digits: a decimal
+    // m·10⁻⁶ (|m| < 10¹³: m and 10⁶ exact, the quotient correctly rounded) that reads back as
+    // given_degrees.
+    if (magnitude < 1e7) {
+        const double m = std::nearbyint(given_degrees * 1e6);
+        if (m / 1e6 == given_degrees) return given_degrees;
+    }
+    if (shortest_digits(given_degrees).count <= 13) return given_degrees;
+    return degrees(radians);
+}
+
 Json numbers(const std::vector<double>& values) {
     Json out = Json::array();
     for (double v : values) out.push_back(number(v));

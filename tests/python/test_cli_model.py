@@ -396,7 +396,11 @@ def test_csv_json_stream_is_each_rows_dump(tmp_path, model):
     the bytes the single-geometry command's `--json` document has (serialize::dump), indented
     one level: numbers as the same shortest text, keys in the same order."""
     geometries = [("30", "40", "180"), ("12.5", "33.3", "90"), ("0.1", "89.9", "359.9"),
-                  ("1e-5", "45", "0"), ("0", "0", "0"), ("89.99999999999999", "1.5e-7", "271.25")]
+                  ("1e-5", "45", "0"), ("0", "0", "0"), ("89.99999999999999", "1.5e-7", "271.25"),
+                  # repeated numbers (the writer's cache), azimuths made into others (the echo
+                  # of the geometry's, not the typed one), 16-17 digit angles
+                  ("30", "40", "180"), ("45", "45", "-180"), ("45", "45", "720"),
+                  ("29.999999999999996", "0.30000000000000004", "123.45678901234567")]
     src = write(tmp_path / "in.csv",
                 "theta_i,theta_s,phi_s\n" + "".join(",".join(g) + "\n" for g in geometries))
     streamed = run("model", "--csv", src, *model, "--json").stdout

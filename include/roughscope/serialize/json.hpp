@@ -29,6 +29,13 @@ Json number(const std::optional<double>& value);
 // back to radians (deg_to_rad) gives exactly `radians`, so an angle entered as 30° is echoed as
 // 30, not 29.999999999999996, and nothing is lost. null if not finite.
 Json degrees(double radians);
+// degrees(radians) of an angle converted from `given_degrees` (deg_to_rad(given_degrees) is
+// `radians` bit for bit; otherwise this is degrees(radians)): the same value, found without the
+// search when given_degrees has at most 13 significant digits. The decimals that convert to the
+// same radians are then within a few ulps (relative ~1e-15) of it: its own digits are the
+// shortest among them (two decimals of at most 13 digits are at least 1e-13 of the value apart)
+// and rounding degrees(radians)'s candidate to as many digits gives them back.
+Json degrees(double radians, double given_degrees);
 // A list of doubles (each through number()).
 Json numbers(const std::vector<double>& values);
 // An empty string as null (an absent reason or name), else the string.

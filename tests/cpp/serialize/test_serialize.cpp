@@ -96,6 +96,51 @@ TEST(SerializeJson, DegreesAreTheShortestDecimalThatMapsBackToTheRadians) {
     EXPECT_TRUE(serialize::degrees(kNaN).is_null());
 }
 
+TEST(SerializeJson, DegreesOfAGivenAngleAreTheShortestDecimalThatMapsBackToo) {
+    // degrees(radians, given) against the brute-force definition for angles typed with 1 to 13
+    // digits (its shortcut), typed with 16-17 digits (a shorter decimal may map to the same
+    // radians: 29.999999999999996 gives 30), given degrees that do not convert to the radians,
+    // and the ends of the double range.
+    const auto brute_force = [](double radians) {
+        const double deg = rad_to_deg(radians);
+        for (int digits = 1; digits <= 17; ++digits) {
+            char buf[64];
+            std::snprintf(buf, sizeof buf, "%.*g", digits, deg);
+            const double candidate = std::strtod(buf, nullptr);
+            if (deg_to_rad(candidate) == radians) return candidate;
+        }
+        return deg;
+    };
+    std::mt19937_64 rng(11);
+    std::uniform_int_distribution<std::int64_t> mantissa(-9'999'999'999'999, 9'999'999'999'999);
+    std::uniform_int_distribution<int> places(0, 13), digits(1, 13);
+    std::uniform_real_distribution<double> any(-400.0, 400.0);
+    std::vector<double> given = {
+        30.0, 29.999999999999996, 45.0, 1e-280, 1e300, -1e300, 1e-300, 1e301,
+        0.1,  0.30000000000000004};
+    for (int k = 0; k < 20000; ++k) {
+        // A decimal of `digits` significant digits (or fewer) with `places` decimals.
+        const std::int64_t m =
+            mantissa(rng) / static_cast<std::int64_t>(std::pow(10, 13 - digits(rng)));
+        given.push_back(static_cast<double>(m) / std::pow(10.0, places(rng)));
+        given.push_back(any(rng));  // 16-17 digits
+    }
+    std::size_t shortened = 0;
+    for (const double d : given) {
+        const double r = deg_to_rad(d);
+        const double expected = brute_force(r);
+        ASSERT_EQ(serialize::degrees(r, d).get<double>(), expected) << "degrees " << d;
+        shortened += expected != d;
+        // Given degrees that convert to other radians: degrees(radians) itself.
+        const double other = std::nextafter(r, 10.0);
+        ASSERT_EQ(serialize::degrees(other, d).get<double>(), brute_force(other)) << d;
+    }
+    EXPECT_GT(shortened, 100U);  // the 16-17 digit angles do meet shorter decimals
+    EXPECT_EQ(serialize::degrees(deg_to_rad(29.999999999999996), 29.999999999999996).get<double>(),
+              brute_force(deg_to_rad(29.999999999999996)));
+    EXPECT_TRUE(serialize::degrees(kNaN, 30.0).is_null());
+}
+
 TEST(SerializeEstimation, RoughnessEstimateHasTheDocumentedKeys) {
     RoughnessEstimate e;
     e.sigma_over_T = Estimate{0.5, 0.01};
