@@ -63,20 +63,23 @@ TEST(SerializeJson, DoublesRoundTripExactlyThroughDumpAndParse) {
         EXPECT_EQ(back[k].get<double>(), values[k]) << k;  // bit-exact, no pre-rounding
 }
 
+// serialize::degrees's definition, brute force: strtod of printf's "%.*g" of the degrees at 1,
+// 2, ... 17 digits, the first whose deg_to_rad is the radians.
+double shortest_degrees_brute_force(double radians) {
+    const double deg = rad_to_deg(radians);
+    for (int digits = 1; digits <= 17; ++digits) {
+        char buf[64];
+        std::snprintf(buf, sizeof buf, "%.*g", digits, deg);
+        const double candidate = std::strtod(buf, nullptr);
+        if (deg_to_rad(candidate) == radians) return candidate;
+    }
+    return deg;
+}
+
 TEST(SerializeJson, DegreesAreTheShortestDecimalThatMapsBackToTheRadians) {
-    // The definition, brute force: strtod of printf's "%.*g" of the degrees at 1, 2, ... 17
-    // digits, the first whose deg_to_rad is the radians (the serializer skips precisions that
-    // cannot qualify and builds the candidates without text).
-    const auto brute_force = [](double radians) {
-        const double deg = rad_to_deg(radians);
-        for (int digits = 1; digits <= 17; ++digits) {
-            char buf[64];
-            std::snprintf(buf, sizeof buf, "%.*g", digits, deg);
-            const double candidate = std::strtod(buf, nullptr);
-            if (deg_to_rad(candidate) == radians) return candidate;
-        }
-        return deg;
-    };
+    // Against the definition, brute force (the serializer skips precisions that cannot qualify
+    // and builds the candidates without text).
+    const auto brute_force = shortest_degrees_brute_force;
     std::mt19937_64 rng(5);
     std::uniform_int_distribution<int> tenths(-3600, 3600), places(0, 6);
     std::uniform_real_distribution<double> any(-7.0, 7.0);
@@ -101,16 +104,7 @@ TEST(SerializeJson, DegreesOfAGivenAngleAreTheShortestDecimalThatMapsBackToo) {
     // digits (its shortcut), typed with 16-17 digits (a shorter decimal may map to the same
     // radians: 29.999999999999996 gives 30), given degrees that do not convert to the radians,
     // and the ends of the double range.
-    const auto brute_force = [](double radians) {
-        const double deg = rad_to_deg(radians);
-        for (int digits = 1; digits <= 17; ++digits) {
-            char buf[64];
-            std::snprintf(buf, sizeof buf, "%.*g", digits, deg);
-            const double candidate = std::strtod(buf, nullptr);
-            if (deg_to_rad(candidate) == radians) return candidate;
-        }
-        return deg;
-    };
+    const auto brute_force = shortest_degrees_brute_force;
     std::mt19937_64 rng(11);
     std::uniform_int_distribution<std::int64_t> mantissa(-9'999'999'999'999, 9'999'999'999'999);
     std::uniform_int_distribution<int> places(0, 13), digits(1, 13);
