@@ -101,7 +101,8 @@ struct Point {
 };
 
 Point point_from(const Geometry& g) {
-    return {g, rad_to_deg(g.theta_i_rad), rad_to_deg(g.theta_s_rad), rad_to_deg(g.phi_s_rad)};
+    return {g, rad_to_deg(g.theta_i_rad), rad_to_deg(g.theta_s_rad), rad_to_deg(g.phi_s_rad),
+            std::nullopt};
 }
 
 // Roughness of the B–K model for one evaluation: σ and T (absolute scale) or σ/T alone
@@ -159,7 +160,7 @@ Point point_from_flags(const Args& a) {
         const Eigen::Vector3d V = parse_direction(a.view_text, "--view");
         const auto geom = geometry_from_vectors(N, L, V);
         if (geom) return point_from(*geom);
-        return {std::nullopt, angle_deg(N, L), angle_deg(N, V), std::nullopt};
+        return {std::nullopt, angle_deg(N, L), angle_deg(N, V), std::nullopt, std::nullopt};
     }
     // --theta-i --theta-s --phi-s
     if (!given(a.o_theta_i) || !given(a.o_theta_s) || !given(a.o_phi_s)) {
