@@ -57,6 +57,9 @@ struct Accumulator {
     }
 };
 
+// Per class (RoughnessClass order).
+using ClassSums = std::array<Accumulator, 3>;
+
 struct RegionAccumulator {
     Accumulator gaussian, exponential, T;
     Accumulator log_ratio;  // ln(E1/E2) of the region's tiles/pixels
@@ -276,6 +279,127 @@ void RatioInverseTable::build_coefficients() {
         coefficients_[j] = {x0, d0, 3.0 * (x1 - x0) - 2.0 * d0 - d1, 2.0 * (x0 - x1) + d0 + d1,
                             1.0 / dy};
     }
+    build_ratio_bins();
+}
+
+void RatioInverseTable::build_ratio_bins() {
+    // The anchor: the table's end of larger x.
+    const bool front = x_.front() >= x_.back();
+    anchor_sign_ = front ? 1.0 : -1.0;
+    anchor_log_ratio_ = front ? y_.front() : y_.back();
+    inv_anchor_ratio_ = std::exp(-anchor_log_ratio_);
+    constexpr int kLowestOctave = -48, kOctaves = 128;
+    ratio_bin_key_min_ =
+        std::bit_cast<std::uint64_t>(std::ldexp(1.0, kLowestOctave)) >> kRatioBinShift;
+    const std::size_t bins = std::size_t{kOctaves} << (52 - kRatioBinShift);
+    ratio_bins_.assign(5 * bins, 0.0);
+    // x and dx/du at u (find at ln ratio = y_a + ln(1 + s u); d ln ratio/du = 1/(s + u)), and
+    // how far x is uncertain from the rounding of ln ratio alone (a few ulp of it, through the
+    // slope): near the anchor x is ill-conditioned in ln ratio, whatever the method.
+    auto at = [&](double u, double& x, double& dx_du, double& conditioning) {
+        Value v;
+        std::size_t hint = 0;
+        const double lr = anchor_log_ratio_ + std::log1p(anchor_sign_ * u);
+        if (!find(lr, v, hint)) return false;
+        x = v.x;
+        dx_du = v.dx_dlog_ratio / (anchor_sign_ + u);
+        conditioning = 4.0 * std::numeric_limits<double>::epsilon() * (1.0 + std::abs(lr)) *
+                       std::abs(v.dx_dlog_ratio);
+        return std::isfinite(x) && std::isfinite(dx_du);
+    };
+    for (std::size_t i = 0; i < bins; ++i) {
+        const std::uint64_t key = ratio_bin_key_min_ + i;
+        const double u0 = std::bit_cast<double>(key << kRatioBinShift);
+        const double u1 = std::bit_cast<double>((key + 1) << kRatioBinShift);
+        const double um = std::bit_cast<double>((key << kRatioBinShift) |
+                                                (std::uint64_t{1} << (kRatioBinShift - 1)));
+        const double du = u1 - u0;
+        double x0 = 0, x1 = 0, xm = 0, s0 = 0, s1 = 0, sm = 0, unused = 0, conditioning = 0;
+        if (!at(u0, x0, s0, unused) || !at(u1, x1, s1, unused) || !at(um, xm, sm, conditioning))
+            continue;
+        const double d0 = s0 * du, d1 = s1 * du;
+        const std::array<double, 5> c{x0, d0, 3.0 * (x1 - x0) - 2.0 * d0 - d1,
+                                      2.0 * (x0 - x1) + d0 + d1, 1.0 / du};
+        const double t = 0.5;
+        const double x = c[0] + t * (c[1] + t * (c[2] + t * c[3]));
+        const double slope = (c[1] + t * (2.0 * c[2] + t * 3.0 * c[3])) * c[4];
+        if (!(x > 0.0) || !(std::abs(x - xm) <= kRatioBinTolerance * xm + conditioning) ||
+            !(std::abs(slope - sm) <= kRatioBinSlopeTolerance * std::abs(sm)))
+            continue;
+        std::copy(c.begin(), c.end(), ratio_bins_.begin() + static_cast<std::ptrdiff_t>(5 * i));
+    }
+}
+
+namespace {
+
+// The loop of find_ratio_bins (find_ratio's bin arithmetic, the bin's position t from the
+// mantissa's low bits as a double in [1, 2) minus 1 — exact, and without a 64-bit integer
+// conversion SSE2 lacks), inlined into a default and an AVX2 build of it.
+[[gnu::always_inline]] inline void ratio_bins_loop(std::size_t n, const double* __restrict ratio,
+                                                   const double* __restrict bins,
+                                                   std::int64_t key_min, std::int64_t count,
+                                                   int shift, double sign, double inv_anchor,
+                                                   double* __restrict x, double* __restrict slope) {
+    const std::uint64_t mantissa = (std::uint64_t{1} << shift) - 1;
+    const std::uint64_t one = std::bit_cast<std::uint64_t>(1.0);
+    const int up = 52 - shift;
+    const std::uint64_t quiet_nan =
+        std::bit_cast<std::uint64_t>(std::numeric_limits<double>::quiet_NaN());
+    for (std::size_t i = 0; i < n; ++i) {
+        const double u = sign * (ratio[i] * inv_anchor - 1.0);
+        const auto bits = std::bit_cast<std::uint64_t>(u);
+        const std::int64_t bin = static_cast<std::int64_t>(bits >> shift) - key_min;
+        const bool inside = static_cast<std::uint64_t>(bin) < static_cast<std::uint64_t>(count);
+        const std::int64_t k = 5 * (bin & -static_cast<std::int64_t>(inside));  // bin 0 outside
+        const double c0 = bins[k], c1 = bins[k + 1], c2 = bins[k + 2], c3 = bins[k + 3];
+        const double t = std::bit_cast<double>(((bits & mantissa) << up) | one) - 1.0;
+        const double value = c0 + t * (c1 + t * (c2 + t * c3));
+        // 1/(bin width) = 2^(shift − 52) / 2^(exponent of u): from the exponent's bits (one
+        // gather fewer than reading the bin's c4, the same power of 2).
+        const double inv_width = std::bit_cast<double>(
+            (std::uint64_t{2046 + 52 - static_cast<std::uint64_t>(shift)} - ((bits >> 52) & 0x7ff))
+            << 52);
+        slope[i] = (c1 + t * (2.0 * c2 + t * 3.0 * c3)) * inv_width * (sign + u);
+        // NaN where the bin is not used: the quiet-NaN bits ORed in (no branch for the
+        // vectoriser).
+        const auto unused = static_cast<std::uint64_t>(!(inside & (c0 > 0.0)));
+        x[i] = std::bit_cast<double>(std::bit_cast<std::uint64_t>(value) |
+                                     ((std::uint64_t{0} - unused) & quiet_nan));
+    }
+}
+
+[[gnu::target("avx2")]] void ratio_bins_avx2(std::size_t n, const double* ratio, const double* bins,
+                                             std::int64_t key_min, std::int64_t count, int shift,
+                                             double sign, double inv_anchor, double* x,
+                                             double* slope) {
+    ratio_bins_loop(n, ratio, bins, key_min, count, shift, sign, inv_anchor, x, slope);
+}
+
+void ratio_bins_default(std::size_t n, const double* ratio, const double* bins,
+                        std::int64_t key_min, std::int64_t count, int shift, double sign,
+                        double inv_anchor, double* x, double* slope) {
+    ratio_bins_loop(n, ratio, bins, key_min, count, shift, sign, inv_anchor, x, slope);
+}
+
+bool has_avx2() {
+    static const bool avx2 = __builtin_cpu_supports("avx2") != 0;
+    return avx2;
+}
+
+}  // namespace
+
+void RatioInverseTable::find_ratio_bins(std::size_t n, const double* ratio, double* x,
+                                        double* dx_dlog_ratio) const {
+    auto* run = has_avx2() ? ratio_bins_avx2 : ratio_bins_default;
+    run(n, ratio, ratio_bins_.data(), static_cast<std::int64_t>(ratio_bin_key_min_),
+        static_cast<std::int64_t>(ratio_bins_.size() / 5), kRatioBinShift, anchor_sign_,
+        inv_anchor_ratio_, x, dx_dlog_ratio);
+}
+
+std::size_t RatioInverseTable::ratio_bins_used() const {
+    std::size_t used = 0;
+    for (std::size_t i = 0; i < ratio_bins_.size(); i += 5) used += ratio_bins_[i] > 0.0 ? 1 : 0;
+    return used;
 }
 
 RatioRange RatioInverseTable::ratio_range() const {
@@ -402,28 +526,39 @@ struct Sums {
     }
 };
 
+// out = (p0 + p1 + p2)·scale (p1, p2 null: p0·scale); whether every value is finite — the sum of
+// finite floats in double is finite, and v − v is +0 for a finite v and NaN otherwise (an
+// integer OR of its bits, so that the compiler vectorises the loop).
+bool scaled_row_is_finite(std::size_t W, const float* __restrict p0, const float* __restrict p1,
+                          const float* __restrict p2, double scale, double* __restrict out) {
+    std::uint64_t not_finite = 0;
+    if (p1 == nullptr) {
+        for (std::size_t x = 0; x < W; ++x) {
+            const double v = static_cast<double>(p0[x]) * scale;
+            out[x] = v;
+            not_finite |= std::bit_cast<std::uint64_t>(v - v);
+        }
+    } else {
+        for (std::size_t x = 0; x < W; ++x) {
+            const double v = (static_cast<double>(p0[x]) + p1[x] + p2[x]) * scale;
+            out[x] = v;
+            not_finite |= std::bit_cast<std::uint64_t>(v - v);
+        }
+    }
+    return not_finite == 0;
+}
+
 // The brightness of one row of a capture: channel average / s_k. A non-finite value in the row
-// (any plane: the sum of finite floats in double is finite) is check_linear_image's
-// InvalidArgument, so every value of the images is checked once, as it is read.
+// (any plane) is check_linear_image's InvalidArgument, so every value of the images is checked
+// once, as it is read.
 void load_row(const MapCapture& c, std::size_t r, std::vector<double>& out) {
     const LinearImage& im = *c.image;
     const double scale = 1.0 / (static_cast<double>(im.channels) * c.exposure_scale);
     const float* p0 = im.plane(0) + r * im.width;
-    double total = 0.0;
-    if (im.channels == 1) {
-        for (std::size_t x = 0; x < im.width; ++x) {
-            out[x] = static_cast<double>(p0[x]) * scale;
-            total += out[x];
-        }
-    } else {
-        const float* p1 = im.plane(1) + r * im.width;
-        const float* p2 = im.plane(2) + r * im.width;
-        for (std::size_t x = 0; x < im.width; ++x) {
-            out[x] = (static_cast<double>(p0[x]) + p1[x] + p2[x]) * scale;
-            total += out[x];
-        }
-    }
-    if (std::isfinite(total)) return;
+    const bool three = im.channels != 1;
+    if (scaled_row_is_finite(im.width, p0, three ? im.plane(1) + r * im.width : nullptr,
+                             three ? im.plane(2) + r * im.width : nullptr, scale, out.data()))
+        return;
     for (std::size_t ch = 0; ch < im.channels; ++ch)
         for (std::size_t x = 0; x < im.width; ++x) {
             const std::size_t k = ch * im.pixel_count() + r * im.width + x;
@@ -443,6 +578,112 @@ struct Counts {
         no_solution_T += c.no_solution_T;
     }
 };
+
+// What decides a pixel's fate before its look-ups.
+enum class PixelState : std::uint8_t { Estimate, Missing, NoSolution };
+
+struct RowCounts {
+    std::size_t valid = 0, missing = 0, no_solution = 0, no_solution_other = 0;
+    ClassSums classes;  // of the primary σ/T
+};
+
+// v, or NaN where the mask is all ones (bit operations: a select without a branch).
+inline double nan_where(double v, std::uint64_t mask) {
+    constexpr auto kNaNBits =
+        std::bit_cast<std::uint64_t>(std::numeric_limits<double>::quiet_NaN());
+    return std::bit_cast<double>((std::bit_cast<std::uint64_t>(v) & ~mask) | (mask & kNaNBits));
+}
+// All ones where `condition`, else 0.
+inline std::uint64_t mask_of(bool condition) {
+    return std::uint64_t{0} - static_cast<std::uint64_t>(condition);
+}
+
+// A row of a flat sample's per-pixel map into its layers, every cell written once: from the
+// pixels' state (as a double, 0 an estimate, PixelState), ratio, var(ln ratio) and both
+// correlations' σ/T and slope d(σ/T)/d ln ratio (σ/T NaN: no solution). sd(σ/T) = |slope| ·
+// sd(ln ratio); the class by the primary correlation's σ/T (`klass`: the class as a double, a
+// row of scratch, narrowed to the class layer after). In 64-bit masks and selects without
+// branches, so that the compiler vectorises the loop.
+[[gnu::always_inline]] inline RowCounts write_flat_row_body(
+    std::size_t n, const double* __restrict ratio, const double* __restrict var,
+    const double* __restrict state, const double* __restrict xg, const double* __restrict sg,
+    const double* __restrict xe, const double* __restrict se, bool gaussian, double slightly,
+    double very, float* __restrict e12, float* __restrict g, float* __restrict gse,
+    float* __restrict e, float* __restrict ese, double* __restrict klass,
+    std::uint8_t* __restrict cls) {
+    const double* __restrict xp = gaussian ? xg : xe;
+    const double* __restrict xo = gaussian ? xe : xg;
+    std::uint64_t valid = 0, missing = 0, no_solution = 0, no_solution_other = 0;
+    std::uint64_t n0 = 0, n1 = 0, n2 = 0;
+    double s0 = 0, s1 = 0, s2 = 0, q0 = 0, q1 = 0, q2 = 0;
+    // (The class sums in lanes: their order of addition is the build's, not the threads'.)
+#pragma omp simd reduction(+ : valid, missing, no_solution, no_solution_other, n0, n1, n2, s0, \
+                               s1, s2, q0, q1, q2)
+    for (std::size_t i = 0; i < n; ++i) {
+        const double st = state[i], p = xp[i], o = xo[i], sd = std::sqrt(var[i]);
+        const std::uint64_t is_missing = mask_of(st == 1.0);
+        const std::uint64_t not_estimate = mask_of(st != 0.0);
+        const std::uint64_t no_g = not_estimate | mask_of(xg[i] != xg[i]);
+        const std::uint64_t no_e = not_estimate | mask_of(xe[i] != xe[i]);
+        const std::uint64_t no_p = not_estimate | mask_of(p != p);
+        const std::uint64_t no_o = not_estimate | mask_of(o != o);
+        e12[i] = static_cast<float>(nan_where(ratio[i], not_estimate));
+        g[i] = static_cast<float>(nan_where(xg[i], no_g));
+        gse[i] = static_cast<float>(nan_where(std::abs(sg[i]) * sd, no_g));
+        e[i] = static_cast<float>(nan_where(xe[i], no_e));
+        ese[i] = static_cast<float>(nan_where(std::abs(se[i]) * sd, no_e));
+        const double c = 1.0 + (p > very ? 1.0 : 0.0) - (p < slightly ? 1.0 : 0.0);
+        klass[i] = std::bit_cast<double>((std::bit_cast<std::uint64_t>(c) & ~no_p) |
+                                         (no_p & std::bit_cast<std::uint64_t>(255.0)));
+        valid += 1 & ~no_p;
+        missing += 1 & is_missing;
+        no_solution += 1 & no_p & ~is_missing;
+        no_solution_other += 1 & no_o & ~is_missing;
+        const std::uint64_t m0 = ~no_p & mask_of(p < slightly), m2 = ~no_p & mask_of(p > very);
+        const std::uint64_t m1 = ~no_p & ~m0 & ~m2;
+        // The layer's value (a float), as row_class_sums reads it.
+        const auto bits = std::bit_cast<std::uint64_t>(static_cast<double>(static_cast<float>(p)));
+        const double v0 = std::bit_cast<double>(bits & m0), v1 = std::bit_cast<double>(bits & m1),
+                     v2 = std::bit_cast<double>(bits & m2);
+        n0 += 1 & m0;
+        n1 += 1 & m1;
+        n2 += 1 & m2;
+        s0 += v0;
+        s1 += v1;
+        s2 += v2;
+        q0 += v0 * v0;
+        q1 += v1 * v1;
+        q2 += v2 * v2;
+    }
+    for (std::size_t i = 0; i < n; ++i) cls[i] = static_cast<std::uint8_t>(klass[i]);
+    RowCounts counts{valid, missing, no_solution, no_solution_other, {}};
+    counts.classes[0] = {n0, s0, q0};
+    counts.classes[1] = {n1, s1, q1};
+    counts.classes[2] = {n2, s2, q2};
+    return counts;
+}
+
+// write_flat_row_body built for AVX2 and for the baseline (SSE2, where its 64-bit masks do not
+// vectorise), the processor's pick at run time: the same arithmetic (ISO C++ does not contract
+// into FMA), so the same layers either way.
+[[gnu::target("avx2")]] RowCounts write_flat_row_avx2(
+    std::size_t n, const double* ratio, const double* var, const double* state, const double* xg,
+    const double* sg, const double* xe, const double* se, bool gaussian, double slightly,
+    double very, float* e12, float* g, float* gse, float* e, float* ese, double* klass,
+    std::uint8_t* cls) {
+    return write_flat_row_body(n, ratio, var, state, xg, sg, xe, se, gaussian, slightly, very, e12,
+                               g, gse, e, ese, klass, cls);
+}
+RowCounts write_flat_row(std::size_t n, const double* ratio, const double* var, const double* state,
+                         const double* xg, const double* sg, const double* xe, const double* se,
+                         bool gaussian, double slightly, double very, float* e12, float* g,
+                         float* gse, float* e, float* ese, double* klass, std::uint8_t* cls) {
+    if (has_avx2())
+        return write_flat_row_avx2(n, ratio, var, state, xg, sg, xe, se, gaussian, slightly, very,
+                                   e12, g, gse, e, ese, klass, cls);
+    return write_flat_row_body(n, ratio, var, state, xg, sg, xe, se, gaussian, slightly, very, e12,
+                               g, gse, e, ese, klass, cls);
+}
 
 // Evaluates cells into the layers of the map (one copy per thread: its own hints and counts).
 class Evaluator {
@@ -490,15 +731,13 @@ class Evaluator {
         }
     }
 
-    // A flat sample's pixel (the layers' cells already NaN / no class): the two tables at
-    // ln(E1/E2), the error through their slopes.
-    void evaluate_flat(std::size_t index, double ratio, double var_log_ratio) {
-        const double lr = std::log(ratio);
-        const double sd_lr = std::sqrt(var_log_ratio);
+    // A flat sample's pixel (the layers' cells already NaN / no class): the two tables at the
+    // ratio E1/E2, the error through their slopes.
+    void evaluate_flat(std::size_t index, double ratio, double sd_lr) {
         map_.E1_over_E2[index] = static_cast<float>(ratio);
         RatioInverseTable::Value vg, ve;
-        const bool g = table_g_.find(lr, vg, hint_g_);
-        const bool e = table_e_.find(lr, ve, hint_e_);
+        const bool g = table_g_.find_ratio(ratio, vg, hint_g_);
+        const bool e = table_e_.find_ratio(ratio, ve, hint_e_);
         if (g) {
             map_.sigma_over_T_gaussian[index] = static_cast<float>(vg.x);
             map_.sigma_over_T_gaussian_stderr[index] =
@@ -516,7 +755,7 @@ class Evaluator {
             const RatioInverseTable::Value& vp = gaussian ? vg : ve;
             std::optional<Estimate> primary;
             if (has_primary) primary = Estimate{vp.x, std::abs(vp.dx_dlog_ratio) * sd_lr};
-            estimate_T(index, lr, sd_lr, primary, std::nullopt, std::nullopt);
+            estimate_T(index, std::log(ratio), sd_lr, primary, std::nullopt, std::nullopt);
         }
         if (!has_primary) {
             ++counts_.no_solution;
@@ -526,6 +765,45 @@ class Evaluator {
         const double x = gaussian ? vg.x : ve.x;
         map_.roughness_class[index] = class_code(roughness_class_of_sigma_over_T(
             x, o_.slightly_rough_max_sigma_over_T, o_.very_rough_min_sigma_over_T));
+    }
+
+    // A flat sample without σ (the layers E1/E2, σ/T and its error of both correlations, the
+    // class): a row of pixels from `begin`, every cell written once (no fill first).
+    bool fast_flat() const { return flat_ && !o_.sigma_um; }
+    // Returns the row's class sums.
+    ClassSums evaluate_flat_row(std::size_t begin, std::size_t count, const double* ratio,
+                                const double* var_log_ratio, const double* state) {
+        for (auto* v : {&xg_, &sg_, &xe_, &se_, &klass_}) v->resize(count);
+        table_g_.find_ratio_bins(count, ratio, xg_.data(), sg_.data());
+        table_e_.find_ratio_bins(count, ratio, xe_.data(), se_.data());
+        // The ratios outside the bins (few, or none): find at ln ratio (NaN stays where the
+        // table has no solution).
+        const auto rest = [&](const RatioInverseTable& table, std::vector<double>& x,
+                              std::vector<double>& slope, std::size_t& hint) {
+            for (std::size_t i = 0; i < count; ++i) {
+                if (state[i] != 0.0 || !std::isnan(x[i])) continue;
+                RatioInverseTable::Value v;
+                if (!table.find(std::log(ratio[i]), v, hint)) continue;
+                x[i] = v.x;
+                slope[i] = v.dx_dlog_ratio;
+            }
+        };
+        rest(table_g_, xg_, sg_, hint_g_);
+        rest(table_e_, xe_, se_, hint_e_);
+        const bool gaussian = o_.correlation == Correlation::Gaussian;
+        const RowCounts c = write_flat_row(
+            count, ratio, var_log_ratio, state, xg_.data(), sg_.data(), xe_.data(), se_.data(),
+            gaussian, o_.slightly_rough_max_sigma_over_T, o_.very_rough_min_sigma_over_T,
+            map_.E1_over_E2.data() + begin, map_.sigma_over_T_gaussian.data() + begin,
+            map_.sigma_over_T_gaussian_stderr.data() + begin,
+            map_.sigma_over_T_exponential.data() + begin,
+            map_.sigma_over_T_exponential_stderr.data() + begin, klass_.data(),
+            map_.roughness_class.data() + begin);
+        counts_.valid += c.valid;
+        counts_.missing += c.missing;
+        counts_.no_solution += c.no_solution;
+        counts_.no_solution_exponential += c.no_solution_other;
+        return c.classes;
     }
 
     bool flat() const { return flat_; }
@@ -668,6 +946,8 @@ class Evaluator {
     std::optional<RoughnessClass> flat_g_class_;
     std::size_t hint_g_ = 0, hint_e_ = 0, hint_t_ = 0, hint_t2_ = 0;
     Counts counts_;
+    // A row's σ/T and slopes, and its class as a double (evaluate_flat_row).
+    std::vector<double> xg_, sg_, xe_, se_, klass_;
 };
 
 // A cell without an estimate has no class (its float layers stay NaN).
@@ -692,10 +972,24 @@ bool pixel_used(const MapCapture& c1, const MapCapture& c2, const MapOptions& o,
     return true;
 }
 
+// The class statistics of a finished row of cells (the per-class mean of the summary: the rows'
+// sums are added in row order afterwards, so the means do not depend on the bands).
+ClassSums row_class_sums(const RoughnessMap& map, const MapOptions& o, std::size_t row) {
+    const MapLayerValues& primary = o.correlation == Correlation::Gaussian
+                                        ? map.sigma_over_T_gaussian
+                                        : map.sigma_over_T_exponential;
+    ClassSums sums;
+    for (std::size_t i = row * map.width; i < (row + 1) * map.width; ++i) {
+        const std::uint8_t c = map.roughness_class[i];
+        if (c != kClassNone) sums[c].add(primary[i]);
+    }
+    return sums;
+}
+
 // Tiles: one pass over the rows, the sums of each tile of a row of tiles.
 void tile_map(const std::vector<MapCapture>& captures, const MapOptions& o, Evaluator& ev,
-              RoughnessMap& map, std::vector<std::int32_t>& cell_region, std::size_t ty_begin,
-              std::size_t ty_end) {
+              RoughnessMap& map, std::vector<std::int32_t>& cell_region,
+              std::vector<ClassSums>& row_classes, std::size_t ty_begin, std::size_t ty_end) {
     const MapCapture& c1 = captures[0];
     const MapCapture& c2 = captures[1];
     const std::size_t W = c1.image->width, H = c1.image->height, w = o.window_px;
@@ -754,6 +1048,7 @@ void tile_map(const std::vector<MapCapture>& captures, const MapOptions& o, Eval
             cell.normal = normals[tx];
             ev.evaluate(index, cell);
         }
+        row_classes[ty] = row_class_sums(map, o, ty);
     }
 }
 
@@ -769,128 +1064,185 @@ void clear_rows(RoughnessMap& map, std::size_t r_begin, std::size_t r_end) {
         if (!layer->empty()) std::fill_n(layer->data() + begin, count, kClassNone);
 }
 
-// What decides a pixel's fate before its look-ups.
-enum class PixelState : std::uint8_t { Estimate, Missing, NoSolution };
+// The per-pixel map's running column sums restart from zero every kSumRestartRows rows, and its
+// bands of rows start on such a row: a pixel's sums do not depend on where its band began (the
+// map is the same on any number of threads, bit for bit) and the running sums' rounding never
+// builds up over more than kSumRestartRows rows.
+constexpr std::size_t kSumRestartRows = 64;
+
+// The per-pixel map's column sums (n, Σx1, Σx2, Σx1², Σx2², Σx1x2 over rows [r − R, r + R]) +=
+// row (a, b, weights u) · add_weight − row (ra, rb, ru) · remove_weight, in one pass. (Free
+// functions with restrict parameters, so that the compiler vectorises them.)
+void update_column_sums(std::size_t W, const double* __restrict a, const double* __restrict b,
+                        const double* __restrict u, double add_weight, const double* __restrict ra,
+                        const double* __restrict rb, const double* __restrict ru,
+                        double remove_weight, double* __restrict n, double* __restrict s1,
+                        double* __restrict s2, double* __restrict s11, double* __restrict s22,
+                        double* __restrict s12) {
+    for (std::size_t x = 0; x < W; ++x) {
+        const double w = add_weight * u[x], wa = w * a[x], wb = w * b[x];
+        const double v = remove_weight * ru[x], va = v * ra[x], vb = v * rb[x];
+        n[x] += w - v;
+        s1[x] += wa - va;
+        s2[x] += wb - vb;
+        s11[x] += wa * a[x] - va * ra[x];
+        s22[x] += wb * b[x] - vb * rb[x];
+        s12[x] += wa * b[x] - va * rb[x];
+    }
+}
+
+// The window's sums at each pixel of a row (2R + 1 column sums from c*[x], padded), then the
+// pixel's ratio x1/x2, var(ln x1/x2) of one pixel (the delta method on the window's means,
+// variances and covariance, docs/maps.md, in the form n²/(n − 1) · [Σx1²/(Σx1)² + Σx2²/(Σx2)²
+// − 2 Σx1x2/(Σx1 Σx2)], one division for it and the ratio) and its state (PixelState).
+[[gnu::always_inline]] inline void pixel_statistics_body(
+    std::size_t W, const double* __restrict a, const double* __restrict b,
+    const double* __restrict u, const double* __restrict cn, const double* __restrict cs1,
+    const double* __restrict cs2, const double* __restrict cs11, const double* __restrict cs22,
+    const double* __restrict cs12, double* __restrict ratio, double* __restrict var,
+    double* __restrict state) {
+    constexpr std::size_t kTaps = 2 * kPixelNoiseRadius + 1;
+    for (std::size_t x = 0; x < W; ++x) {
+        double n = 0, s1 = 0, s2 = 0, s11 = 0, s22 = 0, s12 = 0;
+        for (std::size_t d = 0; d < kTaps; ++d) {
+            n += cn[x + d];
+            s1 += cs1[x + d];
+            s2 += cs2[x + d];
+            s11 += cs11[x + d];
+            s22 += cs22[x + d];
+            s12 += cs12[x + d];
+        }
+        const double s1s2 = s1 * s2;
+        const double p = s1s2 * s1s2 * (n - 1.0);
+        const double inv = 1.0 / (p * b[x]);
+        const double bracket = s11 * s2 * s2 + s22 * s1 * s1 - 2.0 * s12 * s1s2;
+        var[x] = std::max(0.0, n * n * bracket * b[x] * inv);
+        ratio[x] = a[x] * p * inv;
+        // Running sums of ±1 stay exact integers in n. Without branches (and in doubles, for
+        // the vectoriser): 1 missing, 2 no solution, 0 an estimate.
+        const double missing = !(u[x] > 0.0) || n < 3.0 ? 1.0 : 0.0;
+        const double no_solution =
+            !(a[x] > 0.0) || !(b[x] > 0.0) || !(s1 > 0.0) || !(s2 > 0.0) ? 1.0 : 0.0;
+        state[x] = missing + 2.0 * (1.0 - missing) * no_solution;
+    }
+}
+// pixel_statistics_body for AVX2 (four lanes) and for the baseline (two), as write_flat_row.
+[[gnu::target("avx2")]] void pixel_statistics_avx2(std::size_t W, const double* a, const double* b,
+                                                   const double* u, const double* cn,
+                                                   const double* cs1, const double* cs2,
+                                                   const double* cs11, const double* cs22,
+                                                   const double* cs12, double* ratio, double* var,
+                                                   double* state) {
+    pixel_statistics_body(W, a, b, u, cn, cs1, cs2, cs11, cs22, cs12, ratio, var, state);
+}
+void pixel_statistics(std::size_t W, const double* a, const double* b, const double* u,
+                      const double* cn, const double* cs1, const double* cs2, const double* cs11,
+                      const double* cs22, const double* cs12, double* ratio, double* var,
+                      double* state) {
+    if (has_avx2())
+        pixel_statistics_avx2(W, a, b, u, cn, cs1, cs2, cs11, cs22, cs12, ratio, var, state);
+    else
+        pixel_statistics_body(W, a, b, u, cn, cs1, cs2, cs11, cs22, cs12, ratio, var, state);
+}
+static_assert(static_cast<int>(PixelState::Estimate) == 0 &&
+              static_cast<int>(PixelState::Missing) == 1 &&
+              static_cast<int>(PixelState::NoSolution) == 2);
 
 // Per pixel: the pixel's ratio, the noise from the (2R + 1)² neighbourhood. Row by row, each
 // step a loop over plain arrays of the row: the column sums over rows [r − R, r + R] (running:
-// the new row added, the old one removed), the window's sums over 2R + 1 columns and the
-// pixel's ln-ratio variance, then the look-ups per pixel.
+// the new row added and the old one removed in one pass), the window's sums over 2R + 1 columns
+// and the pixel's ln-ratio variance, then the look-ups per pixel.
 void pixel_map(const std::vector<MapCapture>& captures, const MapOptions& o, Evaluator& ev,
-               RoughnessMap& map, std::vector<std::int32_t>& cell_region, std::size_t r_begin,
-               std::size_t r_end) {
+               RoughnessMap& map, std::vector<std::int32_t>& cell_region,
+               std::vector<ClassSums>& row_classes, std::size_t r_begin, std::size_t r_end) {
     const MapCapture& c1 = captures[0];
     const MapCapture& c2 = captures[1];
     const std::size_t W = c1.image->width, H = c1.image->height, R = kPixelNoiseRadius;
     const std::size_t ring = 2 * R + 2;
-    // The ring of rows: the two brightnesses and the pixel's weight (1 used, 0 not).
+    // The ring of rows: the two brightnesses and the pixel's weight (1 used, 0 not); the row each
+    // slot holds.
     std::vector<std::vector<double>> x1(ring, std::vector<double>(W)),
         x2(ring, std::vector<double>(W)), used(ring, std::vector<double>(W));
+    std::vector<std::size_t> slot_row(ring, H);
     // The column sums n, Σx1, Σx2, Σx1², Σx2², Σx1x2, each padded by R zeros either side.
     const std::size_t padded = W + 2 * R;
     std::array<std::vector<double>, 6> col;
     for (auto& c : col) c.assign(padded, 0.0);
-    std::vector<double> ratio(W), var(W);
-    std::vector<PixelState> state(W);
+    std::vector<double> ratio(W), var(W), state(W);
     auto load = [&](std::size_t r) {
         const std::size_t k = r % ring;
+        if (slot_row[k] == r) return;
         load_row(c1, r, x1[k]);
         load_row(c2, r, x2[k]);
-        for (std::size_t x = 0; x < W; ++x) used[k][x] = pixel_used(c1, c2, o, r * W + x) ? 1 : 0;
+        const std::uint8_t* __restrict f1 = c1.image->flags.data() + r * W;
+        const std::uint8_t* __restrict f2 = c2.image->flags.data() + r * W;
+        double* __restrict u = used[k].data();
+        for (std::size_t x = 0; x < W; ++x) u[x] = (f1[x] | f2[x]) == 0 ? 1.0 : 0.0;
+        if (!o.normal_map.empty())
+            for (std::size_t x = 0; x < W; ++x)
+                if (!pixel_used(c1, c2, o, r * W + x)) u[x] = 0.0;
+        slot_row[k] = r;
     };
-    auto add_row = [&](std::size_t r, double sign) {
-        const std::size_t k = r % ring;
-        const double* __restrict a = x1[k].data();
-        const double* __restrict b = x2[k].data();
-        const double* __restrict u = used[k].data();
-        double* __restrict n = col[0].data() + R;
-        double* __restrict s1 = col[1].data() + R;
-        double* __restrict s2 = col[2].data() + R;
-        double* __restrict s11 = col[3].data() + R;
-        double* __restrict s22 = col[4].data() + R;
-        double* __restrict s12 = col[5].data() + R;
-        for (std::size_t x = 0; x < W; ++x) {
-            const double w = sign * u[x], wa = w * a[x], wb = w * b[x];
-            n[x] += w;
-            s1[x] += wa;
-            s2[x] += wb;
-            s11[x] += wa * a[x];
-            s22[x] += wb * b[x];
-            s12[x] += wa * b[x];
+    // Row `add` into the column sums and row `remove` out of them (either H: none).
+    auto update = [&](std::size_t add, std::size_t remove) {
+        const std::size_t k = add < H ? add % ring : remove % ring;
+        const std::size_t q = remove < H ? remove % ring : k;
+        update_column_sums(W, x1[k].data(), x2[k].data(), used[k].data(), add < H ? 1.0 : 0.0,
+                           x1[q].data(), x2[q].data(), used[q].data(), remove < H ? 1.0 : 0.0,
+                           col[0].data() + R, col[1].data() + R, col[2].data() + R,
+                           col[3].data() + R, col[4].data() + R, col[5].data() + R);
+    };
+    // The column sums of rows [r − R, r + R] ∩ [0, H), from zero.
+    auto restart = [&](std::size_t r) {
+        for (auto& c : col) std::fill(c.begin(), c.end(), 0.0);
+        for (std::size_t q = r >= R ? r - R : 0; q < std::min(H, r + R + 1); ++q) {
+            load(q);
+            update(q, H);
         }
     };
-    // The window's sums at each pixel of row k, then var(ln x1/x2) of one pixel (the delta
-    // method on the window's means, variances and covariance) and the pixel's state.
-    auto row_statistics = [&](std::size_t k) {
-        const double* __restrict a = x1[k].data();
-        const double* __restrict b = x2[k].data();
-        const double* __restrict u = used[k].data();
-        const double* __restrict cn = col[0].data();
-        const double* __restrict cs1 = col[1].data();
-        const double* __restrict cs2 = col[2].data();
-        const double* __restrict cs11 = col[3].data();
-        const double* __restrict cs22 = col[4].data();
-        const double* __restrict cs12 = col[5].data();
-        double* __restrict out_ratio = ratio.data();
-        double* __restrict out_var = var.data();
-        PixelState* __restrict out_state = state.data();
-        for (std::size_t x = 0; x < W; ++x) {
-            double n = 0, s1 = 0, s2 = 0, s11 = 0, s22 = 0, s12 = 0;
-            for (std::size_t d = 0; d <= 2 * R; ++d) {
-                n += cn[x + d];
-                s1 += cs1[x + d];
-                s2 += cs2[x + d];
-                s11 += cs11[x + d];
-                s22 += cs22[x + d];
-                s12 += cs12[x + d];
-            }
-            const double m1 = s1 / n, m2 = s2 / n;
-            const double v1 = std::max(0.0, (s11 - n * m1 * m1) / (n - 1.0));
-            const double v2 = std::max(0.0, (s22 - n * m2 * m2) / (n - 1.0));
-            const double c12 = (s12 - n * m1 * m2) / (n - 1.0);
-            out_var[x] = std::max(0.0, v1 / (m1 * m1) + v2 / (m2 * m2) - 2.0 * c12 / (m1 * m2));
-            out_ratio[x] = a[x] / b[x];
-            // Running sums of ±1 stay exact integers in n.
-            const bool missing = !(u[x] > 0.0) || n < 3.0;
-            const bool no_solution = !(a[x] > 0.0) || !(b[x] > 0.0) || !(m1 > 0.0) || !(m2 > 0.0);
-            out_state[x] = missing ? PixelState::Missing
-                                   : (no_solution ? PixelState::NoSolution : PixelState::Estimate);
-        }
-    };
-    // The column sums hold rows [removed, added) = [r − R, r + R] ∩ [0, H) at row r.
-    std::size_t added = r_begin >= R ? r_begin - R : 0, removed = added;
     const bool labels = !o.region_labels.empty();
     for (std::size_t r = r_begin; r < r_end; ++r) {
-        for (; added < std::min(H, r + R + 1); ++added) {
-            load(added);
-            add_row(added, 1.0);
+        if (r == r_begin || r % kSumRestartRows == 0) {
+            restart(r);
+        } else {
+            // Row r + R comes in (if any), row r − R − 1 leaves (if any).
+            const std::size_t add = r + R < H ? r + R : H, remove = r >= R + 1 ? r - R - 1 : H;
+            if (add < H) load(add);
+            if (add < H || remove < H) update(add, remove);
         }
-        for (; removed + R < r; ++removed) add_row(removed, -1.0);
         const std::size_t k = r % ring;
-        row_statistics(k);
-        clear_rows(map, r, r + 1);
+        pixel_statistics(W, x1[k].data(), x2[k].data(), used[k].data(), col[0].data(),
+                         col[1].data(), col[2].data(), col[3].data(), col[4].data(), col[5].data(),
+                         ratio.data(), var.data(), state.data());
         const std::size_t row = r * W;
         if (labels)
             std::copy_n(o.region_labels.begin() + static_cast<std::ptrdiff_t>(row), W,
                         cell_region.begin() + static_cast<std::ptrdiff_t>(row));
-        for (std::size_t x = 0; x < W; ++x) {
-            const std::size_t index = row + x;
-            if (state[x] == PixelState::Missing) {
-                ++ev.counts().missing;
-            } else if (state[x] == PixelState::NoSolution) {
-                ++ev.counts().no_solution;
-                ++ev.counts().no_solution_exponential;
-            } else if (ev.flat()) {
-                ev.evaluate_flat(index, ratio[x], var[x]);
-            } else {
-                Cell cell;
-                cell.ratio = ratio[x];
-                cell.log_ratio = std::log(ratio[x]);
-                cell.var_log_ratio = var[x];
-                const float* nm = o.normal_map.data() + 3 * index;
-                cell.normal = Eigen::Vector3d(nm[0], nm[1], nm[2]);
-                ev.evaluate(index, cell);
+        if (ev.fast_flat()) {
+            row_classes[r] = ev.evaluate_flat_row(row, W, ratio.data(), var.data(), state.data());
+        } else {
+            clear_rows(map, r, r + 1);
+            for (std::size_t x = 0; x < W; ++x) {
+                const std::size_t index = row + x;
+                const auto st = static_cast<PixelState>(static_cast<int>(state[x]));
+                if (st == PixelState::Missing) {
+                    ++ev.counts().missing;
+                } else if (st == PixelState::NoSolution) {
+                    ++ev.counts().no_solution;
+                    ++ev.counts().no_solution_exponential;
+                } else if (ev.flat()) {
+                    ev.evaluate_flat(index, ratio[x], std::sqrt(var[x]));
+                } else {
+                    Cell cell;
+                    cell.ratio = ratio[x];
+                    cell.log_ratio = std::log(ratio[x]);
+                    cell.var_log_ratio = var[x];
+                    const float* nm = o.normal_map.data() + 3 * index;
+                    cell.normal = Eigen::Vector3d(nm[0], nm[1], nm[2]);
+                    ev.evaluate(index, cell);
+                }
             }
+            row_classes[r] = row_class_sums(map, o, r);
         }
     }
 }
@@ -909,28 +1261,29 @@ std::optional<Estimate> pooled_sigma_over_T(const RatioInverseTable& table,
 }
 
 void summarise(const std::vector<MapCapture>& captures, const MapOptions& o, RoughnessMap& map,
-               const std::vector<std::int32_t>& cell_region) {
-    std::array<Accumulator, 3> classes;
-    std::vector<RegionAccumulator> regions(o.region_names.size());
-    const MapLayerValues& primary = o.correlation == Correlation::Gaussian
-                                        ? map.sigma_over_T_gaussian
-                                        : map.sigma_over_T_exponential;
-    const std::size_t cells = map.width * map.height;
-    for (std::size_t i = 0; i < cells; ++i) {
-        const std::uint8_t c = map.roughness_class[i];
-        const std::int32_t region = cell_region.empty() ? -1 : cell_region[i];
-        if (region >= 0 && !map.T_um.empty() && std::isfinite(map.T_um[i]))
-            regions[static_cast<std::size_t>(region)].T.add(map.T_um[i]);
-        if (region >= 0 && std::isfinite(map.E1_over_E2[i]) && map.E1_over_E2[i] > 0.0f)
-            regions[static_cast<std::size_t>(region)].log_ratio.add(
-                std::log(static_cast<double>(map.E1_over_E2[i])));
-        if (c == kClassNone) {
-            if (region >= 0) ++regions[static_cast<std::size_t>(region)].missing;
-            continue;
+               const std::vector<std::int32_t>& cell_region,
+               const std::vector<ClassSums>& row_classes) {
+    ClassSums classes;
+    for (const ClassSums& row : row_classes)
+        for (std::size_t c = 0; c < 3; ++c) {
+            classes[c].n += row[c].n;
+            classes[c].sum += row[c].sum;
+            classes[c].sum2 += row[c].sum2;
         }
-        classes[c].add(primary[i]);
+    std::vector<RegionAccumulator> regions(o.region_names.size());
+    const std::size_t cells = map.width * map.height;
+    for (std::size_t i = 0; i < cells && !cell_region.empty(); ++i) {
+        const std::uint8_t c = map.roughness_class[i];
+        const std::int32_t region = cell_region[i];
         if (region < 0) continue;
         RegionAccumulator& ra = regions[static_cast<std::size_t>(region)];
+        if (!map.T_um.empty() && std::isfinite(map.T_um[i])) ra.T.add(map.T_um[i]);
+        if (std::isfinite(map.E1_over_E2[i]) && map.E1_over_E2[i] > 0.0f)
+            ra.log_ratio.add(std::log(static_cast<double>(map.E1_over_E2[i])));
+        if (c == kClassNone) {
+            ++ra.missing;
+            continue;
+        }
         ++ra.classes[c];
         if (std::isfinite(map.sigma_over_T_gaussian[i]))
             ra.gaussian.add(map.sigma_over_T_gaussian[i]);
@@ -1030,14 +1383,20 @@ RoughnessMap roughness_map(const std::vector<MapCapture>& captures, const MapOpt
     if (!o.normal_map.empty() || cells < 65536) threads = std::min<std::size_t>(threads, 1);
     std::vector<Evaluator> evaluators(threads, prototype);
     std::vector<std::exception_ptr> errors(threads);
+    std::vector<ClassSums> row_classes(rows);
+    // A band's first row (a pixel map's bands start where its column sums restart).
+    auto band_start = [&](std::size_t t) {
+        const std::size_t r = rows * t / threads;
+        return o.window_px == 1 && t < threads ? r / kSumRestartRows * kSumRestartRows : r;
+    };
     auto run = [&](std::size_t t) {
         try {
-            const std::size_t begin = rows * t / threads, end = rows * (t + 1) / threads;
+            const std::size_t begin = band_start(t), end = band_start(t + 1);
             if (o.window_px == 1) {
-                pixel_map(captures, o, evaluators[t], map, cell_region, begin, end);
+                pixel_map(captures, o, evaluators[t], map, cell_region, row_classes, begin, end);
             } else {
                 clear_rows(map, begin, end);
-                tile_map(captures, o, evaluators[t], map, cell_region, begin, end);
+                tile_map(captures, o, evaluators[t], map, cell_region, row_classes, begin, end);
             }
         } catch (...) {
             errors[t] = std::current_exception();
@@ -1086,7 +1445,7 @@ RoughnessMap roughness_map(const std::vector<MapCapture>& captures, const MapOpt
     map.missing = counts.missing;
     map.no_solution = counts.no_solution;
     map.no_solution_exponential = counts.no_solution_exponential;
-    summarise(captures, o, map, cell_region);
+    summarise(captures, o, map, cell_region, row_classes);
     if (map.no_solution > 0)
         map.warnings.push_back(concat("roughness map: ", std::to_string(map.no_solution), " of ",
                                       std::to_string(cells),

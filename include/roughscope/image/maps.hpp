@@ -130,12 +130,50 @@ class RatioInverseTable {
         v.dx_dlog_ratio = (c[1] + t * (2.0 * c[2] + t * 3.0 * c[3])) * c[4];
         return true;
     }
+    // find(ln ratio, …) without the logarithm where it can (the per-pixel map). Near the table's
+    // anchor — its end of larger x, where σ/T → ∞ at the model ratio's finite bound — x is a
+    // smooth function of u = s·(ratio·e^(−y_a) − 1) (y_a the anchor's ln ratio; s = +1 when it
+    // is y_0, −1 when it is y_last), and the bits of u as a double select a bin: 64 per octave of
+    // u over [2^−48, 2^80) (the exponent and the top 6 bits of the mantissa). In a bin x is the
+    // cubic Hermite interpolant, in the bin's position t (the mantissa's other bits), of find's x
+    // and slope at the bin's two ends. A bin is used only when both ends lie inside the table and
+    // its middle agrees with find (kRatioBinTolerance); every other ratio (outside the bins,
+    // ≤ 0, NaN) goes through find(std::log(ratio), …). `interval` is written by that path only.
+    bool find_ratio(double ratio, Value& v, std::size_t& interval) const {
+        const double u = anchor_sign_ * (ratio * inv_anchor_ratio_ - 1.0);
+        const auto bits = std::bit_cast<std::uint64_t>(u);
+        const std::uint64_t bin = (bits >> kRatioBinShift) - ratio_bin_key_min_;
+        if (bin < ratio_bins_.size() / 5) {
+            const double* c = ratio_bins_.data() + 5 * bin;
+            if (c[0] > 0.0) {
+                const double t = static_cast<double>(bits & kRatioBinMantissa) * kRatioBinT;
+                v.x = c[0] + t * (c[1] + t * (c[2] + t * c[3]));
+                v.dx_dlog_ratio =
+                    (c[1] + t * (2.0 * c[2] + t * 3.0 * c[3])) * c[4] * (anchor_sign_ + u);
+                return true;
+            }
+        }
+        return find(std::log(ratio), v, interval);
+    }
+    // find_ratio over arrays, its bins only (a loop without branches, vectorised; AVX2 where the
+    // processor has it, the same arithmetic): x[i] and dx_dlog_ratio[i] at ratio[i] where its
+    // bin is used, x[i] = NaN where find_ratio would go to find (the caller does that).
+    void find_ratio_bins(std::size_t n, const double* ratio, double* x,
+                         double* dx_dlog_ratio) const;
+    // The largest relative difference between a ratio bin's cubic and find at the bin's middle
+    // for the bin to be used: x (beyond what the rounding of ln ratio alone moves find's x by)
+    // and the slope (find's own slope is a cubic's derivative, good to ~1e-7).
+    static constexpr double kRatioBinTolerance = 4e-9;
+    static constexpr double kRatioBinSlopeTolerance = 1e-5;
+    // How many of the ratio bins are used (the rest go through find(ln ratio)).
+    std::size_t ratio_bins_used() const;
     // The ratios E1/E2 the table inverts (open interval).
     RatioRange ratio_range() const;
     std::size_t size() const { return y_.size(); }
 
   private:
     void build_coefficients();
+    void build_ratio_bins();
     std::vector<double> y_, x_, dxdy_;  // y increasing
     // Per interval j: x = c0 + c1 t + c2 t² + c3 t³, t = (y − y_j)·c4 (the Hermite cubic).
     std::vector<std::array<double, 5>> coefficients_;
@@ -157,6 +195,15 @@ class RatioInverseTable {
     double key_floor_front_ = 0.0, key_floor_back_ = 0.0;
     std::int64_t key_min_ = 0;
     double bucket_scale_ = 0.0;
+    // The ratio bins of find_ratio, five numbers each: x = c0 + t (c1 + t (c2 + t c3)),
+    // c4 = 1/(bin width in u); c0 = 0 where the bin is not used.
+    static constexpr int kRatioBinShift = 52 - 6;
+    static constexpr std::uint64_t kRatioBinMantissa = (std::uint64_t{1} << kRatioBinShift) - 1;
+    static constexpr double kRatioBinT =
+        1.0 / static_cast<double>(std::uint64_t{1} << kRatioBinShift);
+    std::vector<double> ratio_bins_;
+    std::uint64_t ratio_bin_key_min_ = 0;
+    double anchor_sign_ = 1.0, inv_anchor_ratio_ = 1.0, anchor_log_ratio_ = 0.0;
 };
 
 // ---------------------------------------------------------------------------------------------

@@ -245,6 +245,89 @@ TEST(RatioInverseTable, LookUpsInAnyOrderFindTheirInterval) {
     }
 }
 
+// find_ratio (the ratio's bits select a bin, no logarithm) against find at ln(ratio), over ratios
+// spread log-uniformly in the distance to the table's anchor — the bins, the ends of the table
+// and beyond it (the fallback) — for tables of Eq. 16/18 (both orders of the angles), of the
+// two-geometry model and of T given σ.
+TEST(RatioInverseTable, RatioBinsEqualTheLookUpAtTheLogRatio) {
+    const Geometry g1 = normal_view_geometry(kTheta1), g2 = normal_view_geometry(kTheta2);
+    const Geometry o1 = make_geometry(kTheta1, deg_to_rad(20.0), 0.3);
+    const Geometry o2 = make_geometry(kTheta2, deg_to_rad(20.0), 0.3);
+    struct Case {
+        std::string name;
+        RatioInverseTable table;
+    };
+    std::vector<Case> cases;
+    for (const Correlation c : {Correlation::Gaussian, Correlation::Exponential}) {
+        const std::string n(to_string(c));
+        cases.push_back({n + " 30/45", RatioInverseTable::sigma_over_T(g1, g2, c)});
+        cases.push_back({n + " 45/30", RatioInverseTable::sigma_over_T(g2, g1, c)});
+        cases.push_back({n + " oblique", RatioInverseTable::sigma_over_T(o1, o2, c)});
+        cases.push_back({n + " T given σ", RatioInverseTable::correlation_length(g1, g2, 0.05, c)});
+    }
+    std::mt19937_64 rng(11);
+    std::uniform_real_distribution<double> log2_distance(-60.0, 90.0);
+    for (const Case& k : cases) {
+        const RatioRange range = k.table.ratio_range();
+        std::size_t hint = 0, both = 0, neither = 0;
+        double worst = 0.0, worst_slope = 0.0;
+        for (int i = 0; i < 40000; ++i) {
+            // A ratio at 2^d from either end of the table, inside or outside it.
+            const double d = std::exp2(log2_distance(rng));
+            const double end = i % 2 == 0 ? range.lower : range.upper;
+            const double ratio = i % 4 < 2 ? end * (1.0 + d) : end * (1.0 - std::min(d, 0.999));
+            RatioInverseTable::Value a, b;
+            const bool fa = k.table.find_ratio(ratio, a, hint);
+            const bool fb = k.table.find(std::log(ratio), b, hint);
+            ASSERT_EQ(fa, fb) << k.name << " ratio " << ratio;
+            if (!fa) {
+                ++neither;
+                continue;
+            }
+            ++both;
+            // Beyond what the rounding of the ratio alone moves x by (ill-conditioned near the
+            // anchor, whatever the method).
+            const double rounding = 8.0 * std::numeric_limits<double>::epsilon() *
+                                    (1.0 + std::abs(std::log(ratio))) * std::abs(b.dx_dlog_ratio);
+            worst = std::max(worst, std::max(0.0, std::abs(a.x - b.x) - rounding) / b.x);
+            // The slope where that rounding is negligible (the slope's is larger still).
+            if (rounding < 1e-10 * b.x)
+                worst_slope = std::max(worst_slope, std::abs(a.dx_dlog_ratio - b.dx_dlog_ratio) /
+                                                        std::abs(b.dx_dlog_ratio));
+        }
+        std::printf(
+            "%s: %zu ratio bins used; %zu ratios inside, %zu outside; largest relative "
+            "difference from find(ln ratio) %.2e, slope %.2e\n",
+            k.name.c_str(), k.table.ratio_bins_used(), both, neither, worst, worst_slope);
+        EXPECT_GT(both, 5000U) << k.name;
+        EXPECT_GT(neither, 5000U) << k.name;
+        EXPECT_LT(worst, 1e-8) << k.name;
+        EXPECT_LT(worst_slope, 1e-4) << k.name;
+    }
+    // Eq. 16/18 at normal view: the bins cover every ratio of σ/T in [0.03, 1e3] (Gaussian) and
+    // [0.15, 1e3] (exponential) — no fallback. (Towards σ/T → 0 the exponential's ratio ends at
+    // (a2/a1)^(3/2) C, with σ/T ∝ √(distance to it): a square root no cubic follows, so those
+    // last bins go to find.)
+    for (const Correlation c : {Correlation::Gaussian, Correlation::Exponential}) {
+        const RatioInverseTable table = RatioInverseTable::sigma_over_T(g1, g2, c);
+        EXPECT_GT(table.ratio_bins_used(), 2000U) << to_string(c);
+        for (double s = c == Correlation::Gaussian ? 0.03 : 0.15; s <= 1e3; s *= 1.01) {
+            const double ratio = model_ratio_very_rough(g1, g2, s, c);
+            RatioInverseTable::Value v;
+            std::size_t hint = 1u << 30;  // untouched by the bins
+            ASSERT_TRUE(table.find_ratio(ratio, v, hint)) << s;
+            EXPECT_EQ(hint, 1u << 30) << to_string(c) << " σ/T " << s << " went to find";
+            EXPECT_NEAR(v.x, s, 1e-7 * s);
+        }
+    }
+    // No ratio, no value.
+    const RatioInverseTable table = RatioInverseTable::sigma_over_T(g1, g2, Correlation::Gaussian);
+    RatioInverseTable::Value v;
+    std::size_t hint = 0;
+    for (const double bad : {0.0, -1.0, std::nan(""), std::numeric_limits<double>::infinity()})
+        EXPECT_FALSE(table.find_ratio(bad, v, hint)) << bad;
+}
+
 TEST(RatioInverseTable, BadInput) {
     const Geometry g = normal_view_geometry(kTheta1);
     EXPECT_THROW(RatioInverseTable::sigma_over_T(g, g, Correlation::Gaussian), InvalidArgument);
@@ -293,6 +376,123 @@ TEST(RoughnessMap, UncertaintyIsCalibrated) {
             EXPECT_GE(sd, 0.8);
             EXPECT_LE(sd, 1.25);
             EXPECT_LT(std::abs(mean), 0.2);
+        }
+    }
+}
+
+// Per pixel, every layer against its definition (docs/maps.md) computed here pixel by pixel:
+// the used pixels of the clipped 5 × 5 neighbourhood, their means, variances and covariance,
+// var(ln E1/E2) = v1/m1² + v2/m2² − 2 c12/(m1 m2), the tables at ln(x1/x2). A noisy pair with
+// flagged pixels, a patch whose ratio no model produces, more rows than the column sums'
+// restart (64), on one and on three threads.
+TEST(RoughnessMap, PixelMapEqualsItsDefinition) {
+    const std::size_t W = 57, H = 150;
+    LitPair p = render_lit_pair(plane(W, H), {very_rough_truth(0.8)}, {}, {}, kTheta1, kTheta2, 5);
+    std::mt19937_64 rng(3);
+    for (int i = 0; i < 300; ++i) p.a.flags[rng() % (W * H)] = kPixelSaturated;
+    for (int i = 0; i < 300; ++i) p.b.flags[rng() % (W * H)] = kPixelSaturated;
+    const RatioRange range = ratio_range_gaussian(kTheta1, kTheta2);
+    for (std::size_t r = 90; r < 100; ++r)
+        for (std::size_t x = 10; x < 30; ++x)
+            p.b.values[r * W + x] = static_cast<float>(p.a.values[r * W + x] / (0.5 * range.lower));
+    const RatioInverseTable tg = RatioInverseTable::sigma_over_T(
+        normal_view_geometry(kTheta1), normal_view_geometry(kTheta2), Correlation::Gaussian);
+    const RatioInverseTable te = RatioInverseTable::sigma_over_T(
+        normal_view_geometry(kTheta1), normal_view_geometry(kTheta2), Correlation::Exponential);
+    auto relative = [](double got, double expected) {
+        return std::abs(got - expected) / std::abs(expected);
+    };
+    for (const std::size_t threads : {std::size_t{1}, std::size_t{3}}) {
+        MapOptions o;
+        o.window_px = 1;
+        o.threads = threads;
+        o.check_registration = false;
+        const RoughnessMap map = roughness_map(flat_captures(p), o);
+        ASSERT_EQ(map.width * map.height, W * H);
+        std::size_t missing = 0, no_solution = 0, valid = 0;
+        double worst = 0.0, worst_se = 0.0;
+        for (std::size_t r = 0; r < H; ++r)
+            for (std::size_t x = 0; x < W; ++x) {
+                const std::size_t i = r * W + x;
+                auto used = [&](std::size_t q) { return p.a.flags[q] == 0 && p.b.flags[q] == 0; };
+                double n = 0, s1 = 0, s2 = 0;
+                for (std::size_t rr = r >= 2 ? r - 2 : 0; rr <= std::min(H - 1, r + 2); ++rr)
+                    for (std::size_t xx = x >= 2 ? x - 2 : 0; xx <= std::min(W - 1, x + 2); ++xx)
+                        if (used(rr * W + xx)) {
+                            n += 1;
+                            s1 += p.a.values[rr * W + xx];
+                            s2 += p.b.values[rr * W + xx];
+                        }
+                if (!used(i) || n < 3) {
+                    ++missing;
+                    EXPECT_EQ(map.roughness_class[i], kClassNone);
+                    EXPECT_TRUE(std::isnan(map.E1_over_E2[i]));
+                    continue;
+                }
+                const double m1 = s1 / n, m2 = s2 / n;
+                double v1 = 0, v2 = 0, c12 = 0;
+                for (std::size_t rr = r >= 2 ? r - 2 : 0; rr <= std::min(H - 1, r + 2); ++rr)
+                    for (std::size_t xx = x >= 2 ? x - 2 : 0; xx <= std::min(W - 1, x + 2); ++xx)
+                        if (used(rr * W + xx)) {
+                            const double d1 = p.a.values[rr * W + xx] - m1;
+                            const double d2 = p.b.values[rr * W + xx] - m2;
+                            v1 += d1 * d1 / (n - 1);
+                            v2 += d2 * d2 / (n - 1);
+                            c12 += d1 * d2 / (n - 1);
+                        }
+                const double sd =
+                    std::sqrt(v1 / (m1 * m1) + v2 / (m2 * m2) - 2.0 * c12 / (m1 * m2));
+                const double ratio =
+                    static_cast<double>(p.a.values[i]) / static_cast<double>(p.b.values[i]);
+                EXPECT_LT(relative(map.E1_over_E2[i], ratio), 1e-6) << i;
+                const auto vg = tg.lookup(std::log(ratio)), ve = te.lookup(std::log(ratio));
+                if (!vg) {
+                    ++no_solution;
+                    EXPECT_FALSE(ve.has_value()) << i;
+                    EXPECT_EQ(map.roughness_class[i], kClassNone);
+                    EXPECT_TRUE(std::isnan(map.sigma_over_T_gaussian[i]));
+                    EXPECT_TRUE(std::isnan(map.sigma_over_T_exponential_stderr[i]));
+                    continue;
+                }
+                ++valid;
+                ASSERT_TRUE(ve.has_value()) << i;
+                worst = std::max({worst, relative(map.sigma_over_T_gaussian[i], vg->x),
+                                  relative(map.sigma_over_T_exponential[i], ve->x)});
+                worst_se = std::max({worst_se,
+                                     relative(map.sigma_over_T_gaussian_stderr[i],
+                                              std::abs(vg->dx_dlog_ratio) * sd),
+                                     relative(map.sigma_over_T_exponential_stderr[i],
+                                              std::abs(ve->dx_dlog_ratio) * sd)});
+                EXPECT_EQ(map.roughness_class[i],
+                          static_cast<std::uint8_t>(roughness_class_of_sigma_over_T(vg->x)))
+                    << i;
+            }
+        std::printf(
+            "%zu threads: %zu valid, %zu missing, %zu no solution; largest relative "
+            "difference σ/T %.2e, stderr %.2e\n",
+            threads, valid, missing, no_solution, worst, worst_se);
+        EXPECT_EQ(map.valid, valid);
+        EXPECT_EQ(map.missing, missing);
+        EXPECT_EQ(map.no_solution, no_solution);
+        EXPECT_GE(no_solution, 150U);
+        EXPECT_GE(missing, 400U);
+        EXPECT_LT(worst, 1e-6);
+        EXPECT_LT(worst_se, 1e-5);
+        // The per-class means are those of the class layer's cells.
+        for (std::size_t c = 0; c < 3; ++c) {
+            double sum = 0;
+            std::size_t count = 0;
+            for (std::size_t i = 0; i < W * H; ++i)
+                if (map.roughness_class[i] == c) {
+                    sum += map.sigma_over_T_gaussian[i];
+                    ++count;
+                }
+            EXPECT_EQ(map.classes[c].count, count);
+            if (count > 0) {
+                ASSERT_TRUE(map.classes[c].mean_sigma_over_T.has_value());
+                EXPECT_NEAR(map.classes[c].mean_sigma_over_T->value, sum / count,
+                            1e-12 * sum / count);
+            }
         }
     }
 }
