@@ -2,6 +2,7 @@
 #include "roughscope/image/maps.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <bit>
 #include <cmath>
 #include <cstdint>
@@ -339,12 +340,14 @@ namespace {
                                                    const double* __restrict bins,
                                                    std::int64_t key_min, std::int64_t count,
                                                    int shift, double sign, double inv_anchor,
-                                                   double* __restrict x, double* __restrict slope) {
+                                                   double* __restrict x, double* __restrict slope,
+                                                   std::uint64_t& pending) {
     const std::uint64_t mantissa = (std::uint64_t{1} << shift) - 1;
     const std::uint64_t one = std::bit_cast<std::uint64_t>(1.0);
     const int up = 52 - shift;
     const std::uint64_t quiet_nan =
         std::bit_cast<std::uint64_t>(std::numeric_limits<double>::quiet_NaN());
+    std::uint64_t left = 0;
     for (std::size_t i = 0; i < n; ++i) {
         const double u = sign * (ratio[i] * inv_anchor - 1.0);
         const auto bits = std::bit_cast<std::uint64_t>(u);
@@ -359,41 +362,55 @@ namespace {
         const double inv_width = std::bit_cast<double>(
             (std::uint64_t{2046 + 52 - static_cast<std::uint64_t>(shift)} - ((bits >> 52) & 0x7ff))
             << 52);
-        slope[i] = (c1 + t * (2.0 * c2 + t * 3.0 * c3)) * inv_width * (sign + u);
-        // NaN where the bin is not used: the quiet-NaN bits ORed in (no branch for the
+        const double d = (c1 + t * (2.0 * c2 + t * 3.0 * c3)) * inv_width * (sign + u);
+        // Both NaN where the bin is not used: the quiet-NaN bits ORed in (no branch for the
         // vectoriser).
-        const auto unused = static_cast<std::uint64_t>(!(inside & (c0 > 0.0)));
-        x[i] = std::bit_cast<double>(std::bit_cast<std::uint64_t>(value) |
-                                     ((std::uint64_t{0} - unused) & quiet_nan));
+        const std::uint64_t unused =
+            (std::uint64_t{0} - static_cast<std::uint64_t>(!(inside & (c0 > 0.0)))) & quiet_nan;
+        x[i] = std::bit_cast<double>(std::bit_cast<std::uint64_t>(value) | unused);
+        slope[i] = std::bit_cast<double>(std::bit_cast<std::uint64_t>(d) | unused);
+        // A ratio (not NaN) outside the used bins: for find.
+        left |= unused & (std::uint64_t{0} - static_cast<std::uint64_t>(ratio[i] == ratio[i]));
     }
+    pending = left;
 }
 
-[[gnu::target("avx2")]] void ratio_bins_avx2(std::size_t n, const double* ratio, const double* bins,
+[[gnu::target("avx2")]] bool ratio_bins_avx2(std::size_t n, const double* ratio, const double* bins,
                                              std::int64_t key_min, std::int64_t count, int shift,
                                              double sign, double inv_anchor, double* x,
                                              double* slope) {
-    ratio_bins_loop(n, ratio, bins, key_min, count, shift, sign, inv_anchor, x, slope);
+    std::uint64_t pending = 0;
+    ratio_bins_loop(n, ratio, bins, key_min, count, shift, sign, inv_anchor, x, slope, pending);
+    return pending != 0;
 }
 
-void ratio_bins_default(std::size_t n, const double* ratio, const double* bins,
+bool ratio_bins_default(std::size_t n, const double* ratio, const double* bins,
                         std::int64_t key_min, std::int64_t count, int shift, double sign,
                         double inv_anchor, double* x, double* slope) {
-    ratio_bins_loop(n, ratio, bins, key_min, count, shift, sign, inv_anchor, x, slope);
+    std::uint64_t pending = 0;
+    ratio_bins_loop(n, ratio, bins, key_min, count, shift, sign, inv_anchor, x, slope, pending);
+    return pending != 0;
 }
+
+std::atomic<bool> avx2_allowed{true};
 
 bool has_avx2() {
     static const bool avx2 = __builtin_cpu_supports("avx2") != 0;
-    return avx2;
+    return avx2 && avx2_allowed.load(std::memory_order_relaxed);
 }
 
 }  // namespace
 
-void RatioInverseTable::find_ratio_bins(std::size_t n, const double* ratio, double* x,
+bool allow_avx2_in_maps(bool allowed) {
+    return avx2_allowed.exchange(allowed, std::memory_order_relaxed);
+}
+
+bool RatioInverseTable::find_ratio_bins(std::size_t n, const double* ratio, double* x,
                                         double* dx_dlog_ratio) const {
     auto* run = has_avx2() ? ratio_bins_avx2 : ratio_bins_default;
-    run(n, ratio, ratio_bins_.data(), static_cast<std::int64_t>(ratio_bin_key_min_),
-        static_cast<std::int64_t>(ratio_bins_.size() / 5), kRatioBinShift, anchor_sign_,
-        inv_anchor_ratio_, x, dx_dlog_ratio);
+    return run(n, ratio, ratio_bins_.data(), static_cast<std::int64_t>(ratio_bin_key_min_),
+               static_cast<std::int64_t>(ratio_bins_.size() / 5), kRatioBinShift, anchor_sign_,
+               inv_anchor_ratio_, x, dx_dlog_ratio);
 }
 
 std::size_t RatioInverseTable::ratio_bins_used() const {
@@ -599,10 +616,11 @@ inline std::uint64_t mask_of(bool condition) {
 }
 
 // A row of a flat sample's per-pixel map into its layers, every cell written once: from the
-// pixels' state (as a double, 0 an estimate, PixelState), ratio, var(ln ratio) and both
-// correlations' σ/T and slope d(σ/T)/d ln ratio (σ/T NaN: no solution). sd(σ/T) = |slope| ·
-// sd(ln ratio); the class by the primary correlation's σ/T (`klass`: the class as a double, a
-// row of scratch, narrowed to the class layer after). In 64-bit masks and selects without
+// pixels' state (as a double, PixelState), ratio, var(ln ratio) and both correlations' σ/T and
+// slope d(σ/T)/d ln ratio — all NaN where there is no estimate (state ≠ 0, or a ratio the table
+// does not invert), so the layers are their conversions: E1/E2, σ/T, sd(σ/T) = |slope| ·
+// sd(ln ratio). The class by the primary correlation's σ/T (`klass`: the class as a double, a
+// row of scratch, narrowed to the class layer after) and its sums. In 64-bit masks, without
 // branches, so that the compiler vectorises the loop.
 [[gnu::always_inline]] inline RowCounts write_flat_row_body(
     std::size_t n, const double* __restrict ratio, const double* __restrict var,
@@ -613,34 +631,26 @@ inline std::uint64_t mask_of(bool condition) {
     std::uint8_t* __restrict cls) {
     const double* __restrict xp = gaussian ? xg : xe;
     const double* __restrict xo = gaussian ? xe : xg;
-    std::uint64_t valid = 0, missing = 0, no_solution = 0, no_solution_other = 0;
-    std::uint64_t n0 = 0, n1 = 0, n2 = 0;
+    std::uint64_t valid = 0, valid_other = 0, missing = 0, n0 = 0, n1 = 0, n2 = 0;
     double s0 = 0, s1 = 0, s2 = 0, q0 = 0, q1 = 0, q2 = 0;
     // (The class sums in lanes: their order of addition is the build's, not the threads'.)
-#pragma omp simd reduction(+ : valid, missing, no_solution, no_solution_other, n0, n1, n2, s0, \
-                               s1, s2, q0, q1, q2)
+#pragma omp simd reduction(+ : valid, valid_other, missing, n0, n1, n2, s0, s1, s2, q0, q1, q2)
     for (std::size_t i = 0; i < n; ++i) {
-        const double st = state[i], p = xp[i], o = xo[i], sd = std::sqrt(var[i]);
-        const std::uint64_t is_missing = mask_of(st == 1.0);
-        const std::uint64_t not_estimate = mask_of(st != 0.0);
-        const std::uint64_t no_g = not_estimate | mask_of(xg[i] != xg[i]);
-        const std::uint64_t no_e = not_estimate | mask_of(xe[i] != xe[i]);
-        const std::uint64_t no_p = not_estimate | mask_of(p != p);
-        const std::uint64_t no_o = not_estimate | mask_of(o != o);
-        e12[i] = static_cast<float>(nan_where(ratio[i], not_estimate));
-        g[i] = static_cast<float>(nan_where(xg[i], no_g));
-        gse[i] = static_cast<float>(nan_where(std::abs(sg[i]) * sd, no_g));
-        e[i] = static_cast<float>(nan_where(xe[i], no_e));
-        ese[i] = static_cast<float>(nan_where(std::abs(se[i]) * sd, no_e));
-        const double c = 1.0 + (p > very ? 1.0 : 0.0) - (p < slightly ? 1.0 : 0.0);
-        klass[i] = std::bit_cast<double>((std::bit_cast<std::uint64_t>(c) & ~no_p) |
-                                         (no_p & std::bit_cast<std::uint64_t>(255.0)));
-        valid += 1 & ~no_p;
-        missing += 1 & is_missing;
-        no_solution += 1 & no_p & ~is_missing;
-        no_solution_other += 1 & no_o & ~is_missing;
-        const std::uint64_t m0 = ~no_p & mask_of(p < slightly), m2 = ~no_p & mask_of(p > very);
-        const std::uint64_t m1 = ~no_p & ~m0 & ~m2;
+        const double p = xp[i], sd = std::sqrt(var[i]);
+        e12[i] = static_cast<float>(ratio[i]);
+        g[i] = static_cast<float>(xg[i]);
+        gse[i] = static_cast<float>(std::abs(sg[i]) * sd);
+        e[i] = static_cast<float>(xe[i]);
+        ese[i] = static_cast<float>(std::abs(se[i]) * sd);
+        const std::uint64_t none = mask_of(p != p);
+        const std::uint64_t m0 = mask_of(p < slightly), m2 = mask_of(p > very);
+        const std::uint64_t m1 = ~none & ~m0 & ~m2;
+        klass[i] = std::bit_cast<double>((std::bit_cast<std::uint64_t>(1.0) & m1) |
+                                         (std::bit_cast<std::uint64_t>(2.0) & m2) |
+                                         (std::bit_cast<std::uint64_t>(255.0) & none));
+        valid += 1 & ~none;
+        valid_other += xo[i] == xo[i] ? 1 : 0;
+        missing += state[i] == 1.0 ? 1 : 0;
         // The layer's value (a float), as row_class_sums reads it.
         const auto bits = std::bit_cast<std::uint64_t>(static_cast<double>(static_cast<float>(p)));
         const double v0 = std::bit_cast<double>(bits & m0), v1 = std::bit_cast<double>(bits & m1),
@@ -656,7 +666,8 @@ inline std::uint64_t mask_of(bool condition) {
         q2 += v2 * v2;
     }
     for (std::size_t i = 0; i < n; ++i) cls[i] = static_cast<std::uint8_t>(klass[i]);
-    RowCounts counts{valid, missing, no_solution, no_solution_other, {}};
+    // Every pixel is an estimate, missing, or without a solution.
+    RowCounts counts{valid, missing, n - valid - missing, n - valid_other - missing, {}};
     counts.classes[0] = {n0, s0, q0};
     counts.classes[1] = {n1, s1, q1};
     counts.classes[2] = {n2, s2, q2};
@@ -774,8 +785,8 @@ class Evaluator {
     ClassSums evaluate_flat_row(std::size_t begin, std::size_t count, const double* ratio,
                                 const double* var_log_ratio, const double* state) {
         for (auto* v : {&xg_, &sg_, &xe_, &se_, &klass_}) v->resize(count);
-        table_g_.find_ratio_bins(count, ratio, xg_.data(), sg_.data());
-        table_e_.find_ratio_bins(count, ratio, xe_.data(), se_.data());
+        const bool pending_g = table_g_.find_ratio_bins(count, ratio, xg_.data(), sg_.data());
+        const bool pending_e = table_e_.find_ratio_bins(count, ratio, xe_.data(), se_.data());
         // The ratios outside the bins (few, or none): find at ln ratio (NaN stays where the
         // table has no solution).
         const auto rest = [&](const RatioInverseTable& table, std::vector<double>& x,
@@ -788,8 +799,8 @@ class Evaluator {
                 slope[i] = v.dx_dlog_ratio;
             }
         };
-        rest(table_g_, xg_, sg_, hint_g_);
-        rest(table_e_, xe_, se_, hint_e_);
+        if (pending_g) rest(table_g_, xg_, sg_, hint_g_);
+        if (pending_e) rest(table_e_, xe_, se_, hint_e_);
         const bool gaussian = o_.correlation == Correlation::Gaussian;
         const RowCounts c = write_flat_row(
             count, ratio, var_log_ratio, state, xg_.data(), sg_.data(), xe_.data(), se_.data(),
@@ -1069,6 +1080,8 @@ void clear_rows(RoughnessMap& map, std::size_t r_begin, std::size_t r_end) {
 // map is the same on any number of threads, bit for bit) and the running sums' rounding never
 // builds up over more than kSumRestartRows rows.
 constexpr std::size_t kSumRestartRows = 64;
+// The per-pixel map's passes over a row go in chunks of this many pixels.
+constexpr std::size_t kPixelChunk = 256;
 
 // The per-pixel map's column sums (n, Σx1, Σx2, Σx1², Σx2², Σx1x2 over rows [r − R, r + R]) +=
 // row (a, b, weights u) · add_weight − row (ra, rb, ru) · remove_weight, in one pass. (Free
@@ -1117,13 +1130,15 @@ void update_column_sums(std::size_t W, const double* __restrict a, const double*
         const double inv = 1.0 / (p * b[x]);
         const double bracket = s11 * s2 * s2 + s22 * s1 * s1 - 2.0 * s12 * s1s2;
         var[x] = std::max(0.0, n * n * bracket * b[x] * inv);
-        ratio[x] = a[x] * p * inv;
         // Running sums of ±1 stay exact integers in n. Without branches (and in doubles, for
-        // the vectoriser): 1 missing, 2 no solution, 0 an estimate.
+        // the vectoriser): 1 missing, 2 no solution, 0 an estimate — whose ratio alone is a
+        // number (NaN otherwise, which the look-ups carry through to the layers).
         const double missing = !(u[x] > 0.0) || n < 3.0 ? 1.0 : 0.0;
         const double no_solution =
             !(a[x] > 0.0) || !(b[x] > 0.0) || !(s1 > 0.0) || !(s2 > 0.0) ? 1.0 : 0.0;
-        state[x] = missing + 2.0 * (1.0 - missing) * no_solution;
+        const double st = missing + 2.0 * (1.0 - missing) * no_solution;
+        state[x] = st;
+        ratio[x] = nan_where(a[x] * p * inv, mask_of(st != 0.0));
     }
 }
 // pixel_statistics_body for AVX2 (four lanes) and for the baseline (two), as write_flat_row.
@@ -1211,16 +1226,35 @@ void pixel_map(const std::vector<MapCapture>& captures, const MapOptions& o, Eva
             if (add < H || remove < H) update(add, remove);
         }
         const std::size_t k = r % ring;
-        pixel_statistics(W, x1[k].data(), x2[k].data(), used[k].data(), col[0].data(),
-                         col[1].data(), col[2].data(), col[3].data(), col[4].data(), col[5].data(),
-                         ratio.data(), var.data(), state.data());
+        // The statistics of pixels [c, c + count) of the row.
+        auto statistics = [&](std::size_t c, std::size_t count) {
+            pixel_statistics(count, x1[k].data() + c, x2[k].data() + c, used[k].data() + c,
+                             col[0].data() + c, col[1].data() + c, col[2].data() + c,
+                             col[3].data() + c, col[4].data() + c, col[5].data() + c, ratio.data(),
+                             var.data(), state.data());
+        };
         const std::size_t row = r * W;
         if (labels)
             std::copy_n(o.region_labels.begin() + static_cast<std::ptrdiff_t>(row), W,
                         cell_region.begin() + static_cast<std::ptrdiff_t>(row));
         if (ev.fast_flat()) {
-            row_classes[r] = ev.evaluate_flat_row(row, W, ratio.data(), var.data(), state.data());
+            // In chunks of the row, so that the chunk's scratch stays in the first-level cache
+            // between the passes (statistics, look-ups, layers); the class sums added in order.
+            ClassSums sums;
+            for (std::size_t c = 0; c < W; c += kPixelChunk) {
+                const std::size_t count = std::min(kPixelChunk, W - c);
+                statistics(c, count);
+                const ClassSums chunk =
+                    ev.evaluate_flat_row(row + c, count, ratio.data(), var.data(), state.data());
+                for (std::size_t q = 0; q < 3; ++q) {
+                    sums[q].n += chunk[q].n;
+                    sums[q].sum += chunk[q].sum;
+                    sums[q].sum2 += chunk[q].sum2;
+                }
+            }
+            row_classes[r] = sums;
         } else {
+            statistics(0, W);
             clear_rows(map, r, r + 1);
             for (std::size_t x = 0; x < W; ++x) {
                 const std::size_t index = row + x;

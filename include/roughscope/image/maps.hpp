@@ -157,8 +157,9 @@ class RatioInverseTable {
     }
     // find_ratio over arrays, its bins only (a loop without branches, vectorised; AVX2 where the
     // processor has it, the same arithmetic): x[i] and dx_dlog_ratio[i] at ratio[i] where its
-    // bin is used, x[i] = NaN where find_ratio would go to find (the caller does that).
-    void find_ratio_bins(std::size_t n, const double* ratio, double* x,
+    // bin is used, both NaN elsewhere. True when a ratio that is not NaN missed the bins (find
+    // at its logarithm is the caller's).
+    bool find_ratio_bins(std::size_t n, const double* ratio, double* x,
                          double* dx_dlog_ratio) const;
     // The largest relative difference between a ratio bin's cubic and find at the bin's middle
     // for the bin to be used: x (beyond what the rounding of ln ratio alone moves find's x by)
@@ -319,5 +320,11 @@ struct RoughnessMap {
 // the first two are used and a warning says so (a per-tile least-squares fit is left to
 // image/measure.hpp's region measurement).
 RoughnessMap roughness_map(const std::vector<MapCapture>& captures, const MapOptions& options);
+
+// The per-pixel map's row loops and RatioInverseTable::find_ratio_bins run an AVX2 build of
+// themselves where the processor has it, the baseline build elsewhere: the same arithmetic, so
+// the same map. This switch (for tests and benchmarks; default true) allows or forbids the AVX2
+// build process-wide and returns the previous setting.
+bool allow_avx2_in_maps(bool allowed);
 
 }  // namespace roughscope::image

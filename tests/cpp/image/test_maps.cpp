@@ -391,6 +391,11 @@ TEST(RoughnessMap, PixelMapEqualsItsDefinition) {
     std::mt19937_64 rng(3);
     for (int i = 0; i < 300; ++i) p.a.flags[rng() % (W * H)] = kPixelSaturated;
     for (int i = 0; i < 300; ++i) p.b.flags[rng() % (W * H)] = kPixelSaturated;
+    // Rows 20–29 flagged but for every third pixel of every other row: neighbourhoods of 2 to 6
+    // used pixels, either side of the 3 a pixel needs.
+    for (std::size_t r = 20; r < 30; ++r)
+        for (std::size_t x = 0; x < W; ++x)
+            if (r % 2 == 1 || x % 3 != 0) p.a.flags[r * W + x] = kPixelSaturated;
     const RatioRange range = ratio_range_gaussian(kTheta1, kTheta2);
     for (std::size_t r = 90; r < 100; ++r)
         for (std::size_t x = 10; x < 30; ++x)
@@ -402,12 +407,15 @@ TEST(RoughnessMap, PixelMapEqualsItsDefinition) {
     auto relative = [](double got, double expected) {
         return std::abs(got - expected) / std::abs(expected);
     };
-    for (const std::size_t threads : {std::size_t{1}, std::size_t{3}}) {
+    for (const std::size_t threads : {std::size_t{1}, std::size_t{3}, std::size_t{0}}) {
         MapOptions o;
         o.window_px = 1;
-        o.threads = threads;
+        o.threads = std::max<std::size_t>(threads, 1);
         o.check_registration = false;
+        // threads 0: one thread, the baseline build of the row loops (not AVX2).
+        const bool before = allow_avx2_in_maps(threads != 0);
         const RoughnessMap map = roughness_map(flat_captures(p), o);
+        allow_avx2_in_maps(before);
         ASSERT_EQ(map.width * map.height, W * H);
         std::size_t missing = 0, no_solution = 0, valid = 0;
         double worst = 0.0, worst_se = 0.0;
@@ -467,10 +475,10 @@ TEST(RoughnessMap, PixelMapEqualsItsDefinition) {
                           static_cast<std::uint8_t>(roughness_class_of_sigma_over_T(vg->x)))
                     << i;
             }
-        std::printf(
-            "%zu threads: %zu valid, %zu missing, %zu no solution; largest relative "
-            "difference σ/T %.2e, stderr %.2e\n",
-            threads, valid, missing, no_solution, worst, worst_se);
+        std::printf("%s: %zu valid, %zu missing, %zu no solution; largest relative "
+                    "difference σ/T %.2e, stderr %.2e\n",
+                    threads == 0 ? "baseline build" : (threads == 1 ? "1 thread" : "3 threads"),
+                    valid, missing, no_solution, worst, worst_se);
         EXPECT_EQ(map.valid, valid);
         EXPECT_EQ(map.missing, missing);
         EXPECT_EQ(map.no_solution, no_solution);
@@ -785,6 +793,43 @@ TEST(RoughnessClassOfSigmaOverT, Thresholds) {
 
 namespace roughscope::image {
 namespace {
+
+// The per-pixel map's AVX2 and baseline builds of its row loops give the same map, bit for bit
+// (a noisy pair with flagged pixels and ratios outside the model's range).
+TEST(RoughnessMap, VectorBuildsGiveTheSameMap) {
+    const std::size_t W = 301, H = 77;
+    LitPair p = render_lit_pair(plane(W, H), {very_rough_truth(0.6)}, {}, {}, kTheta1, kTheta2, 9);
+    const RatioRange range = ratio_range_gaussian(kTheta1, kTheta2);
+    for (std::size_t i = 0; i < W * H; i += 37) p.a.flags[i] = kPixelSaturated;
+    for (std::size_t i = 5; i < W * H; i += 53)
+        p.b.values[i] = static_cast<float>(p.a.values[i] / (0.5 * range.lower));
+    MapOptions o;
+    o.window_px = 1;
+    o.check_registration = false;
+    const RoughnessMap fast = roughness_map(flat_captures(p), o);
+    const bool before = allow_avx2_in_maps(false);
+    const RoughnessMap baseline = roughness_map(flat_captures(p), o);
+    allow_avx2_in_maps(before);
+    auto same = [](const MapLayerValues& a, const MapLayerValues& b) {
+        if (a.size() != b.size()) return false;
+        for (std::size_t i = 0; i < a.size(); ++i)
+            if (!((std::isnan(a[i]) && std::isnan(b[i])) || a[i] == b[i])) return false;
+        return true;
+    };
+    EXPECT_TRUE(same(fast.E1_over_E2, baseline.E1_over_E2));
+    EXPECT_TRUE(same(fast.sigma_over_T_gaussian, baseline.sigma_over_T_gaussian));
+    EXPECT_TRUE(same(fast.sigma_over_T_gaussian_stderr, baseline.sigma_over_T_gaussian_stderr));
+    EXPECT_TRUE(same(fast.sigma_over_T_exponential, baseline.sigma_over_T_exponential));
+    EXPECT_TRUE(
+        same(fast.sigma_over_T_exponential_stderr, baseline.sigma_over_T_exponential_stderr));
+    EXPECT_TRUE(fast.roughness_class == baseline.roughness_class);
+    EXPECT_EQ(fast.valid, baseline.valid);
+    EXPECT_EQ(fast.missing, baseline.missing);
+    EXPECT_EQ(fast.no_solution, baseline.no_solution);
+    EXPECT_GT(fast.no_solution, 100U);
+    EXPECT_GT(fast.missing, 300U);
+    for (std::size_t c = 0; c < 3; ++c) EXPECT_EQ(fast.classes[c].count, baseline.classes[c].count);
+}
 
 // Bands of rows on several threads give the same map as one thread, per pixel and per tile.
 TEST(RoughnessMap, ThreadsDoNotChangeTheResult) {
