@@ -475,10 +475,11 @@ TEST(RoughnessMap, PixelMapEqualsItsDefinition) {
                           static_cast<std::uint8_t>(roughness_class_of_sigma_over_T(vg->x)))
                     << i;
             }
-        std::printf("%s: %zu valid, %zu missing, %zu no solution; largest relative "
-                    "difference σ/T %.2e, stderr %.2e\n",
-                    threads == 0 ? "baseline build" : (threads == 1 ? "1 thread" : "3 threads"),
-                    valid, missing, no_solution, worst, worst_se);
+        std::printf(
+            "%s: %zu valid, %zu missing, %zu no solution; largest relative "
+            "difference σ/T %.2e, stderr %.2e\n",
+            threads == 0 ? "baseline build" : (threads == 1 ? "1 thread" : "3 threads"), valid,
+            missing, no_solution, worst, worst_se);
         EXPECT_EQ(map.valid, valid);
         EXPECT_EQ(map.missing, missing);
         EXPECT_EQ(map.no_solution, no_solution);
