@@ -320,6 +320,40 @@ TEST(RatioInverseTable, RatioBinsEqualTheLookUpAtTheLogRatio) {
             EXPECT_NEAR(v.x, s, 1e-7 * s);
         }
     }
+    // find_ratio_bins (the row's loop, AVX2 or baseline build) gives find_ratio's numbers bit for
+    // bit where a bin is used, and NaN with `true` (a ratio for find) where none is.
+    for (const Case& k : cases) {
+        std::vector<double> ratios;
+        const RatioRange range = k.table.ratio_range();
+        for (int i = 0; i < 2000; ++i) {
+            const double d = std::exp2(log2_distance(rng));
+            ratios.push_back((i % 2 == 0 ? range.lower : range.upper) *
+                             (i % 4 < 2 ? 1.0 + d : 1.0 - std::min(d, 0.999)));
+        }
+        ratios.push_back(std::nan(""));
+        for (const bool avx2 : {true, false}) {
+            const bool before = allow_avx2_in_maps(avx2);
+            std::vector<double> x(ratios.size()), slope(ratios.size());
+            const bool pending =
+                k.table.find_ratio_bins(ratios.size(), ratios.data(), x.data(), slope.data());
+            allow_avx2_in_maps(before);
+            bool missed = false;
+            for (std::size_t i = 0; i < ratios.size(); ++i) {
+                RatioInverseTable::Value v;
+                std::size_t hint = std::size_t{1} << 30;
+                const bool found = k.table.find_ratio(ratios[i], v, hint);
+                if (found && hint == std::size_t{1} << 30) {  // from a bin
+                    ASSERT_EQ(x[i], v.x) << k.name << " " << ratios[i];
+                    ASSERT_EQ(slope[i], v.dx_dlog_ratio) << k.name << " " << ratios[i];
+                } else {
+                    ASSERT_TRUE(std::isnan(x[i]) && std::isnan(slope[i])) << k.name;
+                    missed = missed || !std::isnan(ratios[i]);
+                }
+            }
+            EXPECT_EQ(pending, missed) << k.name;
+            EXPECT_TRUE(missed) << k.name;
+        }
+    }
     // No ratio, no value.
     const RatioInverseTable table = RatioInverseTable::sigma_over_T(g1, g2, Correlation::Gaussian);
     RatioInverseTable::Value v;
