@@ -167,6 +167,7 @@ write("capture_file", "sphere.json", """{
 write("capture_file", "maps.json", """{
   "object": {"shape": "normal_map", "file": "n.png"},
   "maps": {"window_px": 4, "max_shift_px": 0.5, "allow_misregistration": false,
+           "both_correlations": true, "ratio_layer": false,
            "regions": [{"name": "a", "rect": [0, 0, 8, 8]}, {"name": "b", "circle": [9, 9, 3]}]},
   "captures": [{"image": "a.png", "light": [0.5, 0, 0.866]}, {"image": "b.png", "light": [0.7, 0, 0.7]}]
 }

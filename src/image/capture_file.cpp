@@ -286,7 +286,8 @@ ObjectSpec parse_object(const Context& ctx, const Json& j) {
 MapRequest parse_maps(const Context& ctx, const Json& j) {
     ctx.only(j, "maps",
              {"window_px", "min_used_fraction", "max_shift_px", "allow_misregistration",
-              "slightly_rough_max_sigma_over_T", "very_rough_min_sigma_over_T", "regions"});
+              "slightly_rough_max_sigma_over_T", "very_rough_min_sigma_over_T", "both_correlations",
+              "ratio_layer", "regions"});
     MapRequest maps;
     MapOptions& o = maps.options;
     if (j.contains("window_px"))
@@ -300,6 +301,10 @@ MapRequest parse_maps(const Context& ctx, const Json& j) {
     if (j.contains("allow_misregistration"))
         o.allow_misregistration =
             boolean(ctx, j["allow_misregistration"], "maps.allow_misregistration");
+    if (j.contains("both_correlations"))
+        o.both_correlations = boolean(ctx, j["both_correlations"], "maps.both_correlations");
+    if (j.contains("ratio_layer"))
+        o.ratio_layer = boolean(ctx, j["ratio_layer"], "maps.ratio_layer");
     if (j.contains("slightly_rough_max_sigma_over_T"))
         o.slightly_rough_max_sigma_over_T = ctx.positive(j["slightly_rough_max_sigma_over_T"],
                                                          "maps.slightly_rough_max_sigma_over_T");

@@ -585,13 +585,12 @@ void load_row(const MapCapture& c, std::size_t r, std::vector<double>& out) {
 
 // What a band of rows counted.
 struct Counts {
-    std::size_t valid = 0, missing = 0, no_solution = 0, no_solution_exponential = 0,
-                no_solution_T = 0;
+    std::size_t valid = 0, missing = 0, no_solution = 0, no_solution_other = 0, no_solution_T = 0;
     void add(const Counts& c) {
         valid += c.valid;
         missing += c.missing;
         no_solution += c.no_solution;
-        no_solution_exponential += c.no_solution_exponential;
+        no_solution_other += c.no_solution_other;
         no_solution_T += c.no_solution_T;
     }
 };
@@ -616,32 +615,43 @@ inline std::uint64_t mask_of(bool condition) {
 }
 
 // A row of a flat sample's per-pixel map into its layers, every cell written once: from the
-// pixels' state (as a double, PixelState), ratio, var(ln ratio) and both correlations' σ/T and
-// slope d(σ/T)/d ln ratio — all NaN where there is no estimate (state ≠ 0, or a ratio the table
-// does not invert), so the layers are their conversions: E1/E2, σ/T, sd(σ/T) = |slope| ·
-// sd(ln ratio). The class by the primary correlation's σ/T (`klass`: the class as a double, a
-// row of scratch, narrowed to the class layer after) and its sums. In 64-bit masks, without
-// branches, so that the compiler vectorises the loop.
+// pixels' state (as a double, PixelState), ratio, var(ln ratio) and σ/T and slope d(σ/T)/d ln
+// ratio of the primary correlation (MapOptions::correlation; xo/so: of the other, kOther) — all
+// NaN where there is no estimate (state ≠ 0, or a ratio the table does not invert), so the
+// layers are their conversions: σ/T, sd(σ/T) = |slope| · sd(ln ratio) (and E1/E2, kRatio). The
+// class by the primary σ/T (`klass`: the class as a double, a row of scratch, narrowed to the
+// class layer after) and its sums. In 64-bit masks, without branches, so that the compiler
+// vectorises the loop.
+struct FlatRowIn {
+    const double *ratio, *var, *state, *xp, *sp, *xo, *so;
+    double slightly, very;
+};
+struct FlatRowOut {
+    float *ratio, *p, *pse, *o, *ose;
+    double* klass;
+    std::uint8_t* cls;
+};
+template <bool kOther, bool kRatio>
 [[gnu::always_inline]] inline RowCounts write_flat_row_body(
     std::size_t n, const double* __restrict ratio, const double* __restrict var,
-    const double* __restrict state, const double* __restrict xg, const double* __restrict sg,
-    const double* __restrict xe, const double* __restrict se, bool gaussian, double slightly,
-    double very, float* __restrict e12, float* __restrict g, float* __restrict gse,
-    float* __restrict e, float* __restrict ese, double* __restrict klass,
-    std::uint8_t* __restrict cls) {
-    const double* __restrict xp = gaussian ? xg : xe;
-    const double* __restrict xo = gaussian ? xe : xg;
+    const double* __restrict state, const double* __restrict xp, const double* __restrict sp,
+    const double* __restrict xo, const double* __restrict so, double slightly, double very,
+    float* __restrict e12, float* __restrict lp, float* __restrict lpse, float* __restrict lo,
+    float* __restrict lose, double* __restrict klass, std::uint8_t* __restrict cls) {
     std::uint64_t valid = 0, valid_other = 0, missing = 0, n0 = 0, n1 = 0, n2 = 0;
     double s0 = 0, s1 = 0, s2 = 0, q0 = 0, q1 = 0, q2 = 0;
     // (The class sums in lanes: their order of addition is the build's, not the threads'.)
 #pragma omp simd reduction(+ : valid, valid_other, missing, n0, n1, n2, s0, s1, s2, q0, q1, q2)
     for (std::size_t i = 0; i < n; ++i) {
         const double p = xp[i], sd = std::sqrt(var[i]);
-        e12[i] = static_cast<float>(ratio[i]);
-        g[i] = static_cast<float>(xg[i]);
-        gse[i] = static_cast<float>(std::abs(sg[i]) * sd);
-        e[i] = static_cast<float>(xe[i]);
-        ese[i] = static_cast<float>(std::abs(se[i]) * sd);
+        if constexpr (kRatio) e12[i] = static_cast<float>(ratio[i]);
+        lp[i] = static_cast<float>(p);
+        lpse[i] = static_cast<float>(std::abs(sp[i]) * sd);
+        if constexpr (kOther) {
+            lo[i] = static_cast<float>(xo[i]);
+            lose[i] = static_cast<float>(std::abs(so[i]) * sd);
+            valid_other += xo[i] == xo[i] ? 1 : 0;
+        }
         const std::uint64_t none = mask_of(p != p);
         const std::uint64_t m0 = mask_of(p < slightly), m2 = mask_of(p > very);
         const std::uint64_t m1 = ~none & ~m0 & ~m2;
@@ -649,7 +659,6 @@ inline std::uint64_t mask_of(bool condition) {
                                          (std::bit_cast<std::uint64_t>(2.0) & m2) |
                                          (std::bit_cast<std::uint64_t>(255.0) & none));
         valid += 1 & ~none;
-        valid_other += xo[i] == xo[i] ? 1 : 0;
         missing += state[i] == 1.0 ? 1 : 0;
         // The layer's value (a float), as row_class_sums reads it.
         const auto bits = std::bit_cast<std::uint64_t>(static_cast<double>(static_cast<float>(p)));
@@ -666,34 +675,46 @@ inline std::uint64_t mask_of(bool condition) {
         q2 += v2 * v2;
     }
     for (std::size_t i = 0; i < n; ++i) cls[i] = static_cast<std::uint8_t>(klass[i]);
-    // Every pixel is an estimate, missing, or without a solution.
-    RowCounts counts{valid, missing, n - valid - missing, n - valid_other - missing, {}};
+    // Every pixel is an estimate, missing, or without a solution (the other correlation's
+    // count: kOther only).
+    RowCounts counts{
+        valid, missing, n - valid - missing, kOther ? n - valid_other - missing : 0, {}};
     counts.classes[0] = {n0, s0, q0};
     counts.classes[1] = {n1, s1, q1};
     counts.classes[2] = {n2, s2, q2};
     return counts;
 }
 
+template <bool kOther, bool kRatio>
+RowCounts write_flat_row_baseline(std::size_t n, const FlatRowIn& in, const FlatRowOut& out) {
+    return write_flat_row_body<kOther, kRatio>(n, in.ratio, in.var, in.state, in.xp, in.sp, in.xo,
+                                               in.so, in.slightly, in.very, out.ratio, out.p,
+                                               out.pse, out.o, out.ose, out.klass, out.cls);
+}
 // write_flat_row_body built for AVX2 and for the baseline (SSE2, where its 64-bit masks do not
 // vectorise), the processor's pick at run time: the same arithmetic (ISO C++ does not contract
 // into FMA), so the same layers either way.
-[[gnu::target("avx2")]] RowCounts write_flat_row_avx2(
-    std::size_t n, const double* ratio, const double* var, const double* state, const double* xg,
-    const double* sg, const double* xe, const double* se, bool gaussian, double slightly,
-    double very, float* e12, float* g, float* gse, float* e, float* ese, double* klass,
-    std::uint8_t* cls) {
-    return write_flat_row_body(n, ratio, var, state, xg, sg, xe, se, gaussian, slightly, very, e12,
-                               g, gse, e, ese, klass, cls);
+template <bool kOther, bool kRatio>
+[[gnu::target("avx2")]] RowCounts write_flat_row_avx2(std::size_t n, const FlatRowIn& in,
+                                                      const FlatRowOut& out) {
+    return write_flat_row_body<kOther, kRatio>(n, in.ratio, in.var, in.state, in.xp, in.sp, in.xo,
+                                               in.so, in.slightly, in.very, out.ratio, out.p,
+                                               out.pse, out.o, out.ose, out.klass, out.cls);
 }
-RowCounts write_flat_row(std::size_t n, const double* ratio, const double* var, const double* state,
-                         const double* xg, const double* sg, const double* xe, const double* se,
-                         bool gaussian, double slightly, double very, float* e12, float* g,
-                         float* gse, float* e, float* ese, double* klass, std::uint8_t* cls) {
-    if (has_avx2())
-        return write_flat_row_avx2(n, ratio, var, state, xg, sg, xe, se, gaussian, slightly, very,
-                                   e12, g, gse, e, ese, klass, cls);
-    return write_flat_row_body(n, ratio, var, state, xg, sg, xe, se, gaussian, slightly, very, e12,
-                               g, gse, e, ese, klass, cls);
+// The other correlation's layers written where out.o is not null, E1/E2 where out.ratio is not.
+RowCounts write_flat_row(std::size_t n, const FlatRowIn& in, const FlatRowOut& out) {
+    const bool avx2 = has_avx2(), other = out.o != nullptr, ratio = out.ratio != nullptr;
+    if (other && ratio)
+        return avx2 ? write_flat_row_avx2<true, true>(n, in, out)
+                    : write_flat_row_baseline<true, true>(n, in, out);
+    if (other)
+        return avx2 ? write_flat_row_avx2<true, false>(n, in, out)
+                    : write_flat_row_baseline<true, false>(n, in, out);
+    if (ratio)
+        return avx2 ? write_flat_row_avx2<false, true>(n, in, out)
+                    : write_flat_row_baseline<false, true>(n, in, out);
+    return avx2 ? write_flat_row_avx2<false, false>(n, in, out)
+                : write_flat_row_baseline<false, false>(n, in, out);
 }
 
 // Evaluates cells into the layers of the map (one copy per thread: its own hints and counts).
@@ -761,7 +782,7 @@ class Evaluator {
         }
         const bool gaussian = o_.correlation == Correlation::Gaussian;
         const bool has_primary = gaussian ? g : e;
-        if (!(gaussian ? e : g)) ++counts_.no_solution_exponential;
+        if (!(gaussian ? e : g)) ++counts_.no_solution_other;
         if (o_.sigma_um) {
             const RatioInverseTable::Value& vp = gaussian ? vg : ve;
             std::optional<Estimate> primary;
@@ -778,15 +799,21 @@ class Evaluator {
             x, o_.slightly_rough_max_sigma_over_T, o_.very_rough_min_sigma_over_T));
     }
 
-    // A flat sample without σ (the layers E1/E2, σ/T and its error of both correlations, the
-    // class): a row of pixels from `begin`, every cell written once (no fill first).
+    // A flat sample without σ (σ/T and its error, the class; the other correlation's σ/T and
+    // error and E1/E2 where their layers are made): a row of pixels from `begin`, every cell
+    // written once (no fill first).
     bool fast_flat() const { return flat_ && !o_.sigma_um; }
     // Returns the row's class sums.
     ClassSums evaluate_flat_row(std::size_t begin, std::size_t count, const double* ratio,
                                 const double* var_log_ratio, const double* state) {
-        for (auto* v : {&xg_, &sg_, &xe_, &se_, &klass_}) v->resize(count);
-        const bool pending_g = table_g_.find_ratio_bins(count, ratio, xg_.data(), sg_.data());
-        const bool pending_e = table_e_.find_ratio_bins(count, ratio, xe_.data(), se_.data());
+        const bool gaussian = o_.correlation == Correlation::Gaussian;
+        const bool other = !(gaussian ? map_.sigma_over_T_exponential.empty()
+                                      : map_.sigma_over_T_gaussian.empty());
+        for (auto* v : {&xp_, &sp_, &xo_, &so_, &klass_}) v->resize(count);
+        const RatioInverseTable& tp = gaussian ? table_g_ : table_e_;
+        const RatioInverseTable& to = gaussian ? table_e_ : table_g_;
+        const bool pending_p = tp.find_ratio_bins(count, ratio, xp_.data(), sp_.data());
+        const bool pending_o = other && to.find_ratio_bins(count, ratio, xo_.data(), so_.data());
         // The ratios outside the bins (few, or none): find at ln ratio (NaN stays where the
         // table has no solution).
         const auto rest = [&](const RatioInverseTable& table, std::vector<double>& x,
@@ -799,21 +826,35 @@ class Evaluator {
                 slope[i] = v.dx_dlog_ratio;
             }
         };
-        if (pending_g) rest(table_g_, xg_, sg_, hint_g_);
-        if (pending_e) rest(table_e_, xe_, se_, hint_e_);
-        const bool gaussian = o_.correlation == Correlation::Gaussian;
-        const RowCounts c = write_flat_row(
-            count, ratio, var_log_ratio, state, xg_.data(), sg_.data(), xe_.data(), se_.data(),
-            gaussian, o_.slightly_rough_max_sigma_over_T, o_.very_rough_min_sigma_over_T,
-            map_.E1_over_E2.data() + begin, map_.sigma_over_T_gaussian.data() + begin,
-            map_.sigma_over_T_gaussian_stderr.data() + begin,
-            map_.sigma_over_T_exponential.data() + begin,
-            map_.sigma_over_T_exponential_stderr.data() + begin, klass_.data(),
-            map_.roughness_class.data() + begin);
+        if (pending_p) rest(tp, xp_, sp_, gaussian ? hint_g_ : hint_e_);
+        if (pending_o) rest(to, xo_, so_, gaussian ? hint_e_ : hint_g_);
+        MapLayerValues& lp = gaussian ? map_.sigma_over_T_gaussian : map_.sigma_over_T_exponential;
+        MapLayerValues& lpse =
+            gaussian ? map_.sigma_over_T_gaussian_stderr : map_.sigma_over_T_exponential_stderr;
+        MapLayerValues& lo = gaussian ? map_.sigma_over_T_exponential : map_.sigma_over_T_gaussian;
+        MapLayerValues& lose =
+            gaussian ? map_.sigma_over_T_exponential_stderr : map_.sigma_over_T_gaussian_stderr;
+        const FlatRowIn in{ratio,
+                           var_log_ratio,
+                           state,
+                           xp_.data(),
+                           sp_.data(),
+                           xo_.data(),
+                           so_.data(),
+                           o_.slightly_rough_max_sigma_over_T,
+                           o_.very_rough_min_sigma_over_T};
+        const FlatRowOut out{map_.E1_over_E2.empty() ? nullptr : map_.E1_over_E2.data() + begin,
+                             lp.data() + begin,
+                             lpse.data() + begin,
+                             other ? lo.data() + begin : nullptr,
+                             other ? lose.data() + begin : nullptr,
+                             klass_.data(),
+                             map_.roughness_class.data() + begin};
+        const RowCounts c = write_flat_row(count, in, out);
         counts_.valid += c.valid;
         counts_.missing += c.missing;
         counts_.no_solution += c.no_solution;
-        counts_.no_solution_exponential += c.no_solution_other;
+        counts_.no_solution_other += c.no_solution_other;
         return c.classes;
     }
 
@@ -856,7 +897,7 @@ class Evaluator {
         }
         const std::optional<Estimate>& primary = o_.correlation == Correlation::Gaussian ? g : e;
         const std::optional<Estimate>& other = o_.correlation == Correlation::Gaussian ? e : g;
-        if (!other) ++counts_.no_solution_exponential;
+        if (!other) ++counts_.no_solution_other;
         if (o_.sigma_um) estimate_T(index, lr, sd_lr, primary, geom1, geom2);
         if (!primary) {
             ++counts_.no_solution;
@@ -957,8 +998,9 @@ class Evaluator {
     std::optional<RoughnessClass> flat_g_class_;
     std::size_t hint_g_ = 0, hint_e_ = 0, hint_t_ = 0, hint_t2_ = 0;
     Counts counts_;
-    // A row's σ/T and slopes, and its class as a double (evaluate_flat_row).
-    std::vector<double> xg_, sg_, xe_, se_, klass_;
+    // A row's σ/T and slopes (primary, other correlation), and its class as a double
+    // (evaluate_flat_row).
+    std::vector<double> xp_, sp_, xo_, so_, klass_;
 };
 
 // A cell without an estimate has no class (its float layers stay NaN).
@@ -970,7 +1012,7 @@ void mark_no_class(RoughnessMap& map, std::size_t index) {
 // A cell whose ratio no model produces (both correlations).
 void mark_no_solution(Evaluator& ev, RoughnessMap& map, std::size_t index) {
     ++ev.counts().no_solution;
-    ++ev.counts().no_solution_exponential;
+    ++ev.counts().no_solution_other;
     mark_no_class(map, index);
 }
 
@@ -1263,7 +1305,7 @@ void pixel_map(const std::vector<MapCapture>& captures, const MapOptions& o, Eva
                     ++ev.counts().missing;
                 } else if (st == PixelState::NoSolution) {
                     ++ev.counts().no_solution;
-                    ++ev.counts().no_solution_exponential;
+                    ++ev.counts().no_solution_other;
                 } else if (ev.flat()) {
                     ev.evaluate_flat(index, ratio[x], std::sqrt(var[x]));
                 } else {
@@ -1319,9 +1361,10 @@ void summarise(const std::vector<MapCapture>& captures, const MapOptions& o, Rou
             continue;
         }
         ++ra.classes[c];
-        if (std::isfinite(map.sigma_over_T_gaussian[i]))
+        // (A normal map makes both layers; a flat sample pools ln E1/E2 below.)
+        if (!map.sigma_over_T_gaussian.empty() && std::isfinite(map.sigma_over_T_gaussian[i]))
             ra.gaussian.add(map.sigma_over_T_gaussian[i]);
-        if (std::isfinite(map.sigma_over_T_exponential[i]))
+        if (!map.sigma_over_T_exponential.empty() && std::isfinite(map.sigma_over_T_exponential[i]))
             ra.exponential.add(map.sigma_over_T_exponential[i]);
     }
     for (std::size_t c = 0; c < 3; ++c) {
@@ -1395,10 +1438,25 @@ RoughnessMap roughness_map(const std::vector<MapCapture>& captures, const MapOpt
     const std::size_t registration_warning_at = map.warnings.size();
     const std::size_t cells = map.width * map.height;
     // The layers without a fill: each band's thread writes every cell of its rows (clear_rows).
-    for (auto* layer :
-         {&map.E1_over_E2, &map.sigma_over_T_gaussian, &map.sigma_over_T_gaussian_stderr,
-          &map.sigma_over_T_exponential, &map.sigma_over_T_exponential_stderr})
-        resize_large_uninitialised(*layer, cells);
+    // A flat sample's per-pixel map without σ makes only the layers asked for (and E1/E2 for
+    // the regions' pooled σ/T, dropped after); the other maps make all of them and drop those
+    // not asked for at the end (tiles are few; cells evaluated one by one write every layer).
+    const bool gaussian = o.correlation == Correlation::Gaussian;
+    const bool lean = o.window_px == 1 && o.normal_map.empty() && !o.sigma_um;
+    MapLayerValues& primary = gaussian ? map.sigma_over_T_gaussian : map.sigma_over_T_exponential;
+    MapLayerValues& primary_stderr =
+        gaussian ? map.sigma_over_T_gaussian_stderr : map.sigma_over_T_exponential_stderr;
+    MapLayerValues& other = gaussian ? map.sigma_over_T_exponential : map.sigma_over_T_gaussian;
+    MapLayerValues& other_stderr =
+        gaussian ? map.sigma_over_T_exponential_stderr : map.sigma_over_T_gaussian_stderr;
+    resize_large_uninitialised(primary, cells);
+    resize_large_uninitialised(primary_stderr, cells);
+    if (!lean || o.both_correlations) {
+        resize_large_uninitialised(other, cells);
+        resize_large_uninitialised(other_stderr, cells);
+    }
+    if (!lean || o.ratio_layer || !o.region_labels.empty())
+        resize_large_uninitialised(map.E1_over_E2, cells);
     resize_large_uninitialised(map.roughness_class, cells);
     if (o.sigma_um) {
         resize_large_uninitialised(map.T_um, cells);
@@ -1478,8 +1536,13 @@ RoughnessMap roughness_map(const std::vector<MapCapture>& captures, const MapOpt
     map.valid = counts.valid;
     map.missing = counts.missing;
     map.no_solution = counts.no_solution;
-    map.no_solution_exponential = counts.no_solution_exponential;
+    if (o.both_correlations) map.no_solution_other = counts.no_solution_other;
     summarise(captures, o, map, cell_region, row_classes);
+    if (!o.both_correlations) {
+        other = MapLayerValues();
+        other_stderr = MapLayerValues();
+    }
+    if (!o.ratio_layer) map.E1_over_E2 = MapLayerValues();
     if (map.no_solution > 0)
         map.warnings.push_back(concat("roughness map: ", std::to_string(map.no_solution), " of ",
                                       std::to_string(cells),

@@ -201,7 +201,13 @@ Json to_json(const image::RoughnessMap& m) {
     out["valid"] = m.valid;
     out["missing"] = m.missing;
     out["no_solution"] = m.no_solution;
-    out["no_solution_exponential"] = m.no_solution_exponential;
+    // Of the other correlation: null unless both correlations' layers were made.
+    out["no_solution_other_correlation"] =
+        m.no_solution_other ? Json(*m.no_solution_other) : Json(nullptr);
+    Json layers = Json::array();
+    for (const MapLayer& layer : map_float_layers(m)) layers.push_back(layer.name);
+    for (const MapClassLayer& layer : map_class_layers(m)) layers.push_back(layer.name);
+    out["layers"] = layers;
     if (m.registration) {
         Json r;
         r["shift_x_px"] = number(m.registration->shift_x_px);
@@ -243,18 +249,19 @@ Json to_json(const image::RoughnessMap& m) {
 }
 
 std::vector<MapLayer> map_float_layers(const image::RoughnessMap& m) {
-    std::vector<MapLayer> layers{
+    const std::vector<MapLayer> all{
         {"sigma_over_T_gaussian", &m.sigma_over_T_gaussian},
         {"sigma_over_T_gaussian_stderr", &m.sigma_over_T_gaussian_stderr},
         {"sigma_over_T_exponential", &m.sigma_over_T_exponential},
         {"sigma_over_T_exponential_stderr", &m.sigma_over_T_exponential_stderr},
         {"E1_over_E2", &m.E1_over_E2},
+        {"T_um", &m.T_um},
+        {"T_um_stderr", &m.T_um_stderr},
     };
-    if (!m.T_um.empty()) {
-        layers.push_back({"T_um", &m.T_um});
-        layers.push_back({"T_um_stderr", &m.T_um_stderr});
-    }
-    return layers;
+    std::vector<MapLayer> made;  // (the layers the map made)
+    for (const MapLayer& layer : all)
+        if (!layer.values->empty()) made.push_back(layer);
+    return made;
 }
 
 std::vector<MapClassLayer> map_class_layers(const image::RoughnessMap& m) {

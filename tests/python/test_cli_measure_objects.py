@@ -198,9 +198,15 @@ def test_map_regions_recover_the_truth_and_files_are_written(flat_map, tmp_path)
         assert err > 0 and abs(value - truth[r["name"]]) <= 4 * err, (r["name"], value, err)
         counts = r["class_counts"]
         assert counts[classes[r["name"]]] >= 0.95 * sum(counts.values()), (r["name"], counts)
-    # Files: every float layer as .tiff and .npy, PNGs, the class map.
-    for name in ("sigma_over_T_gaussian", "sigma_over_T_exponential", "E1_over_E2"):
+    # Files: every float layer made as .tiff and .npy, PNGs, the class map; by default the
+    # layers of the request's correlation (Gaussian) only.
+    for name in ("sigma_over_T_gaussian", "sigma_over_T_gaussian_stderr"):
         assert (out / f"{name}.tiff").is_file() and (out / f"{name}.npy").is_file()
+    for name in ("sigma_over_T_exponential", "E1_over_E2"):
+        assert not (out / f"{name}.tiff").exists()
+    assert m["layers"] == ["sigma_over_T_gaussian", "sigma_over_T_gaussian_stderr",
+                           "roughness_class"]
+    assert m["no_solution_other_correlation"] is None
     assert (out / "sigma_over_T_gaussian.png").is_file()
     assert (out / "roughness_class.png").is_file()
     assert sorted(m["files"]) == sorted(p.name for p in out.iterdir())
@@ -227,6 +233,33 @@ def test_map_regions_recover_the_truth_and_files_are_written(flat_map, tmp_path)
     np.testing.assert_array_equal(back["flags"] & 1, (layer >= 1).astype(np.uint8))
     np.testing.assert_array_equal(back["values"][0][~missing], layer[~missing])
     assert (back["values"][0][missing] == 0).all()
+
+
+def test_map_layers_of_both_correlations_and_the_ratio_on_request(flat_map, tmp_path):
+    def ask(doc):
+        doc["maps"].update(both_correlations=True, ratio_layer=True)
+
+    out = tmp_path / "maps"
+    doc = json.loads(run(edited(flat_map, "layers", ask), "--json", "--maps", out).stdout)
+    m = doc["map"]
+    names = ["sigma_over_T_gaussian", "sigma_over_T_gaussian_stderr", "sigma_over_T_exponential",
+             "sigma_over_T_exponential_stderr", "E1_over_E2"]
+    assert m["layers"] == names + ["roughness_class"]
+    for name in names:
+        assert (out / f"{name}.tiff").is_file() and (out / f"{name}.npy").is_file()
+    assert m["no_solution_other_correlation"] == 0
+    # The exponential layer inverts the same ratios (σ/T growing with the Gaussian's across the
+    # three regions), and the ratio layer is E1/E2 > 0.
+    g = np.load(out / "sigma_over_T_gaussian.npy")
+    e = np.load(out / "sigma_over_T_exponential.npy")
+    r = np.load(out / "E1_over_E2.npy")
+    ok = np.isfinite(g) & np.isfinite(e)
+    assert ok.mean() > 0.9 and (r[ok] > 0).all()
+    assert np.corrcoef(g[ok], e[ok])[0, 1] > 0.9
+    # A layer switch that is not a boolean is refused, naming the key.
+    message = fails(EXIT_DATA, edited(flat_map, "bad-layers",
+                                       lambda d: d["maps"].update(ratio_layer="yes")))
+    assert "maps.ratio_layer" in message
 
 
 def test_a_shifted_pair_is_refused_with_the_shift(flat_map, tmp_path):

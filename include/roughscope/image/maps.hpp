@@ -248,6 +248,13 @@ struct MapOptions {
     RegistrationOptions registration;
     double slightly_rough_max_sigma_over_T = kSlightlyRoughMaxSigmaOverT;
     double very_rough_min_sigma_over_T = kVeryRoughMinSigmaOverT;
+    // Layers beyond those of every map (σ/T of `correlation`, its standard error and the class
+    // by σ/T; with σ known, T, its error and the class by g): σ/T and its standard error of the
+    // other correlation too, and the ratio E1/E2. (Off by default: a 24-MP per-pixel map is
+    // 9 bytes per pixel without them, 21 with both.) The region statistics give both
+    // correlations either way.
+    bool both_correlations = false;
+    bool ratio_layer = false;
     // Non-flat object: 3 floats per pixel (n_x, n_y, n_z, camera frame), row-major; a non-finite
     // normal marks a pixel off the object (not used). Empty: a flat sample.
     std::span<const float> normal_map;
@@ -292,8 +299,10 @@ struct RoughnessMap {
     std::size_t height = 0;
     std::size_t window_px = 1;
     std::size_t image_width = 0, image_height = 0;
-    // Layers, width · height, row-major, NaN where missing. (DefaultInitAllocator: the map
-    // writes every cell once, each band of rows from its own thread, instead of a fill first.)
+    // Layers, width · height, row-major, NaN where missing; empty where not made. σ/T and its
+    // error of MapOptions::correlation always, of the other correlation with
+    // MapOptions::both_correlations; E1/E2 with MapOptions::ratio_layer. (DefaultInitAllocator:
+    // the map writes every cell once, each band of rows from its own thread, not a fill first.)
     MapLayerValues E1_over_E2;
     MapLayerValues sigma_over_T_gaussian, sigma_over_T_gaussian_stderr;
     MapLayerValues sigma_over_T_exponential, sigma_over_T_exponential_stderr;
@@ -304,7 +313,8 @@ struct RoughnessMap {
     std::size_t valid = 0;            // pixels/tiles with a σ/T (of MapOptions::correlation)
     std::size_t missing = 0;          // too few used pixels (flagged, off the object)
     std::size_t no_solution = 0;      // a ratio the model does not produce
-    std::size_t no_solution_exponential = 0;  // the same for the other layer
+    // The same for the other correlation (MapOptions::both_correlations only).
+    std::optional<std::size_t> no_solution_other;
     std::optional<Registration> registration;
     std::array<ClassStatistics, 3> classes;
     std::vector<RegionMapStatistics> regions;

@@ -30,9 +30,10 @@ Json to_json(const image::SphereResult& sphere);
 // are written as files by the CLI and returned as arrays by the Python module).
 Json to_json(const image::RoughnessMap& map);
 
-// The float layers of a map by name ("sigma_over_T_gaussian", "sigma_over_T_gaussian_stderr",
-// "sigma_over_T_exponential", "sigma_over_T_exponential_stderr", "E1_over_E2", and with σ known
-// "T_um", "T_um_stderr"), NaN where missing; the class layers ("roughness_class", and with σ
+// The float layers the map made, by name ("sigma_over_T_gaussian", "sigma_over_T_gaussian_stderr",
+// "sigma_over_T_exponential", "sigma_over_T_exponential_stderr" — of MapOptions::correlation,
+// of both with both_correlations —, "E1_over_E2" with ratio_layer, and with σ known "T_um",
+// "T_um_stderr"), NaN where missing; the class layers ("roughness_class", and with σ
 // "roughness_class_g") as kClass* codes. The CLI writes these as files, the Python module returns
 // them as arrays, under the same names.
 struct MapLayer {

@@ -122,6 +122,7 @@ TEST(RoughnessMap, NoiseFreeTilesEqualTheScalarEstimator) {
         MapOptions o;
         o.window_px = window;
         o.check_registration = false;
+        o.both_correlations = true;
         const RoughnessMap map = roughness_map(flat_captures(p), o);
         double worst = 0.0;
         for (const std::size_t ty : {std::size_t{0}, map.height / 2, map.height - 1})
@@ -389,6 +390,7 @@ TEST(RoughnessMap, UncertaintyIsCalibrated) {
         for (const std::size_t window : {std::size_t{1}, std::size_t{8}}) {
             MapOptions o;
             o.window_px = window;
+            o.correlation = c;  // (its layers only)
             const RoughnessMap map = roughness_map(flat_captures(p), o);
             const auto& v = c == Correlation::Gaussian ? map.sigma_over_T_gaussian
                                                        : map.sigma_over_T_exponential;
@@ -446,6 +448,8 @@ TEST(RoughnessMap, PixelMapEqualsItsDefinition) {
         o.window_px = 1;
         o.threads = std::max<std::size_t>(threads, 1);
         o.check_registration = false;
+        o.both_correlations = true;
+        o.ratio_layer = true;
         // threads 0: one thread, the baseline build of the row loops (not AVX2).
         const bool before = allow_avx2_in_maps(threads != 0);
         const RoughnessMap map = roughness_map(flat_captures(p), o);
@@ -841,6 +845,8 @@ TEST(RoughnessMap, VectorBuildsGiveTheSameMap) {
     MapOptions o;
     o.window_px = 1;
     o.check_registration = false;
+    o.both_correlations = true;
+    o.ratio_layer = true;
     const RoughnessMap fast = roughness_map(flat_captures(p), o);
     const bool before = allow_avx2_in_maps(false);
     const RoughnessMap baseline = roughness_map(flat_captures(p), o);
@@ -874,6 +880,7 @@ TEST(RoughnessMap, ThreadsDoNotChangeTheResult) {
         MapOptions o;
         o.window_px = window;
         o.threads = 1;
+        o.both_correlations = true;
         const RoughnessMap one = roughness_map(flat_captures(p), o);
         o.threads = 3;
         const RoughnessMap three = roughness_map(flat_captures(p), o);
@@ -888,6 +895,116 @@ TEST(RoughnessMap, ThreadsDoNotChangeTheResult) {
         EXPECT_EQ(one.missing, three.missing);
         EXPECT_EQ(one.no_solution, three.no_solution);
     }
+}
+
+// The layers not asked for are not made (empty, and no count of the other correlation's
+// failures); the layers made are the same, bit for bit, as when every layer is asked for — per
+// pixel (each of the row loop's builds) and per tile, either correlation first, with regions
+// (their statistics pool ln E1/E2 and give both correlations either way).
+TEST(RoughnessMap, LayersNotAskedForAreNotMadeAndTheRestIsTheSame) {
+    const std::size_t W = 203, H = 71;
+    LitPair p = render_lit_pair(plane(W, H), {very_rough_truth(0.6)}, {}, {}, kTheta1, kTheta2, 5);
+    const RatioRange range = ratio_range_gaussian(kTheta1, kTheta2);
+    for (std::size_t i = 0; i < W * H; i += 41) p.a.flags[i] = kPixelSaturated;
+    for (std::size_t i = 7; i < W * H; i += 59)
+        p.b.values[i] = static_cast<float>(p.a.values[i] / (0.5 * range.lower));
+    std::vector<std::int32_t> labels(W * H);
+    for (std::size_t i = 0; i < W * H; ++i) labels[i] = (i % W) < W / 2 ? 0 : -1;
+    auto same = [](const MapLayerValues& a, const MapLayerValues& b) {
+        if (a.size() != b.size()) return false;
+        for (std::size_t i = 0; i < a.size(); ++i)
+            if (!((std::isnan(a[i]) && std::isnan(b[i])) || a[i] == b[i])) return false;
+        return true;
+    };
+    auto same_estimate = [](const std::optional<Estimate>& a, const std::optional<Estimate>& b) {
+        return a.has_value() == b.has_value() &&
+               (!a || (a->value == b->value && a->std_error == b->std_error));
+    };
+    const bool before = allow_avx2_in_maps(true);
+    for (const bool avx2 : {true, false})
+        for (const std::size_t window : {std::size_t{1}, std::size_t{4}})
+            for (const Correlation c : {Correlation::Gaussian, Correlation::Exponential})
+                for (const bool regions : {false, true}) {
+                    allow_avx2_in_maps(avx2);
+                    MapOptions o;
+                    o.window_px = window;
+                    o.correlation = c;
+                    o.check_registration = false;
+                    if (regions) {
+                        o.region_labels = labels;
+                        o.region_names = {"left"};
+                    }
+                    o.both_correlations = true;
+                    o.ratio_layer = true;
+                    const RoughnessMap full = roughness_map(flat_captures(p), o);
+                    ASSERT_TRUE(full.no_solution_other.has_value());
+                    EXPECT_GT(*full.no_solution_other, 0U);
+                    for (const bool both : {false, true})
+                        for (const bool ratio : {false, true}) {
+                            SCOPED_TRACE(::testing::Message()
+                                         << "avx2 " << avx2 << " window " << window
+                                         << " exponential " << (c == Correlation::Exponential)
+                                         << " regions " << regions << " both " << both << " ratio "
+                                         << ratio);
+                            o.both_correlations = both;
+                            o.ratio_layer = ratio;
+                            const RoughnessMap m = roughness_map(flat_captures(p), o);
+                            const bool g = c == Correlation::Gaussian;
+                            const auto& primary =
+                                g ? m.sigma_over_T_gaussian : m.sigma_over_T_exponential;
+                            const auto& primary_full =
+                                g ? full.sigma_over_T_gaussian : full.sigma_over_T_exponential;
+                            const auto& primary_se = g ? m.sigma_over_T_gaussian_stderr
+                                                       : m.sigma_over_T_exponential_stderr;
+                            const auto& primary_se_full = g ? full.sigma_over_T_gaussian_stderr
+                                                            : full.sigma_over_T_exponential_stderr;
+                            EXPECT_EQ(primary.size(), m.width * m.height);
+                            EXPECT_TRUE(same(primary, primary_full));
+                            EXPECT_TRUE(same(primary_se, primary_se_full));
+                            const auto& other =
+                                g ? m.sigma_over_T_exponential : m.sigma_over_T_gaussian;
+                            const auto& other_full =
+                                g ? full.sigma_over_T_exponential : full.sigma_over_T_gaussian;
+                            const auto& other_se = g ? m.sigma_over_T_exponential_stderr
+                                                     : m.sigma_over_T_gaussian_stderr;
+                            const auto& other_se_full = g ? full.sigma_over_T_exponential_stderr
+                                                          : full.sigma_over_T_gaussian_stderr;
+                            if (both) {
+                                EXPECT_TRUE(same(other, other_full));
+                                EXPECT_TRUE(same(other_se, other_se_full));
+                                EXPECT_EQ(m.no_solution_other, full.no_solution_other);
+                            } else {
+                                EXPECT_TRUE(other.empty());
+                                EXPECT_TRUE(other_se.empty());
+                                EXPECT_FALSE(m.no_solution_other.has_value());
+                            }
+                            if (ratio)
+                                EXPECT_TRUE(same(m.E1_over_E2, full.E1_over_E2));
+                            else
+                                EXPECT_TRUE(m.E1_over_E2.empty());
+                            EXPECT_TRUE(m.roughness_class == full.roughness_class);
+                            EXPECT_EQ(m.valid, full.valid);
+                            EXPECT_EQ(m.missing, full.missing);
+                            EXPECT_EQ(m.no_solution, full.no_solution);
+                            for (std::size_t k = 0; k < 3; ++k) {
+                                EXPECT_EQ(m.classes[k].count, full.classes[k].count);
+                                EXPECT_TRUE(same_estimate(m.classes[k].mean_sigma_over_T,
+                                                          full.classes[k].mean_sigma_over_T));
+                            }
+                            ASSERT_EQ(m.regions.size(), regions ? 1U : 0U);
+                            for (std::size_t k = 0; k < m.regions.size(); ++k) {
+                                const RegionMapStatistics &a = m.regions[k], &b = full.regions[k];
+                                EXPECT_EQ(a.count, b.count);
+                                EXPECT_TRUE(same_estimate(a.mean_sigma_over_T_gaussian,
+                                                          b.mean_sigma_over_T_gaussian));
+                                EXPECT_TRUE(same_estimate(a.mean_sigma_over_T_exponential,
+                                                          b.mean_sigma_over_T_exponential));
+                                EXPECT_TRUE(a.mean_sigma_over_T_gaussian.has_value());
+                                EXPECT_TRUE(a.mean_sigma_over_T_exponential.has_value());
+                            }
+                        }
+                }
+    allow_avx2_in_maps(before);
 }
 
 }  // namespace
