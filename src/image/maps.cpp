@@ -4,10 +4,12 @@
 #include <algorithm>
 #include <atomic>
 #include <bit>
+#include <cassert>
 #include <cmath>
 #include <cstdint>
 #include <exception>
 #include <limits>
+#include <memory>
 #include <optional>
 #include <string>
 #include <thread>
@@ -717,6 +719,12 @@ RowCounts write_flat_row(std::size_t n, const FlatRowIn& in, const FlatRowOut& o
                 : write_flat_row_baseline<false, false>(n, in, out);
 }
 
+// A flat sample's per-pixel map without σ: the row passes of evaluate_flat_row, which make only
+// the layers asked for (every other map evaluates cells one by one into every layer).
+bool lean_pixel_map(const MapOptions& o) {
+    return o.window_px == 1 && o.normal_map.empty() && !o.sigma_um;
+}
+
 // Evaluates cells into the layers of the map (one copy per thread: its own hints and counts).
 class Evaluator {
   public:
@@ -727,10 +735,18 @@ class Evaluator {
         model_.wavelength_um = o.wavelength_um;
         flat_ = o.normal_map.empty();
         if (flat_) {
-            table_g_ = RatioInverseTable::sigma_over_T(c1_.geometry, c2_.geometry,
-                                                       Correlation::Gaussian, model_, o.table);
-            table_e_ = RatioInverseTable::sigma_over_T(c1_.geometry, c2_.geometry,
-                                                       Correlation::Exponential, model_, o.table);
+            // The tables are shared by the threads' copies (read only). A lean per-pixel map
+            // needs only the primary correlation's, unless both layers or regions are asked for
+            // (the regions' pooled σ/T give both).
+            const bool both = !lean_pixel_map(o) || o.both_correlations || !o.region_labels.empty();
+            const auto build = [&](Correlation c) {
+                return std::make_shared<const RatioInverseTable>(RatioInverseTable::sigma_over_T(
+                    c1_.geometry, c2_.geometry, c, model_, o.table));
+            };
+            if (both || o.correlation == Correlation::Gaussian)
+                table_g_ = build(Correlation::Gaussian);
+            if (both || o.correlation == Correlation::Exponential)
+                table_e_ = build(Correlation::Exponential);
             map_.method = normal_view(c1_.geometry) && normal_view(c2_.geometry)
                               ? "table (Eq. 17/19)"
                               : "table (two-geometry model)";
@@ -745,13 +761,16 @@ class Evaluator {
                                    ? Regime::SlightlyRough
                                    : Regime::Series;
                     try {
-                        table_t_ = RatioInverseTable::correlation_length(
-                            c1_.geometry, c2_.geometry, *o.sigma_um, o.correlation, m, o.table);
+                        table_t_ = std::make_shared<const RatioInverseTable>(
+                            RatioInverseTable::correlation_length(c1_.geometry, c2_.geometry,
+                                                                  *o.sigma_um, o.correlation, m,
+                                                                  o.table));
                         if (o.sigma_um_stderr > 0.0) {
                             sigma_step_ = *o.sigma_um * 1e-4;
-                            table_t2_ = RatioInverseTable::correlation_length(
-                                c1_.geometry, c2_.geometry, *o.sigma_um + sigma_step_,
-                                o.correlation, m, o.table);
+                            table_t2_ = std::make_shared<const RatioInverseTable>(
+                                RatioInverseTable::correlation_length(c1_.geometry, c2_.geometry,
+                                                                      *o.sigma_um + sigma_step_,
+                                                                      o.correlation, m, o.table));
                         }
                     } catch (const NoSolution& e) {
                         map_.warnings.push_back(concat("T given σ: ", e.what()));
@@ -768,8 +787,8 @@ class Evaluator {
     void evaluate_flat(std::size_t index, double ratio, double sd_lr) {
         map_.E1_over_E2[index] = static_cast<float>(ratio);
         RatioInverseTable::Value vg, ve;
-        const bool g = table_g_.find_ratio(ratio, vg, hint_g_);
-        const bool e = table_e_.find_ratio(ratio, ve, hint_e_);
+        const bool g = table_g_->find_ratio(ratio, vg, hint_g_);
+        const bool e = table_e_->find_ratio(ratio, ve, hint_e_);
         if (g) {
             map_.sigma_over_T_gaussian[index] = static_cast<float>(vg.x);
             map_.sigma_over_T_gaussian_stderr[index] =
@@ -810,10 +829,10 @@ class Evaluator {
         const bool other = !(gaussian ? map_.sigma_over_T_exponential.empty()
                                       : map_.sigma_over_T_gaussian.empty());
         for (auto* v : {&xp_, &sp_, &xo_, &so_, &klass_}) v->resize(count);
-        const RatioInverseTable& tp = gaussian ? table_g_ : table_e_;
-        const RatioInverseTable& to = gaussian ? table_e_ : table_g_;
+        const RatioInverseTable& tp = gaussian ? *table_g_ : *table_e_;
+        const RatioInverseTable* to = gaussian ? table_e_.get() : table_g_.get();
         const bool pending_p = tp.find_ratio_bins(count, ratio, xp_.data(), sp_.data());
-        const bool pending_o = other && to.find_ratio_bins(count, ratio, xo_.data(), so_.data());
+        const bool pending_o = other && to->find_ratio_bins(count, ratio, xo_.data(), so_.data());
         // The ratios outside the bins (few, or none): find at ln ratio (NaN stays where the
         // table has no solution).
         const auto rest = [&](const RatioInverseTable& table, std::vector<double>& x,
@@ -827,7 +846,7 @@ class Evaluator {
             }
         };
         if (pending_p) rest(tp, xp_, sp_, gaussian ? hint_g_ : hint_e_);
-        if (pending_o) rest(to, xo_, so_, gaussian ? hint_e_ : hint_g_);
+        if (pending_o) rest(*to, xo_, so_, gaussian ? hint_e_ : hint_g_);
         MapLayerValues& lp = gaussian ? map_.sigma_over_T_gaussian : map_.sigma_over_T_exponential;
         MapLayerValues& lpse =
             gaussian ? map_.sigma_over_T_gaussian_stderr : map_.sigma_over_T_exponential_stderr;
@@ -859,6 +878,10 @@ class Evaluator {
     }
 
     bool flat() const { return flat_; }
+    // A flat sample's σ/T table of correlation c (null where it was not built).
+    const RatioInverseTable* sigma_over_T_table(Correlation c) const {
+        return c == Correlation::Gaussian ? table_g_.get() : table_e_.get();
+    }
 
     void evaluate(std::size_t index, const Cell& cell) {
         const double lr = cell.log_ratio;
@@ -867,9 +890,9 @@ class Evaluator {
         std::optional<Estimate> g, e;
         std::optional<Geometry> geom1, geom2;
         if (flat_) {
-            if (auto v = table_g_.lookup(lr, hint_g_))
+            if (auto v = table_g_->lookup(lr, hint_g_))
                 g = Estimate{v->x, std::abs(v->dx_dlog_ratio) * sd_lr};
-            if (auto v = table_e_.lookup(lr, hint_e_))
+            if (auto v = table_e_->lookup(lr, hint_e_))
                 e = Estimate{v->x, std::abs(v->dx_dlog_ratio) * sd_lr};
         } else {
             const double nn = cell.normal.norm();
@@ -992,8 +1015,7 @@ class Evaluator {
     RoughnessMap& map_;
     TwoGeometryOptions model_;
     bool flat_ = true;
-    RatioInverseTable table_g_, table_e_;
-    std::optional<RatioInverseTable> table_t_, table_t2_;
+    std::shared_ptr<const RatioInverseTable> table_g_, table_e_, table_t_, table_t2_;
     double sigma_step_ = 0.0;
     std::optional<RoughnessClass> flat_g_class_;
     std::size_t hint_g_ = 0, hint_e_ = 0, hint_t_ = 0, hint_t2_ = 0;
@@ -1336,7 +1358,7 @@ std::optional<Estimate> pooled_sigma_over_T(const RatioInverseTable& table,
     return Estimate{v->x, std::abs(v->dx_dlog_ratio) * mean->std_error};
 }
 
-void summarise(const std::vector<MapCapture>& captures, const MapOptions& o, RoughnessMap& map,
+void summarise(const Evaluator& tables, const MapOptions& o, RoughnessMap& map,
                const std::vector<std::int32_t>& cell_region,
                const std::vector<ClassSums>& row_classes) {
     ClassSums classes;
@@ -1375,17 +1397,10 @@ void summarise(const std::vector<MapCapture>& captures, const MapOptions& o, Rou
             map.valid > 0 ? static_cast<double>(s.count) / static_cast<double>(map.valid) : 0.0;
         s.mean_sigma_over_T = classes[c].mean();
     }
-    std::optional<RatioInverseTable> table_g, table_e;
-    if (o.normal_map.empty() && !regions.empty()) {
-        TwoGeometryOptions model;
-        model.factor = o.factor;
-        model.radiometry = o.radiometry;
-        model.wavelength_um = o.wavelength_um;
-        table_g = RatioInverseTable::sigma_over_T(captures[0].geometry, captures[1].geometry,
-                                                  Correlation::Gaussian, model, o.table);
-        table_e = RatioInverseTable::sigma_over_T(captures[0].geometry, captures[1].geometry,
-                                                  Correlation::Exponential, model, o.table);
-    }
+    // A flat sample with regions has both tables (Evaluator).
+    const RatioInverseTable* table_g = tables.sigma_over_T_table(Correlation::Gaussian);
+    const RatioInverseTable* table_e = tables.sigma_over_T_table(Correlation::Exponential);
+    assert(!o.normal_map.empty() || regions.empty() || (table_g && table_e));
     for (std::size_t k = 0; k < regions.size(); ++k) {
         RegionMapStatistics s;
         s.name = o.region_names[k];
@@ -1442,7 +1457,7 @@ RoughnessMap roughness_map(const std::vector<MapCapture>& captures, const MapOpt
     // the regions' pooled σ/T, dropped after); the other maps make all of them and drop those
     // not asked for at the end (tiles are few; cells evaluated one by one write every layer).
     const bool gaussian = o.correlation == Correlation::Gaussian;
-    const bool lean = o.window_px == 1 && o.normal_map.empty() && !o.sigma_um;
+    const bool lean = lean_pixel_map(o);
     MapLayerValues& primary = gaussian ? map.sigma_over_T_gaussian : map.sigma_over_T_exponential;
     MapLayerValues& primary_stderr =
         gaussian ? map.sigma_over_T_gaussian_stderr : map.sigma_over_T_exponential_stderr;
@@ -1537,7 +1552,7 @@ RoughnessMap roughness_map(const std::vector<MapCapture>& captures, const MapOpt
     map.missing = counts.missing;
     map.no_solution = counts.no_solution;
     if (o.both_correlations) map.no_solution_other = counts.no_solution_other;
-    summarise(captures, o, map, cell_region, row_classes);
+    summarise(prototype, o, map, cell_region, row_classes);
     if (!o.both_correlations) {
         other = MapLayerValues();
         other_stderr = MapLayerValues();

@@ -29,7 +29,7 @@ namespace roughscope::image {
 
 struct RegistrationOptions {
     // Larger images are correlated on their central crop of this side (pixels, ≥ 16).
-    std::size_t max_side_px = 1024;
+    std::size_t max_side_px = 512;
 };
 
 struct Registration {
