@@ -10,7 +10,8 @@
 // <rows> = 4096 is the 24-MP pair (5859 x 4096 = 24.0 MP, the size of the other image benchmarks;
 // 6000 x 4000 has the same pixel count); 256 a small one (the smoke run skips /4096).
 // Counters: time_vs_decode = (decode + map) / decode of the two files by read_image (one after
-// the other; decode + map reads them at once, as `measure` does);
+// the other; decode + map reads them at once, as `measure` does), each the best of 5 runs (this
+// VM's page faults move single runs by tens of percent);
 // time_vs_opencv_decode = the same over OpenCV's imread of the two files (IMREAD_UNCHANGED: the
 // decoding baseline of bench_measure.cpp, a decoder this project does not tune — read_image
 // itself is 3-7x faster than it since its buffers ask for huge pages); peak_vs_image = the peak
@@ -141,9 +142,9 @@ void BM_maps_map(benchmark::State& state, std::size_t window) {
     PairFiles p;
     make_pair(p, static_cast<std::size_t>(state.range(0)));
     for (auto _ : state) benchmark::DoNotOptimize(decode_and_map(p, window).valid);
-    const double t_decode = seconds_of([&] { decode_pair(p); }, 3);
-    const double t_opencv = seconds_of([&] { opencv_decode_pair(p); }, 3);
-    const double t_map = seconds_of([&] { (void)decode_and_map(p, window); }, 2);
+    const double t_decode = seconds_of([&] { decode_pair(p); }, 5);
+    const double t_opencv = seconds_of([&] { opencv_decode_pair(p); }, 5);
+    const double t_map = seconds_of([&] { (void)decode_and_map(p, window); }, 5);
     state.counters["time_vs_decode"] = t_map / t_decode;
     state.counters["time_vs_opencv_decode"] = t_map / t_opencv;
     const long one = peak_above_now_kb([&] {
