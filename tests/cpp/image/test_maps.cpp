@@ -1007,5 +1007,79 @@ TEST(RoughnessMap, LayersNotAskedForAreNotMadeAndTheRestIsTheSame) {
     allow_avx2_in_maps(before);
 }
 
+// A colour capture is read as its channel average and a capture's exposure scale s_k divides its
+// values: three equal channels give the one-channel map, and a capture stored 4× brighter with
+// s_k = 4 gives the same map — bit for bit (both are exact in binary), per pixel and per tile.
+// A non-finite value in any channel is refused, naming the capture.
+TEST(RoughnessMap, ColourChannelsAndExposureScalesAreTheStoredValuesBrightness) {
+    const std::size_t W = 97, H = 83;
+    LitPair p = render_lit_pair(plane(W, H), {very_rough_truth(0.8)}, {}, {}, kTheta1, kTheta2, 13);
+    for (std::size_t i = 0; i < W * H; i += 29) p.b.flags[i] = kPixelClippedLow;
+    auto colour = [](const LinearImage& mono) {
+        LinearImage c = mono;
+        c.channels = 3;
+        c.values.resize(3 * mono.values.size());
+        for (std::size_t ch = 0; ch < 3; ++ch)
+            std::copy(mono.values.begin(), mono.values.end(),
+                      c.values.begin() + static_cast<std::ptrdiff_t>(ch * mono.values.size()));
+        return c;
+    };
+    LinearImage brighter = p.b;
+    for (float& v : brighter.values) v *= 4.0f;
+    const LinearImage colour_a = colour(p.a), colour_b = colour(p.b);
+    auto same = [](const MapLayerValues& a, const MapLayerValues& b) {
+        if (a.size() != b.size() || a.empty()) return false;
+        for (std::size_t i = 0; i < a.size(); ++i)
+            if (!((std::isnan(a[i]) && std::isnan(b[i])) || a[i] == b[i])) return false;
+        return true;
+    };
+    for (const std::size_t window : {std::size_t{1}, std::size_t{5}}) {
+        SCOPED_TRACE(window);
+        MapOptions o;
+        o.window_px = window;
+        o.check_registration = false;
+        o.both_correlations = true;
+        o.ratio_layer = true;
+        const RoughnessMap mono = roughness_map(flat_captures(p), o);
+        EXPECT_GT(mono.valid, mono.width * mono.height / 2);
+        auto c = flat_captures(p);
+        c[0].image = &colour_a;
+        c[1].image = &colour_b;
+        const RoughnessMap col = roughness_map(c, o);
+        c = flat_captures(p);
+        c[1].image = &brighter;
+        c[1].exposure_scale = 4.0;
+        const RoughnessMap scaled = roughness_map(c, o);
+        for (const RoughnessMap* m : {&col, &scaled}) {
+            EXPECT_TRUE(same(m->E1_over_E2, mono.E1_over_E2));
+            EXPECT_TRUE(same(m->sigma_over_T_gaussian, mono.sigma_over_T_gaussian));
+            EXPECT_TRUE(same(m->sigma_over_T_gaussian_stderr, mono.sigma_over_T_gaussian_stderr));
+            EXPECT_TRUE(same(m->sigma_over_T_exponential, mono.sigma_over_T_exponential));
+            EXPECT_TRUE(m->roughness_class == mono.roughness_class);
+            EXPECT_EQ(m->valid, mono.valid);
+            EXPECT_EQ(m->missing, mono.missing);
+        }
+        // Without the exposure scale the brighter capture is a different ratio (4× smaller).
+        c[1].exposure_scale = 1.0;
+        const RoughnessMap unscaled = roughness_map(c, o);
+        EXPECT_FALSE(same(unscaled.E1_over_E2, mono.E1_over_E2));
+        // A NaN in the third channel of one pixel of the colour pair.
+        LinearImage broken = colour_b;
+        broken.values[2 * W * H + 40 * W + 50] = std::numeric_limits<float>::quiet_NaN();
+        c = flat_captures(p);
+        c[0].image = &colour_a;
+        c[1].image = &broken;
+        try {
+            (void)roughness_map(c, o);
+            ADD_FAILURE() << "a NaN in a channel was accepted";
+        } catch (const InvalidArgument& e) {
+            const std::string what = e.what();
+            EXPECT_NE(what.find(concat("at sample ", std::to_string(2 * W * H + 40 * W + 50))),
+                      std::string::npos)
+                << what;
+        }
+    }
+}
+
 }  // namespace
 }  // namespace roughscope::image
