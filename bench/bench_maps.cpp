@@ -10,8 +10,8 @@
 // <rows> = 4096 is the 24-MP pair (5859 x 4096 = 24.0 MP, the size of the other image benchmarks;
 // 6000 x 4000 has the same pixel count); 256 a small one (the smoke run skips /4096).
 // Counters: time_vs_decode = (decode + map) / decode of the two files by read_image (one after
-// the other; decode + map reads them at once, as `measure` does), each the best of 5 runs (this
-// VM's page faults move single runs by tens of percent);
+// the other; decode + map reads them at once, as `measure` does), each the best of 7 runs, the
+// two alternating (a shared VM's speed drifts by tens of percent within a run);
 // time_vs_opencv_decode = the same over OpenCV's imread of the two files (IMREAD_UNCHANGED: the
 // decoding baseline of bench_measure.cpp, a decoder this project does not tune — read_image
 // itself is 3-7x faster than it since its buffers ask for huge pages); peak_vs_image = the peak
@@ -43,6 +43,7 @@ namespace sim = roughscope::simulation;
 namespace img = roughscope::image;
 namespace fs = std::filesystem;
 using roughscope::bench::seconds_of;
+using roughscope::bench::seconds_of_interleaved;
 
 struct PairFiles {
     std::vector<fs::path> files;
@@ -142,9 +143,9 @@ void BM_maps_map(benchmark::State& state, std::size_t window) {
     PairFiles p;
     make_pair(p, static_cast<std::size_t>(state.range(0)));
     for (auto _ : state) benchmark::DoNotOptimize(decode_and_map(p, window).valid);
-    const double t_decode = seconds_of([&] { decode_pair(p); }, 5);
+    const auto [t_decode, t_map] = seconds_of_interleaved(
+        [&] { decode_pair(p); }, [&] { (void)decode_and_map(p, window); }, 7);
     const double t_opencv = seconds_of([&] { opencv_decode_pair(p); }, 5);
-    const double t_map = seconds_of([&] { (void)decode_and_map(p, window); }, 5);
     state.counters["time_vs_decode"] = t_map / t_decode;
     state.counters["time_vs_opencv_decode"] = t_map / t_opencv;
     const long one = peak_above_now_kb([&] {
