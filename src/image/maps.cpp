@@ -335,6 +335,23 @@ void RatioInverseTable::build_ratio_bins() {
 
 namespace {
 
+// The row loops' builds (the AVX-512 ones: target "avx512f,avx512dq,avx512vl,avx512bw"): the
+// processor's best instruction set up to the limit (limit_map_instruction_set).
+std::atomic<MapInstructionSet> isa_limit{MapInstructionSet::Avx512};
+MapInstructionSet processor_isa() {
+    static const MapInstructionSet best = [] {
+        if (__builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512dq") &&
+            __builtin_cpu_supports("avx512vl") && __builtin_cpu_supports("avx512bw"))
+            return MapInstructionSet::Avx512;
+        if (__builtin_cpu_supports("avx2")) return MapInstructionSet::Avx2;
+        return MapInstructionSet::Baseline;
+    }();
+    return best;
+}
+MapInstructionSet active_isa() {
+    return std::min(processor_isa(), isa_limit.load(std::memory_order_relaxed));
+}
+
 // The loop of find_ratio_bins (find_ratio's bin arithmetic, the bin's position t from the
 // mantissa's low bits as a double in [1, 2) minus 1 — exact, and without a 64-bit integer
 // conversion SSE2 lacks), inlined into a default and an AVX2 build of it.
@@ -385,6 +402,13 @@ namespace {
     ratio_bins_loop(n, ratio, bins, key_min, count, shift, sign, inv_anchor, x, slope, pending);
     return pending != 0;
 }
+[[gnu::target("avx512f,avx512dq,avx512vl,avx512bw")]] bool ratio_bins_avx512(
+    std::size_t n, const double* ratio, const double* bins, std::int64_t key_min,
+    std::int64_t count, int shift, double sign, double inv_anchor, double* x, double* slope) {
+    std::uint64_t pending = 0;
+    ratio_bins_loop(n, ratio, bins, key_min, count, shift, sign, inv_anchor, x, slope, pending);
+    return pending != 0;
+}
 
 bool ratio_bins_default(std::size_t n, const double* ratio, const double* bins,
                         std::int64_t key_min, std::int64_t count, int shift, double sign,
@@ -394,22 +418,19 @@ bool ratio_bins_default(std::size_t n, const double* ratio, const double* bins,
     return pending != 0;
 }
 
-std::atomic<bool> avx2_allowed{true};
-
-bool has_avx2() {
-    static const bool avx2 = __builtin_cpu_supports("avx2") != 0;
-    return avx2 && avx2_allowed.load(std::memory_order_relaxed);
-}
-
 }  // namespace
 
-bool allow_avx2_in_maps(bool allowed) {
-    return avx2_allowed.exchange(allowed, std::memory_order_relaxed);
+MapInstructionSet limit_map_instruction_set(MapInstructionSet highest) {
+    return isa_limit.exchange(highest, std::memory_order_relaxed);
 }
+MapInstructionSet map_instruction_set() { return active_isa(); }
 
 bool RatioInverseTable::find_ratio_bins(std::size_t n, const double* ratio, double* x,
                                         double* dx_dlog_ratio) const {
-    auto* run = has_avx2() ? ratio_bins_avx2 : ratio_bins_default;
+    const MapInstructionSet isa = active_isa();
+    auto* run = isa == MapInstructionSet::Avx512 ? ratio_bins_avx512
+                : isa == MapInstructionSet::Avx2 ? ratio_bins_avx2
+                                                 : ratio_bins_default;
     return run(n, ratio, ratio_bins_.data(), static_cast<std::int64_t>(ratio_bin_key_min_),
                static_cast<std::int64_t>(ratio_bins_.size() / 5), kRatioBinShift, anchor_sign_,
                inv_anchor_ratio_, x, dx_dlog_ratio);
@@ -548,8 +569,11 @@ struct Sums {
 // out = (p0 + p1 + p2)·scale (p1, p2 null: p0·scale); whether every value is finite — the sum of
 // finite floats in double is finite, and v − v is +0 for a finite v and NaN otherwise (an
 // integer OR of its bits, so that the compiler vectorises the loop).
-bool scaled_row_is_finite(std::size_t W, const float* __restrict p0, const float* __restrict p1,
-                          const float* __restrict p2, double scale, double* __restrict out) {
+[[gnu::always_inline]] inline bool scaled_row_is_finite_body(std::size_t W,
+                                                             const float* __restrict p0,
+                                                             const float* __restrict p1,
+                                                             const float* __restrict p2,
+                                                             double scale, double* __restrict out) {
     std::uint64_t not_finite = 0;
     if (p1 == nullptr) {
         for (std::size_t x = 0; x < W; ++x) {
@@ -565,6 +589,16 @@ bool scaled_row_is_finite(std::size_t W, const float* __restrict p0, const float
         }
     }
     return not_finite == 0;
+}
+[[gnu::target("avx512f,avx512dq,avx512vl,avx512bw")]] bool scaled_row_is_finite_avx512(
+    std::size_t W, const float* p0, const float* p1, const float* p2, double scale, double* out) {
+    return scaled_row_is_finite_body(W, p0, p1, p2, scale, out);
+}
+bool scaled_row_is_finite(std::size_t W, const float* p0, const float* p1, const float* p2,
+                          double scale, double* out) {
+    if (active_isa() == MapInstructionSet::Avx512)
+        return scaled_row_is_finite_avx512(W, p0, p1, p2, scale, out);
+    return scaled_row_is_finite_body(W, p0, p1, p2, scale, out);
 }
 
 // The brightness of one row of a capture: channel average / s_k. A non-finite value in the row
@@ -703,20 +737,34 @@ template <bool kOther, bool kRatio>
                                                in.so, in.slightly, in.very, out.ratio, out.p,
                                                out.pse, out.o, out.ose, out.klass, out.cls);
 }
+template <bool kOther, bool kRatio>
+[[gnu::target("avx512f,avx512dq,avx512vl,avx512bw")]] RowCounts write_flat_row_avx512(
+    std::size_t n, const FlatRowIn& in, const FlatRowOut& out) {
+    return write_flat_row_body<kOther, kRatio>(n, in.ratio, in.var, in.state, in.xp, in.sp, in.xo,
+                                               in.so, in.slightly, in.very, out.ratio, out.p,
+                                               out.pse, out.o, out.ose, out.klass, out.cls);
+}
+template <bool kOther, bool kRatio>
+RowCounts write_flat_row_of(MapInstructionSet isa, std::size_t n, const FlatRowIn& in,
+                            const FlatRowOut& out) {
+    switch (isa) {
+        case MapInstructionSet::Avx512:
+            return write_flat_row_avx512<kOther, kRatio>(n, in, out);
+        case MapInstructionSet::Avx2:
+            return write_flat_row_avx2<kOther, kRatio>(n, in, out);
+        case MapInstructionSet::Baseline:
+            break;
+    }
+    return write_flat_row_baseline<kOther, kRatio>(n, in, out);
+}
 // The other correlation's layers written where out.o is not null, E1/E2 where out.ratio is not.
 RowCounts write_flat_row(std::size_t n, const FlatRowIn& in, const FlatRowOut& out) {
-    const bool avx2 = has_avx2(), other = out.o != nullptr, ratio = out.ratio != nullptr;
-    if (other && ratio)
-        return avx2 ? write_flat_row_avx2<true, true>(n, in, out)
-                    : write_flat_row_baseline<true, true>(n, in, out);
-    if (other)
-        return avx2 ? write_flat_row_avx2<true, false>(n, in, out)
-                    : write_flat_row_baseline<true, false>(n, in, out);
-    if (ratio)
-        return avx2 ? write_flat_row_avx2<false, true>(n, in, out)
-                    : write_flat_row_baseline<false, true>(n, in, out);
-    return avx2 ? write_flat_row_avx2<false, false>(n, in, out)
-                : write_flat_row_baseline<false, false>(n, in, out);
+    const MapInstructionSet isa = active_isa();
+    const bool other = out.o != nullptr, ratio = out.ratio != nullptr;
+    if (other && ratio) return write_flat_row_of<true, true>(isa, n, in, out);
+    if (other) return write_flat_row_of<true, false>(isa, n, in, out);
+    if (ratio) return write_flat_row_of<false, true>(isa, n, in, out);
+    return write_flat_row_of<false, false>(isa, n, in, out);
 }
 
 // A flat sample's per-pixel map without σ: the row passes of evaluate_flat_row, which make only
@@ -1150,12 +1198,12 @@ constexpr std::size_t kPixelChunk = 256;
 // The per-pixel map's column sums (n, Σx1, Σx2, Σx1², Σx2², Σx1x2 over rows [r − R, r + R]) +=
 // row (a, b, weights u) · add_weight − row (ra, rb, ru) · remove_weight, in one pass. (Free
 // functions with restrict parameters, so that the compiler vectorises them.)
-void update_column_sums(std::size_t W, const double* __restrict a, const double* __restrict b,
-                        const double* __restrict u, double add_weight, const double* __restrict ra,
-                        const double* __restrict rb, const double* __restrict ru,
-                        double remove_weight, double* __restrict n, double* __restrict s1,
-                        double* __restrict s2, double* __restrict s11, double* __restrict s22,
-                        double* __restrict s12) {
+[[gnu::always_inline]] inline void update_column_sums_body(
+    std::size_t W, const double* __restrict a, const double* __restrict b,
+    const double* __restrict u, double add_weight, const double* __restrict ra,
+    const double* __restrict rb, const double* __restrict ru, double remove_weight,
+    double* __restrict n, double* __restrict s1, double* __restrict s2, double* __restrict s11,
+    double* __restrict s22, double* __restrict s12) {
     for (std::size_t x = 0; x < W; ++x) {
         const double w = add_weight * u[x], wa = w * a[x], wb = w * b[x];
         const double v = remove_weight * ru[x], va = v * ra[x], vb = v * rb[x];
@@ -1166,6 +1214,24 @@ void update_column_sums(std::size_t W, const double* __restrict a, const double*
         s22[x] += wb * b[x] - vb * rb[x];
         s12[x] += wa * b[x] - va * rb[x];
     }
+}
+[[gnu::target("avx512f,avx512dq,avx512vl,avx512bw")]] void update_column_sums_avx512(
+    std::size_t W, const double* a, const double* b, const double* u, double add_weight,
+    const double* ra, const double* rb, const double* ru, double remove_weight, double* n,
+    double* s1, double* s2, double* s11, double* s22, double* s12) {
+    update_column_sums_body(W, a, b, u, add_weight, ra, rb, ru, remove_weight, n, s1, s2, s11, s22,
+                            s12);
+}
+void update_column_sums(std::size_t W, const double* a, const double* b, const double* u,
+                        double add_weight, const double* ra, const double* rb, const double* ru,
+                        double remove_weight, double* n, double* s1, double* s2, double* s11,
+                        double* s22, double* s12) {
+    if (active_isa() == MapInstructionSet::Avx512)
+        update_column_sums_avx512(W, a, b, u, add_weight, ra, rb, ru, remove_weight, n, s1, s2, s11,
+                                  s22, s12);
+    else
+        update_column_sums_body(W, a, b, u, add_weight, ra, rb, ru, remove_weight, n, s1, s2, s11,
+                                s22, s12);
 }
 
 // The window's sums at each pixel of a row (2R + 1 column sums from c*[x], padded), then the
@@ -1214,14 +1280,27 @@ void update_column_sums(std::size_t W, const double* __restrict a, const double*
                                                    double* state) {
     pixel_statistics_body(W, a, b, u, cn, cs1, cs2, cs11, cs22, cs12, ratio, var, state);
 }
+[[gnu::target("avx512f,avx512dq,avx512vl,avx512bw")]] void pixel_statistics_avx512(
+    std::size_t W, const double* a, const double* b, const double* u, const double* cn,
+    const double* cs1, const double* cs2, const double* cs11, const double* cs22,
+    const double* cs12, double* ratio, double* var, double* state) {
+    pixel_statistics_body(W, a, b, u, cn, cs1, cs2, cs11, cs22, cs12, ratio, var, state);
+}
 void pixel_statistics(std::size_t W, const double* a, const double* b, const double* u,
                       const double* cn, const double* cs1, const double* cs2, const double* cs11,
                       const double* cs22, const double* cs12, double* ratio, double* var,
                       double* state) {
-    if (has_avx2())
-        pixel_statistics_avx2(W, a, b, u, cn, cs1, cs2, cs11, cs22, cs12, ratio, var, state);
-    else
-        pixel_statistics_body(W, a, b, u, cn, cs1, cs2, cs11, cs22, cs12, ratio, var, state);
+    switch (active_isa()) {
+        case MapInstructionSet::Avx512:
+            pixel_statistics_avx512(W, a, b, u, cn, cs1, cs2, cs11, cs22, cs12, ratio, var, state);
+            return;
+        case MapInstructionSet::Avx2:
+            pixel_statistics_avx2(W, a, b, u, cn, cs1, cs2, cs11, cs22, cs12, ratio, var, state);
+            return;
+        case MapInstructionSet::Baseline:
+            break;
+    }
+    pixel_statistics_body(W, a, b, u, cn, cs1, cs2, cs11, cs22, cs12, ratio, var, state);
 }
 static_assert(static_cast<int>(PixelState::Estimate) == 0 &&
               static_cast<int>(PixelState::Missing) == 1 &&

@@ -331,10 +331,14 @@ struct RoughnessMap {
 // image/measure.hpp's region measurement).
 RoughnessMap roughness_map(const std::vector<MapCapture>& captures, const MapOptions& options);
 
-// The per-pixel map's row loops and RatioInverseTable::find_ratio_bins run an AVX2 build of
-// themselves where the processor has it, the baseline build elsewhere: the same arithmetic, so
-// the same map. This switch (for tests and benchmarks; default true) allows or forbids the AVX2
-// build process-wide and returns the previous setting.
-bool allow_avx2_in_maps(bool allowed);
+// The per-pixel map's row loops and RatioInverseTable::find_ratio_bins come in builds for three
+// instruction sets and run the best the processor has (AVX-512: F, DQ, VL and BW): the same
+// arithmetic (ISO C++ does not contract into FMA), so the same map from each.
+enum class MapInstructionSet { Baseline, Avx2, Avx512 };
+// The highest build the row loops may use, process-wide (for tests and benchmarks; default
+// Avx512); returns the previous limit.
+MapInstructionSet limit_map_instruction_set(MapInstructionSet highest);
+// The build the row loops use now: the processor's best up to the limit.
+MapInstructionSet map_instruction_set();
 
 }  // namespace roughscope::image

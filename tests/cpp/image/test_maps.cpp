@@ -1,6 +1,7 @@
 // Roughness maps (image/maps.hpp) against synthetic captures of known roughness
 // (simulation::render_capture) and against the scalar estimators of estimation.hpp.
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -26,6 +27,8 @@ using roughscope::testing::very_rough_truth;
 namespace sim = roughscope::simulation;
 
 const double kTheta1 = deg_to_rad(30.0);
+constexpr std::array<MapInstructionSet, 3> kInstructionSets{
+    MapInstructionSet::Baseline, MapInstructionSet::Avx2, MapInstructionSet::Avx512};
 const double kTheta2 = deg_to_rad(45.0);
 
 std::vector<MapCapture> flat_captures(const LitPair& p) {
@@ -332,12 +335,12 @@ TEST(RatioInverseTable, RatioBinsEqualTheLookUpAtTheLogRatio) {
                              (i % 4 < 2 ? 1.0 + d : 1.0 - std::min(d, 0.999)));
         }
         ratios.push_back(std::nan(""));
-        for (const bool avx2 : {true, false}) {
-            const bool before = allow_avx2_in_maps(avx2);
+        for (const MapInstructionSet isa : kInstructionSets) {
+            const MapInstructionSet before = limit_map_instruction_set(isa);
             std::vector<double> x(ratios.size()), slope(ratios.size());
             const bool pending =
                 k.table.find_ratio_bins(ratios.size(), ratios.data(), x.data(), slope.data());
-            allow_avx2_in_maps(before);
+            limit_map_instruction_set(before);
             bool missed = false;
             for (std::size_t i = 0; i < ratios.size(); ++i) {
                 RatioInverseTable::Value v;
@@ -450,10 +453,11 @@ TEST(RoughnessMap, PixelMapEqualsItsDefinition) {
         o.check_registration = false;
         o.both_correlations = true;
         o.ratio_layer = true;
-        // threads 0: one thread, the baseline build of the row loops (not AVX2).
-        const bool before = allow_avx2_in_maps(threads != 0);
+        // threads 0: one thread, the baseline build of the row loops (no AVX).
+        const MapInstructionSet before = limit_map_instruction_set(
+            threads != 0 ? MapInstructionSet::Avx512 : MapInstructionSet::Baseline);
         const RoughnessMap map = roughness_map(flat_captures(p), o);
-        allow_avx2_in_maps(before);
+        limit_map_instruction_set(before);
         ASSERT_EQ(map.width * map.height, W * H);
         std::size_t missing = 0, no_solution = 0, valid = 0;
         double worst = 0.0, worst_se = 0.0;
@@ -847,29 +851,44 @@ TEST(RoughnessMap, VectorBuildsGiveTheSameMap) {
     o.check_registration = false;
     o.both_correlations = true;
     o.ratio_layer = true;
-    const RoughnessMap fast = roughness_map(flat_captures(p), o);
-    const bool before = allow_avx2_in_maps(false);
+    const MapInstructionSet before = limit_map_instruction_set(MapInstructionSet::Baseline);
+    ASSERT_EQ(map_instruction_set(), MapInstructionSet::Baseline);
     const RoughnessMap baseline = roughness_map(flat_captures(p), o);
-    allow_avx2_in_maps(before);
     auto same = [](const MapLayerValues& a, const MapLayerValues& b) {
         if (a.size() != b.size()) return false;
         for (std::size_t i = 0; i < a.size(); ++i)
             if (!((std::isnan(a[i]) && std::isnan(b[i])) || a[i] == b[i])) return false;
         return true;
     };
-    EXPECT_TRUE(same(fast.E1_over_E2, baseline.E1_over_E2));
-    EXPECT_TRUE(same(fast.sigma_over_T_gaussian, baseline.sigma_over_T_gaussian));
-    EXPECT_TRUE(same(fast.sigma_over_T_gaussian_stderr, baseline.sigma_over_T_gaussian_stderr));
-    EXPECT_TRUE(same(fast.sigma_over_T_exponential, baseline.sigma_over_T_exponential));
-    EXPECT_TRUE(
-        same(fast.sigma_over_T_exponential_stderr, baseline.sigma_over_T_exponential_stderr));
-    EXPECT_TRUE(fast.roughness_class == baseline.roughness_class);
-    EXPECT_EQ(fast.valid, baseline.valid);
-    EXPECT_EQ(fast.missing, baseline.missing);
-    EXPECT_EQ(fast.no_solution, baseline.no_solution);
-    EXPECT_GT(fast.no_solution, 100U);
-    EXPECT_GT(fast.missing, 300U);
-    for (std::size_t c = 0; c < 3; ++c) EXPECT_EQ(fast.classes[c].count, baseline.classes[c].count);
+    for (const MapInstructionSet isa : {MapInstructionSet::Avx2, MapInstructionSet::Avx512}) {
+        limit_map_instruction_set(isa);
+        // (The processor's best up to the limit: the AVX-512 build where it has AVX-512.)
+        std::printf("instruction set limit %d: the row loops use %d\n", static_cast<int>(isa),
+                    static_cast<int>(map_instruction_set()));
+        const RoughnessMap fast = roughness_map(flat_captures(p), o);
+        EXPECT_TRUE(same(fast.E1_over_E2, baseline.E1_over_E2));
+        EXPECT_TRUE(same(fast.sigma_over_T_gaussian, baseline.sigma_over_T_gaussian));
+        EXPECT_TRUE(same(fast.sigma_over_T_gaussian_stderr, baseline.sigma_over_T_gaussian_stderr));
+        EXPECT_TRUE(same(fast.sigma_over_T_exponential, baseline.sigma_over_T_exponential));
+        EXPECT_TRUE(
+            same(fast.sigma_over_T_exponential_stderr, baseline.sigma_over_T_exponential_stderr));
+        EXPECT_TRUE(fast.roughness_class == baseline.roughness_class);
+        EXPECT_EQ(fast.valid, baseline.valid);
+        EXPECT_EQ(fast.missing, baseline.missing);
+        EXPECT_EQ(fast.no_solution, baseline.no_solution);
+        EXPECT_GT(fast.no_solution, 100U);
+        EXPECT_GT(fast.missing, 300U);
+        for (std::size_t c = 0; c < 3; ++c) {
+            EXPECT_EQ(fast.classes[c].count, baseline.classes[c].count);
+            ASSERT_EQ(fast.classes[c].mean_sigma_over_T.has_value(),
+                      baseline.classes[c].mean_sigma_over_T.has_value());
+            if (fast.classes[c].mean_sigma_over_T) {
+                EXPECT_EQ(fast.classes[c].mean_sigma_over_T->value,
+                          baseline.classes[c].mean_sigma_over_T->value);
+            }
+        }
+    }
+    limit_map_instruction_set(before);
 }
 
 // Bands of rows on several threads give the same map as one thread, per pixel and per tile.
@@ -920,12 +939,12 @@ TEST(RoughnessMap, LayersNotAskedForAreNotMadeAndTheRestIsTheSame) {
         return a.has_value() == b.has_value() &&
                (!a || (a->value == b->value && a->std_error == b->std_error));
     };
-    const bool before = allow_avx2_in_maps(true);
-    for (const bool avx2 : {true, false})
+    const MapInstructionSet before = map_instruction_set();
+    for (const MapInstructionSet isa : kInstructionSets)
         for (const std::size_t window : {std::size_t{1}, std::size_t{4}})
             for (const Correlation c : {Correlation::Gaussian, Correlation::Exponential})
                 for (const bool regions : {false, true}) {
-                    allow_avx2_in_maps(avx2);
+                    limit_map_instruction_set(isa);
                     MapOptions o;
                     o.window_px = window;
                     o.correlation = c;
@@ -942,7 +961,7 @@ TEST(RoughnessMap, LayersNotAskedForAreNotMadeAndTheRestIsTheSame) {
                     for (const bool both : {false, true})
                         for (const bool ratio : {false, true}) {
                             SCOPED_TRACE(::testing::Message()
-                                         << "avx2 " << avx2 << " window " << window
+                                         << "isa " << static_cast<int>(isa) << " window " << window
                                          << " exponential " << (c == Correlation::Exponential)
                                          << " regions " << regions << " both " << both << " ratio "
                                          << ratio);
@@ -1004,7 +1023,7 @@ TEST(RoughnessMap, LayersNotAskedForAreNotMadeAndTheRestIsTheSame) {
                             }
                         }
                 }
-    allow_avx2_in_maps(before);
+    limit_map_instruction_set(before);
 }
 
 // A colour capture is read as its channel average and a capture's exposure scale s_k divides its
