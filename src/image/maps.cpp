@@ -727,9 +727,9 @@ RowCounts write_flat_row_baseline(std::size_t n, const FlatRowIn& in, const Flat
                                                in.so, in.slightly, in.very, out.ratio, out.p,
                                                out.pse, out.o, out.ose, out.klass, out.cls);
 }
-// write_flat_row_body built for AVX2 and for the baseline (SSE2, where its 64-bit masks do not
-// vectorise), the processor's pick at run time: the same arithmetic (ISO C++ does not contract
-// into FMA), so the same layers either way.
+// write_flat_row_body built for AVX-512, AVX2 and the baseline (SSE2, where its 64-bit masks do
+// not vectorise), the processor's pick at run time: the same arithmetic (no FMA contraction:
+// -ffp-contract=off), so the same layers from each.
 template <bool kOther, bool kRatio>
 [[gnu::target("avx2")]] RowCounts write_flat_row_avx2(std::size_t n, const FlatRowIn& in,
                                                       const FlatRowOut& out) {

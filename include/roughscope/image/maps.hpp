@@ -333,7 +333,8 @@ RoughnessMap roughness_map(const std::vector<MapCapture>& captures, const MapOpt
 
 // The per-pixel map's row loops and RatioInverseTable::find_ratio_bins come in builds for three
 // instruction sets and run the best the processor has (AVX-512: F, DQ, VL and BW): the same
-// arithmetic (ISO C++ does not contract into FMA), so the same map from each.
+// arithmetic (maps.cpp is compiled with -ffp-contract=off: no fused multiply-add), so the same
+// map from each.
 enum class MapInstructionSet { Baseline, Avx2, Avx512 };
 // The highest build the row loops may use, process-wide (for tests and benchmarks; default
 // Avx512); returns the previous limit.
