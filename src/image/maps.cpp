@@ -874,8 +874,8 @@ class Evaluator {
     ClassSums evaluate_flat_row(std::size_t begin, std::size_t count, const double* ratio,
                                 const double* var_log_ratio, const double* state) {
         const bool gaussian = o_.correlation == Correlation::Gaussian;
-        const bool other = !(gaussian ? map_.sigma_over_T_exponential.empty()
-                                      : map_.sigma_over_T_gaussian.empty());
+        const Correlation c = o_.correlation, oc = other_correlation(c);
+        const bool other = !map_.sigma_over_T(oc).empty();
         for (auto* v : {&xp_, &sp_, &xo_, &so_, &klass_}) v->resize(count);
         const RatioInverseTable& tp = gaussian ? *table_g_ : *table_e_;
         const RatioInverseTable* to = gaussian ? table_e_.get() : table_g_.get();
@@ -895,12 +895,10 @@ class Evaluator {
         };
         if (pending_p) rest(tp, xp_, sp_, gaussian ? hint_g_ : hint_e_);
         if (pending_o) rest(*to, xo_, so_, gaussian ? hint_e_ : hint_g_);
-        MapLayerValues& lp = gaussian ? map_.sigma_over_T_gaussian : map_.sigma_over_T_exponential;
-        MapLayerValues& lpse =
-            gaussian ? map_.sigma_over_T_gaussian_stderr : map_.sigma_over_T_exponential_stderr;
-        MapLayerValues& lo = gaussian ? map_.sigma_over_T_exponential : map_.sigma_over_T_gaussian;
-        MapLayerValues& lose =
-            gaussian ? map_.sigma_over_T_exponential_stderr : map_.sigma_over_T_gaussian_stderr;
+        MapLayerValues& lp = map_.sigma_over_T(c);
+        MapLayerValues& lpse = map_.sigma_over_T_stderr(c);
+        MapLayerValues& lo = map_.sigma_over_T(oc);
+        MapLayerValues& lose = map_.sigma_over_T_stderr(oc);
         const FlatRowIn in{ratio,
                            var_log_ratio,
                            state,
@@ -917,12 +915,12 @@ class Evaluator {
                              other ? lose.data() + begin : nullptr,
                              klass_.data(),
                              map_.roughness_class.data() + begin};
-        const RowCounts c = write_flat_row(count, in, out);
-        counts_.valid += c.valid;
-        counts_.missing += c.missing;
-        counts_.no_solution += c.no_solution;
-        counts_.no_solution_other += c.no_solution_other;
-        return c.classes;
+        const RowCounts row = write_flat_row(count, in, out);
+        counts_.valid += row.valid;
+        counts_.missing += row.missing;
+        counts_.no_solution += row.no_solution;
+        counts_.no_solution_other += row.no_solution_other;
+        return row.classes;
     }
 
     bool flat() const { return flat_; }
@@ -1098,9 +1096,7 @@ bool pixel_used(const MapCapture& c1, const MapCapture& c2, const MapOptions& o,
 // The class statistics of a finished row of cells (the per-class mean of the summary: the rows'
 // sums are added in row order afterwards, so the means do not depend on the bands).
 ClassSums row_class_sums(const RoughnessMap& map, const MapOptions& o, std::size_t row) {
-    const MapLayerValues& primary = o.correlation == Correlation::Gaussian
-                                        ? map.sigma_over_T_gaussian
-                                        : map.sigma_over_T_exponential;
+    const MapLayerValues& primary = map.sigma_over_T(o.correlation);
     ClassSums sums;
     for (std::size_t i = row * map.width; i < (row + 1) * map.width; ++i) {
         const std::uint8_t c = map.roughness_class[i];
@@ -1535,14 +1531,11 @@ RoughnessMap roughness_map(const std::vector<MapCapture>& captures, const MapOpt
     // A flat sample's per-pixel map without σ makes only the layers asked for (and E1/E2 for
     // the regions' pooled σ/T, dropped after); the other maps make all of them and drop those
     // not asked for at the end (tiles are few; cells evaluated one by one write every layer).
-    const bool gaussian = o.correlation == Correlation::Gaussian;
     const bool lean = lean_pixel_map(o);
-    MapLayerValues& primary = gaussian ? map.sigma_over_T_gaussian : map.sigma_over_T_exponential;
-    MapLayerValues& primary_stderr =
-        gaussian ? map.sigma_over_T_gaussian_stderr : map.sigma_over_T_exponential_stderr;
-    MapLayerValues& other = gaussian ? map.sigma_over_T_exponential : map.sigma_over_T_gaussian;
-    MapLayerValues& other_stderr =
-        gaussian ? map.sigma_over_T_exponential_stderr : map.sigma_over_T_gaussian_stderr;
+    MapLayerValues& primary = map.sigma_over_T(o.correlation);
+    MapLayerValues& primary_stderr = map.sigma_over_T_stderr(o.correlation);
+    MapLayerValues& other = map.sigma_over_T(other_correlation(o.correlation));
+    MapLayerValues& other_stderr = map.sigma_over_T_stderr(other_correlation(o.correlation));
     resize_large_uninitialised(primary, cells);
     resize_large_uninitialised(primary_stderr, cells);
     if (!lean || o.both_correlations) {

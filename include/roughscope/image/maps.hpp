@@ -320,7 +320,28 @@ struct RoughnessMap {
     std::vector<RegionMapStatistics> regions;
     std::vector<std::string> warnings;
     std::string method;  // "table (Eq. 17/19)", "table (two-geometry model)", "solver per tile"
+
+    // The σ/T layer and its standard error of correlation c (empty where not made).
+    MapLayerValues& sigma_over_T(Correlation c) {
+        return c == Correlation::Gaussian ? sigma_over_T_gaussian : sigma_over_T_exponential;
+    }
+    const MapLayerValues& sigma_over_T(Correlation c) const {
+        return c == Correlation::Gaussian ? sigma_over_T_gaussian : sigma_over_T_exponential;
+    }
+    MapLayerValues& sigma_over_T_stderr(Correlation c) {
+        return c == Correlation::Gaussian ? sigma_over_T_gaussian_stderr
+                                          : sigma_over_T_exponential_stderr;
+    }
+    const MapLayerValues& sigma_over_T_stderr(Correlation c) const {
+        return c == Correlation::Gaussian ? sigma_over_T_gaussian_stderr
+                                          : sigma_over_T_exponential_stderr;
+    }
 };
+
+// The correlation that is not c.
+inline Correlation other_correlation(Correlation c) {
+    return c == Correlation::Gaussian ? Correlation::Exponential : Correlation::Gaussian;
+}
 
 // Throws InvalidArgument (fewer than 2 captures, a null image, images of different sizes, a
 // non-finite value in either of the two images (checked as the map reads them), window_px or

@@ -837,15 +837,24 @@ TEST(RoughnessClassOfSigmaOverT, Thresholds) {
 namespace roughscope::image {
 namespace {
 
-// The per-pixel map's AVX2 and baseline builds of its row loops give the same map, bit for bit
-// (a noisy pair with flagged pixels and ratios outside the model's range).
-TEST(RoughnessMap, VectorBuildsGiveTheSameMap) {
-    const std::size_t W = 301, H = 77;
-    LitPair p = render_lit_pair(plane(W, H), {very_rough_truth(0.6)}, {}, {}, kTheta1, kTheta2, 9);
+// A noisy pair (σ/T = 0.6) with every flag_step-th pixel of capture 1 saturated and every
+// ratio_step-th pixel (from ratio_first) at a ratio below the model's range.
+LitPair pair_with_flags_and_no_solutions(std::size_t W, std::size_t H, std::uint64_t seed,
+                                         std::size_t flag_step, std::size_t ratio_first,
+                                         std::size_t ratio_step) {
+    LitPair p =
+        render_lit_pair(plane(W, H), {very_rough_truth(0.6)}, {}, {}, kTheta1, kTheta2, seed);
     const RatioRange range = ratio_range_gaussian(kTheta1, kTheta2);
-    for (std::size_t i = 0; i < W * H; i += 37) p.a.flags[i] = kPixelSaturated;
-    for (std::size_t i = 5; i < W * H; i += 53)
+    for (std::size_t i = 0; i < W * H; i += flag_step) p.a.flags[i] = kPixelSaturated;
+    for (std::size_t i = ratio_first; i < W * H; i += ratio_step)
         p.b.values[i] = static_cast<float>(p.a.values[i] / (0.5 * range.lower));
+    return p;
+}
+
+// The per-pixel map's builds of its row loops (baseline, AVX2, AVX-512) give the same map, bit
+// for bit (a noisy pair with flagged pixels and ratios outside the model's range).
+TEST(RoughnessMap, VectorBuildsGiveTheSameMap) {
+    const LitPair p = pair_with_flags_and_no_solutions(301, 77, 9, 37, 5, 53);
     MapOptions o;
     o.window_px = 1;
     o.check_registration = false;
@@ -922,11 +931,7 @@ TEST(RoughnessMap, ThreadsDoNotChangeTheResult) {
 // (their statistics pool ln E1/E2 and give both correlations either way).
 TEST(RoughnessMap, LayersNotAskedForAreNotMadeAndTheRestIsTheSame) {
     const std::size_t W = 203, H = 71;
-    LitPair p = render_lit_pair(plane(W, H), {very_rough_truth(0.6)}, {}, {}, kTheta1, kTheta2, 5);
-    const RatioRange range = ratio_range_gaussian(kTheta1, kTheta2);
-    for (std::size_t i = 0; i < W * H; i += 41) p.a.flags[i] = kPixelSaturated;
-    for (std::size_t i = 7; i < W * H; i += 59)
-        p.b.values[i] = static_cast<float>(p.a.values[i] / (0.5 * range.lower));
+    const LitPair p = pair_with_flags_and_no_solutions(W, H, 5, 41, 7, 59);
     std::vector<std::int32_t> labels(W * H);
     for (std::size_t i = 0; i < W * H; ++i) labels[i] = (i % W) < W / 2 ? 0 : -1;
     auto same = [](const MapLayerValues& a, const MapLayerValues& b) {
@@ -968,26 +973,15 @@ TEST(RoughnessMap, LayersNotAskedForAreNotMadeAndTheRestIsTheSame) {
                             o.both_correlations = both;
                             o.ratio_layer = ratio;
                             const RoughnessMap m = roughness_map(flat_captures(p), o);
-                            const bool g = c == Correlation::Gaussian;
-                            const auto& primary =
-                                g ? m.sigma_over_T_gaussian : m.sigma_over_T_exponential;
-                            const auto& primary_full =
-                                g ? full.sigma_over_T_gaussian : full.sigma_over_T_exponential;
-                            const auto& primary_se = g ? m.sigma_over_T_gaussian_stderr
-                                                       : m.sigma_over_T_exponential_stderr;
-                            const auto& primary_se_full = g ? full.sigma_over_T_gaussian_stderr
-                                                            : full.sigma_over_T_exponential_stderr;
-                            EXPECT_EQ(primary.size(), m.width * m.height);
-                            EXPECT_TRUE(same(primary, primary_full));
-                            EXPECT_TRUE(same(primary_se, primary_se_full));
-                            const auto& other =
-                                g ? m.sigma_over_T_exponential : m.sigma_over_T_gaussian;
-                            const auto& other_full =
-                                g ? full.sigma_over_T_exponential : full.sigma_over_T_gaussian;
-                            const auto& other_se = g ? m.sigma_over_T_exponential_stderr
-                                                     : m.sigma_over_T_gaussian_stderr;
-                            const auto& other_se_full = g ? full.sigma_over_T_exponential_stderr
-                                                          : full.sigma_over_T_gaussian_stderr;
+                            const Correlation oc = other_correlation(c);
+                            EXPECT_EQ(m.sigma_over_T(c).size(), m.width * m.height);
+                            EXPECT_TRUE(same(m.sigma_over_T(c), full.sigma_over_T(c)));
+                            EXPECT_TRUE(
+                                same(m.sigma_over_T_stderr(c), full.sigma_over_T_stderr(c)));
+                            const auto& other = m.sigma_over_T(oc);
+                            const auto& other_full = full.sigma_over_T(oc);
+                            const auto& other_se = m.sigma_over_T_stderr(oc);
+                            const auto& other_se_full = full.sigma_over_T_stderr(oc);
                             if (both) {
                                 EXPECT_TRUE(same(other, other_full));
                                 EXPECT_TRUE(same(other_se, other_se_full));
