@@ -215,8 +215,8 @@ void bind_image(py::module_& m) {
         py::arg("capture_file"), py::arg("layers") = false,
         "Roughness from the photographs named in a capture file (JSON): the dict of "
         "`roughscope measure --json` (docs/measure.md); layers=True adds the roughness map's "
-        "layers as (height, width) arrays under result['map']['layers'] "
-        "`roughscope measure --json` (docs/measure.md).");
+        "layers as (height, width) arrays under result['map']['layers'], named as the files of "
+        "`roughscope measure --maps` (result['map']['layer_names']).");
 }
 
 }  // namespace roughscope::python

@@ -207,7 +207,7 @@ Json to_json(const image::RoughnessMap& m) {
     Json layers = Json::array();
     for (const MapLayer& layer : map_float_layers(m)) layers.push_back(layer.name);
     for (const MapClassLayer& layer : map_class_layers(m)) layers.push_back(layer.name);
-    out["layers"] = layers;
+    out["layer_names"] = layers;
     if (m.registration) {
         Json r;
         r["shift_x_px"] = number(m.registration->shift_x_px);

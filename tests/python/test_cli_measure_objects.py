@@ -204,7 +204,7 @@ def test_map_regions_recover_the_truth_and_files_are_written(flat_map, tmp_path)
         assert (out / f"{name}.tiff").is_file() and (out / f"{name}.npy").is_file()
     for name in ("sigma_over_T_exponential", "E1_over_E2"):
         assert not (out / f"{name}.tiff").exists()
-    assert m["layers"] == ["sigma_over_T_gaussian", "sigma_over_T_gaussian_stderr",
+    assert m["layer_names"] == ["sigma_over_T_gaussian", "sigma_over_T_gaussian_stderr",
                            "roughness_class"]
     assert m["no_solution_other_correlation"] is None
     assert (out / "sigma_over_T_gaussian.png").is_file()
@@ -221,6 +221,7 @@ def test_map_regions_recover_the_truth_and_files_are_written(flat_map, tmp_path)
 
     py = roughscope.measure(str(flat_map), layers=True)
     np.testing.assert_array_equal(py["map"]["layers"]["sigma_over_T_gaussian"], layer)
+    assert sorted(py["map"]["layers"]) == sorted(py["map"]["layer_names"])
     classes_npy = np.load(out / "roughness_class.npy")
     np.testing.assert_array_equal(np.nan_to_num(classes_npy, nan=255).astype(np.uint8),
                                   py["map"]["layers"]["roughness_class"])
@@ -244,7 +245,7 @@ def test_map_layers_of_both_correlations_and_the_ratio_on_request(flat_map, tmp_
     m = doc["map"]
     names = ["sigma_over_T_gaussian", "sigma_over_T_gaussian_stderr", "sigma_over_T_exponential",
              "sigma_over_T_exponential_stderr", "E1_over_E2"]
-    assert m["layers"] == names + ["roughness_class"]
+    assert m["layer_names"] == names + ["roughness_class"]
     for name in names:
         assert (out / f"{name}.tiff").is_file() and (out / f"{name}.npy").is_file()
     assert m["no_solution_other_correlation"] == 0
