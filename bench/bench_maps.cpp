@@ -6,7 +6,9 @@
 // Names: maps/decode/<rows>          baseline: read_image of the two 16-bit TIFFs
 //        maps/registration/<rows>    estimate_misregistration of the decoded pair (part of a map)
 //        maps/map_tiles8/<rows>      read_image of both + roughness_map, window 8
-//        maps/map_pixels/<rows>      read_image of both + roughness_map, per pixel
+//        maps/map_pixels/<rows>      read_image of both + roughness_map, per pixel (the default
+//                                    layers: σ/T of one correlation, its error, the class)
+//        maps/map_pixels_every_layer/<rows>  the same with both correlations and E1/E2
 // <rows> = 4096 is the 24-MP pair (5859 x 4096 = 24.0 MP, the size of the other image benchmarks;
 // 6000 x 4000 has the same pixel count); 256 a small one (the smoke run skips /4096).
 // Counters: time_vs_decode = (decode + map) / decode of the two files by read_image (one after
@@ -97,7 +99,7 @@ void opencv_decode_pair(const PairFiles& p) {
 }
 
 // As `measure` makes a map: the two photographs read at once (one thread each), then the map.
-img::RoughnessMap decode_and_map(const PairFiles& p, std::size_t window) {
+img::RoughnessMap decode_and_map(const PairFiles& p, std::size_t window, bool every_layer) {
     img::LinearImage b;
     std::thread second([&] { b = img::read_image(p.files[1].string(), read_options()); });
     const img::LinearImage a = img::read_image(p.files[0].string(), read_options());
@@ -109,6 +111,8 @@ img::RoughnessMap decode_and_map(const PairFiles& p, std::size_t window) {
     c[1].geometry = roughscope::normal_view_geometry(roughscope::deg_to_rad(45.0));
     img::MapOptions o;
     o.window_px = window;
+    o.both_correlations = every_layer;
+    o.ratio_layer = every_layer;
     return img::roughness_map(c, o);
 }
 
@@ -139,12 +143,12 @@ void BM_maps_decode(benchmark::State& state) {
     for (auto _ : state) decode_pair(p);
 }
 
-void BM_maps_map(benchmark::State& state, std::size_t window) {
+void BM_maps_map(benchmark::State& state, std::size_t window, bool every_layer) {
     PairFiles p;
     make_pair(p, static_cast<std::size_t>(state.range(0)));
-    for (auto _ : state) benchmark::DoNotOptimize(decode_and_map(p, window).valid);
+    for (auto _ : state) benchmark::DoNotOptimize(decode_and_map(p, window, every_layer).valid);
     const auto [t_decode, t_map] = seconds_of_interleaved(
-        [&] { decode_pair(p); }, [&] { (void)decode_and_map(p, window); }, 7);
+        [&] { decode_pair(p); }, [&] { (void)decode_and_map(p, window, every_layer); }, 7);
     const double t_opencv = seconds_of([&] { opencv_decode_pair(p); }, 5);
     state.counters["time_vs_decode"] = t_map / t_decode;
     state.counters["time_vs_opencv_decode"] = t_map / t_opencv;
@@ -152,7 +156,7 @@ void BM_maps_map(benchmark::State& state, std::size_t window) {
         const img::LinearImage im = img::read_image(p.files[0].string(), read_options());
         benchmark::DoNotOptimize(im.values.data());
     });
-    const long map = peak_above_now_kb([&] { (void)decode_and_map(p, window); });
+    const long map = peak_above_now_kb([&] { (void)decode_and_map(p, window, every_layer); });
     state.counters["peak_vs_image"] = one > 0 ? static_cast<double>(map) / one : 0.0;
     state.counters["peak_MB"] = static_cast<double>(map) / 1024.0;
 }
@@ -175,13 +179,18 @@ BENCHMARK(BM_maps_registration)
     ->Arg(4096)
     ->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_maps_decode)->Name("maps/decode")->Arg(256)->Arg(4096)->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(BM_maps_map, tiles8, 8)
+BENCHMARK_CAPTURE(BM_maps_map, tiles8, 8, false)
     ->Name("maps/map_tiles8")
     ->Arg(256)
     ->Arg(4096)
     ->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(BM_maps_map, pixels, 1)
+BENCHMARK_CAPTURE(BM_maps_map, pixels, 1, false)
     ->Name("maps/map_pixels")
+    ->Arg(256)
+    ->Arg(4096)
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_maps_map, pixels_every_layer, 1, true)
+    ->Name("maps/map_pixels_every_layer")
     ->Arg(256)
     ->Arg(4096)
     ->Unit(benchmark::kMillisecond);
