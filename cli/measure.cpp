@@ -111,12 +111,10 @@ std::string text_report(const serialize::Json& doc) {
     return out.str();
 }
 
-// The map's layers as files in `dir` (docs/measure.md "Map files"): <layer>.tiff (float32) and
-// <layer>.npy for every float layer, <layer>.png (false colour with a colour bar) for σ/T and T,
-// <class layer>.png and .npy (codes as float, NaN for none). Everything is encoded first, then
-// every file is opened (temporary files) and only then committed, so a failure leaves no file
-// half-written. Returns the names written.
-std::vector<std::string> write_map_files(const image::RoughnessMap& map, const fs::path& dir) {
+// The map's layers as files (docs/measure.md "Map files"): <layer>.tiff (float32) and <layer>.npy
+// for every float layer, <layer>.png (false colour with a colour bar) for σ/T and T, <class
+// layer>.png and .npy (codes as float, NaN for none). Encoded in memory: {file name, bytes}.
+std::vector<std::pair<std::string, std::string>> encode_map_files(const image::RoughnessMap& map) {
     std::vector<std::pair<std::string, std::string>> files;
     for (const auto& layer : serialize::map_float_layers(map)) {
         files.emplace_back(layer.name + ".tiff",
@@ -139,41 +137,106 @@ std::vector<std::string> write_map_files(const image::RoughnessMap& map, const f
                            : static_cast<float>((*layer.values)[k]);
         files.emplace_back(layer.name + ".npy", image::encode_npy(codes, map.width, map.height));
     }
-    std::error_code ec;
-    fs::create_directories(dir, ec);
-    if (ec) throw DataError(concat("cannot write ", dir.string(), ": ", ec.message()));
-    std::vector<io::OutputFile> outputs;
-    for (const auto& [name, bytes] : files) {
-        outputs.emplace_back(dir / name);
-        outputs.back().write(bytes);
-    }
-    std::vector<std::string> names;
-    for (std::size_t k = 0; k < outputs.size(); ++k) {
-        outputs[k].commit();
-        names.push_back(files[k].first);
-    }
-    return names;
+    return files;
 }
+
+// Every file the run reads: the capture file, the photographs (and bracket shots), the response
+// bracket, the dark frame, the flat field and the normal map.
+std::vector<fs::path> input_files(const image::MeasureRequest& r, const std::string& capture_file) {
+    std::vector<fs::path> files{capture_file};
+    for (const auto& c : r.captures) {
+        files.emplace_back(c.image);
+        for (const auto& shot : c.bracket) files.emplace_back(shot.image);
+    }
+    for (const auto& shot : r.response_bracket) files.emplace_back(shot.image);
+    if (r.dark_frame) files.emplace_back(*r.dark_frame);
+    if (r.flat_field) files.emplace_back(*r.flat_field);
+    if (!r.object.normal_map.empty()) files.emplace_back(r.object.normal_map);
+    return files;
+}
+
+// InvalidArgument when `output` (written for `flag`) is one of the run's inputs: a run never
+// overwrites what it reads.
+void refuse_output_onto_input(const fs::path& output, const std::string& flag,
+                              const std::vector<fs::path>& inputs) {
+    for (const auto& input : inputs) {
+        std::error_code ec;
+        if (fs::equivalent(output, input, ec))
+            throw InvalidArgument(concat(flag, " ", output.string(), ": is an input of this run (",
+                                         input.string(), "); write the result to another file"));
+    }
+}
+
+// One command, one commit: every output of the run (--maps files, --report's index.html,
+// --output) is prepared in memory and opened as a temporary file first; only when all of them
+// are written are they renamed into place, one after the other. A failure before that leaves
+// nothing new behind (the folders created for them are removed again), as does a signal
+// (io::install_output_cleanup_handlers).
+struct PendingOutputs {
+    std::vector<io::OutputDirectory> folders;
+    std::vector<io::OutputFile> files;
+
+    void add(const fs::path& path, const std::string& bytes) {
+        files.emplace_back(path);
+        files.back().write(bytes);
+    }
+    void commit() {
+        for (auto& f : files) f.commit();
+        for (auto& d : folders) d.keep();
+    }
+};
 
 void run_measure(const MeasureCommand& c) {
     const image::MeasureRequest request = image::read_capture_file(c.capture_file);
+    const std::vector<fs::path> inputs = input_files(request, c.capture_file);
+    if (given(c.o_output)) refuse_output_onto_input(c.output_path, "--output", inputs);
+    if (given(c.o_maps) && c.maps_dir.empty())
+        throw InvalidArgument("--maps: empty folder name (give the folder for the map's files)");
+    if (given(c.o_report) && c.report_dir.empty())
+        throw InvalidArgument("--report: empty folder name (give the folder for index.html)");
+    const fs::path index = fs::path(c.report_dir) / "index.html";
+    if (given(c.o_report)) refuse_output_onto_input(index, "--report", inputs);
     const image::MeasureResult result = image::measure(request);
     serialize::Json doc = serialize::to_json(result, request);
+
+    PendingOutputs pending;
     if (given(c.o_maps)) {
         if (!result.map)
             throw InvalidArgument(concat("--maps: ", c.capture_file,
                                          " asks for no map (add \"maps\" to the capture file)"));
+        pending.folders.emplace_back(c.maps_dir, "--maps");
         doc["map"]["directory"] = c.maps_dir;
-        doc["map"]["files"] = write_map_files(*result.map, c.maps_dir);
+        std::vector<std::string> names;
+        for (auto& [name, bytes] : encode_map_files(*result.map)) {
+            refuse_output_onto_input(fs::path(c.maps_dir) / name, "--maps", inputs);
+            pending.add(fs::path(c.maps_dir) / name, bytes);
+            names.push_back(name);
+        }
+        doc["map"]["files"] = names;
     }
     if (given(c.o_report)) {
-        run_python_module("roughscope.report_measure",
-                          {"--out", fs::absolute(c.report_dir).string()}, serialize::dump(doc),
-                          "measure --report");
+        // The report is index.html alone (its figures are embedded): nothing else in the
+        // folder is written, replaced or removed. It reads the map files not yet committed
+        // from their temporary files ("staged_files").
+        pending.folders.emplace_back(c.report_dir, "--report");
+        serialize::Json for_report = doc;
+        if (given(c.o_maps)) {
+            serialize::Json staged = serialize::Json::object();
+            for (std::size_t k = 0; k < pending.files.size(); ++k) {
+                pending.files[k].flush();
+                staged[doc["map"]["files"][k].get<std::string>()] =
+                    pending.files[k].temporary_path();
+            }
+            for_report["map"]["staged_files"] = staged;
+        }
+        pending.add(index, run_python_module("roughscope.report_measure", {"--out", "-"},
+                                             serialize::dump(for_report), "measure --report"));
     }
     const std::string text =
         c.json_output ? serialize::dump(serialize::versioned(doc)) : text_report(doc);
-    write_output(given(c.o_output) ? std::optional<fs::path>(c.output_path) : std::nullopt, text);
+    if (given(c.o_output)) pending.add(c.output_path, text);
+    pending.commit();
+    if (!given(c.o_output)) write_output(std::nullopt, text);
 }
 
 }  // namespace
@@ -190,7 +253,7 @@ void register_measure(CLI::App& app) {
     c.o_output = cmd->add_option("--output", c.output_path, "Write the result to FILE atomically");
     c.o_report = cmd->add_option("--report", c.report_dir,
                                  "Write an HTML report (photographs with the regions, values, "
-                                 "checks) to DIR/index.html");
+                                 "checks) to DIR/index.html (nothing else in DIR is touched)");
     c.o_maps = cmd->add_option("--maps", c.maps_dir,
                                "Write the roughness map's layers (float32 TIFF, .npy, false-colour "
                                "PNG, class map) to DIR (the capture file's \"maps\")");

@@ -1,6 +1,7 @@
 // Running a module of the roughscope Python package (python_runner.hpp).
 #include "python_runner.hpp"
 
+#include <array>
 #include <cerrno>
 #include <csignal>
 #include <cstdlib>
@@ -8,13 +9,17 @@
 #include <filesystem>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
+#include <fcntl.h>
+#include <poll.h>
 #include <sys/types.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include "roughscope/core/errors.hpp"
+#include "roughscope/io/output_file.hpp"
 
 namespace roughscope::cli {
 namespace {
@@ -74,8 +79,62 @@ std::string python_interpreter() {
     return "python3";
 }
 
-void run_python_module(const std::string& module, const std::vector<std::string>& args,
-                       const std::string& input, const std::string& what) {
+namespace {
+
+// Writes `input` to `to_child` and reads `from_out` and `from_err` until both close, with poll()
+// so that neither pipe can fill up and stall the child. Returns {stdout, stderr}.
+std::pair<std::string, std::string> exchange_with_child(int to_child, int from_out, int from_err,
+                                                        const std::string& input) {
+    std::string out, err;
+    std::size_t written = 0;
+    if (input.empty()) {
+        ::close(to_child);
+        to_child = -1;
+    } else {
+        ::fcntl(to_child, F_SETFL, ::fcntl(to_child, F_GETFL) | O_NONBLOCK);
+    }
+    char buf[65536];
+    while (from_out >= 0 || from_err >= 0) {
+        std::array<pollfd, 3> fds{};
+        nfds_t n = 0;
+        if (to_child >= 0) fds[n++] = {to_child, POLLOUT, 0};
+        if (from_out >= 0) fds[n++] = {from_out, POLLIN, 0};
+        if (from_err >= 0) fds[n++] = {from_err, POLLIN, 0};
+        if (::poll(fds.data(), n, -1) < 0) {
+            if (errno == EINTR) continue;
+            break;
+        }
+        for (nfds_t k = 0; k < n; ++k) {
+            const pollfd& p = fds[k];
+            if (p.revents == 0) continue;
+            if (p.fd == to_child) {
+                const ssize_t w = ::write(to_child, input.data() + written, input.size() - written);
+                if (w > 0) written += static_cast<std::size_t>(w);
+                // A child that exits early closes the pipe (EPIPE: SIGPIPE is ignored here).
+                if ((w < 0 && errno != EINTR && errno != EAGAIN) || written == input.size()) {
+                    ::close(to_child);
+                    to_child = -1;
+                }
+                continue;
+            }
+            const ssize_t r = ::read(p.fd, buf, sizeof buf);
+            if (r < 0 && (errno == EINTR || errno == EAGAIN)) continue;
+            if (r <= 0) {
+                ::close(p.fd);
+                (p.fd == from_out ? from_out : from_err) = -1;
+                continue;
+            }
+            (p.fd == from_out ? out : err).append(buf, static_cast<std::size_t>(r));
+        }
+    }
+    if (to_child >= 0) ::close(to_child);
+    return {std::move(out), std::move(err)};
+}
+
+}  // namespace
+
+std::string run_python_module(const std::string& module, const std::vector<std::string>& args,
+                              const std::string& input, const std::string& what) {
     const std::string interpreter = python_interpreter();
     std::vector<std::string> argv_text{interpreter, "-m", module};
     argv_text.insert(argv_text.end(), args.begin(), args.end());
@@ -94,17 +153,14 @@ void run_python_module(const std::string& module, const std::vector<std::string>
         }
     }
 
-    Pipe in, err;
+    Pipe in, out, err;
     const pid_t pid = ::fork();
     if (pid < 0) throw DataError(what + ": cannot start " + interpreter + ": fork failed");
     if (pid == 0) {  // child: only async-signal-safe calls until exec
         ::dup2(in.fd[0], STDIN_FILENO);
-        ::dup2(err.fd[1], STDOUT_FILENO);
+        ::dup2(out.fd[1], STDOUT_FILENO);
         ::dup2(err.fd[1], STDERR_FILENO);
-        ::close(in.fd[0]);
-        ::close(in.fd[1]);
-        ::close(err.fd[0]);
-        ::close(err.fd[1]);
+        for (int f : {in.fd[0], in.fd[1], out.fd[0], out.fd[1], err.fd[0], err.fd[1]}) ::close(f);
         if (!pythonpath.empty()) ::setenv("PYTHONPATH", pythonpath.c_str(), 1);
         ::execvp(argv[0], argv.data());
         const std::string msg = "cannot run the Python interpreter '" + interpreter +
@@ -112,39 +168,26 @@ void run_python_module(const std::string& module, const std::vector<std::string>
         [[maybe_unused]] const ssize_t n = ::write(STDERR_FILENO, msg.data(), msg.size());
         ::_exit(127);
     }
+    const io::ChildProcessGuard guard(pid);
     in.close(0);
+    out.close(1);
     err.close(1);
 
-    // Feed the document; a child that exits early closes the pipe (EPIPE, not
-    // SIGPIPE).
     struct sigaction ignore {
     }, previous{};
     ignore.sa_handler = SIG_IGN;
     ::sigaction(SIGPIPE, &ignore, &previous);
-    std::size_t written = 0;
-    while (written < input.size()) {
-        const ssize_t n = ::write(in.fd[1], input.data() + written, input.size() - written);
-        if (n < 0 && errno == EINTR) continue;
-        if (n <= 0) break;
-        written += static_cast<std::size_t>(n);
-    }
-    in.close(1);
+    auto [output, errors] =
+        exchange_with_child(std::exchange(in.fd[1], -1), std::exchange(out.fd[0], -1),
+                            std::exchange(err.fd[0], -1), input);
     ::sigaction(SIGPIPE, &previous, nullptr);
 
-    std::string output;
-    char buf[4096];
-    for (;;) {
-        const ssize_t n = ::read(err.fd[0], buf, sizeof buf);
-        if (n < 0 && errno == EINTR) continue;
-        if (n <= 0) break;
-        output.append(buf, static_cast<std::size_t>(n));
-    }
     int status = 0;
     while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
     }
     const bool ok = WIFEXITED(status) && WEXITSTATUS(status) == 0;
-    if (ok) return;
-    std::string message = last_line(output);
+    if (ok) return std::move(output);
+    std::string message = last_line(errors);
     if (message.empty())
         message = WIFSIGNALED(status) ? "the Python process was killed by signal " +
                                             std::to_string(WTERMSIG(status))

@@ -14,8 +14,9 @@ std::string python_interpreter();
 // beside the executable (<bin>/../python) first on PYTHONPATH, and writes `input` to its standard
 // input through a pipe. Its standard output and error are captured. On a non-zero exit (or a
 // failure to start) throws roughscope::DataError "<what>: <the last line Python printed on
-// stderr>"; returns normally on exit status 0.
-void run_python_module(const std::string& module, const std::vector<std::string>& args,
-                       const std::string& input, const std::string& what);
+// stderr>"; on exit status 0 returns what it wrote on standard output. While it runs, a signal
+// that ends the CLI (install_output_cleanup_handlers) kills it too (io::ChildProcessGuard).
+std::string run_python_module(const std::string& module, const std::vector<std::string>& args,
+                              const std::string& input, const std::string& what);
 
 }  // namespace roughscope::cli

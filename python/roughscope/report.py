@@ -15,7 +15,9 @@ linked relatively) — with:
   (each ``section(outdir)`` returns an HTML fragment, or None to be left out).
 
 Everything is written to a temporary folder beside DIR and renamed at the end, so DIR is either
-the previous report or the complete new one. On success the path of index.html is printed; on
+the previous report or the complete new one. DIR is replaced only when it is new, empty or a
+report written before (it holds the marker file ``.roughscope-report``); a folder holding other
+files is refused, never emptied. On success the path of index.html is printed; on
 failure a one-line error goes to stderr and the exit status is 1.
 """
 
@@ -180,17 +182,44 @@ Pattern Recognition (2007)</p>
     return index
 
 
+# The file that marks a folder as a report this module wrote (and may replace as a whole).
+MARKER = ".roughscope-report"
+
+
+def _is_previous_report(folder):
+    """Whether `folder` holds a report written by this module (its marker, or, from versions
+    before the marker, an index.html with this report's title)."""
+    if (folder / MARKER).is_file():
+        return True
+    index = folder / "index.html"
+    try:
+        with open(index, encoding="utf-8", errors="replace") as f:
+            return "<title>roughscope report</title>" in f.read(4096)
+    except OSError:
+        return False
+
+
 def write_report(out):
     """Build the report in a temporary folder beside `out`, then move it into place.
 
-    Returns the final path of index.html.
+    `out` is replaced as a whole only when it is missing, empty or a report written before (it
+    holds MARKER); a folder holding anything else is refused, so that no file of the user's is
+    ever removed. A symbolic link to a folder is followed. Returns the final path of index.html.
     """
-    out = pathlib.Path(out)
+    out = pathlib.Path(os.path.realpath(out))
+    if out.exists():
+        if not out.is_dir():
+            raise NotADirectoryError(f"cannot write the report to {out}: it is not a folder")
+        if any(out.iterdir()) and not _is_previous_report(out):
+            raise FileExistsError(
+                f"cannot write the report to {out}: the folder holds files that are not a "
+                "roughscope report (it would be replaced as a whole); choose a new or empty folder")
     out.parent.mkdir(parents=True, exist_ok=True)
     tmp = pathlib.Path(tempfile.mkdtemp(prefix=f".{out.name}-tmp-", dir=out.parent))
     old = None
     try:
         build_report(tmp)
+        (tmp / MARKER).write_text("written by python -m roughscope.report\n", encoding="utf-8")
         os.chmod(tmp, 0o755)
         if out.exists():
             old = pathlib.Path(tempfile.mkdtemp(prefix=f".{out.name}-old-", dir=out.parent))
@@ -212,13 +241,15 @@ def main(argv=None):
         prog="python -m roughscope.report",
         description="Write the roughscope HTML report (figures and checks of the paper).")
     parser.add_argument("--out", default="out/report",
-                        help="output folder (default: out/report); replaced as a whole")
+                        help="output folder (default: out/report); replaced as a whole when it "
+                             "is new, empty or a previous report, refused otherwise")
     args = parser.parse_args(argv)
     try:
         index = write_report(args.out)
     except Exception as exc:  # one line, no traceback: this is a command-line tool
-        message = " ".join(str(exc).split()) or type(exc).__name__
-        print(f"roughscope.report: error: {message}", file=sys.stderr)
+        from .report_measure import one_line_error
+
+        print(f"roughscope.report: error: {one_line_error(exc)}", file=sys.stderr)
         return 1
     print(index)
     return 0

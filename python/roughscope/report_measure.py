@@ -12,13 +12,13 @@
 
 import argparse
 import base64
+import contextlib
 import html
 import io
 import json
 import math
 import os
 import pathlib
-import shutil
 import sys
 import tempfile
 
@@ -229,25 +229,48 @@ _PAGE = """<!DOCTYPE html>
 """
 
 
-def write_page(out, body, title):
-    """Write out/index.html atomically (a temporary folder renamed into place)."""
+def page_html(body, title):
+    """The complete, self-contained page (figures embedded as data URIs)."""
     from .report import _CSS
 
+    return _PAGE.format(title=_e(title), css=_CSS, version=_e(_core.__version__), body=body)
+
+
+def prepare_folder(out):
+    """`out` as a folder for index.html: created when missing (with its parents); an error
+    naming the path when it exists and is not a folder."""
     out = pathlib.Path(out)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    tmp = pathlib.Path(tempfile.mkdtemp(prefix=f".{out.name}-tmp-", dir=out.parent))
+    if out.exists() and not out.is_dir():
+        raise NotADirectoryError(f"cannot write the report to {out}: it is not a folder")
+    out.mkdir(parents=True, exist_ok=True)
+    return out
+
+
+def write_page(out, body, title):
+    """Write out/index.html atomically and nothing else: a temporary file in `out` renamed over
+    index.html. Nothing already in `out` is removed or changed; `out` (or a symbolic link to a
+    folder) is created when missing. A path that exists and is not a folder is an error."""
+    out = prepare_folder(out)
+    index = out / "index.html"
+    fd, tmp = tempfile.mkstemp(prefix=".index.html.tmp-", dir=out)
     try:
-        (tmp / "index.html").write_text(
-            _PAGE.format(title=_e(title), css=_CSS, version=_e(_core.__version__), body=body),
-            encoding="utf-8")
-        os.chmod(tmp, 0o755)
-        if out.exists():
-            shutil.rmtree(out)
-        os.replace(tmp, out)
+        with os.fdopen(fd, "w", encoding="utf-8") as f:
+            f.write(page_html(body, title))
+        os.chmod(tmp, 0o644)
+        os.replace(tmp, index)
     except BaseException:
-        shutil.rmtree(tmp, ignore_errors=True)
+        with contextlib.suppress(OSError):
+            os.unlink(tmp)
         raise
-    return out / "index.html"
+    return index
+
+
+def one_line_error(exc):
+    """A one-line message for `exc`: an OSError as "<path>: <reason>" (no Python reprs)."""
+    if isinstance(exc, OSError) and exc.strerror and exc.filename is not None:
+        reason = exc.strerror[0].lower() + exc.strerror[1:]
+        return f"{os.fsdecode(exc.filename)}: {reason}"
+    return " ".join(str(exc).split()) or type(exc).__name__
 
 
 # --------------------------------------------------------------------------------------------
@@ -448,15 +471,22 @@ def main(argv=None):
         prog="python -m roughscope.report_measure",
         description="Write the HTML report of one measurement (the JSON of roughscope measure "
                     "--json on standard input).")
-    parser.add_argument("--out", required=True, help="output folder (replaced as a whole)")
+    parser.add_argument("--out", required=True,
+                        help="folder for index.html (nothing else in it is touched), or - for "
+                             "the page on standard output")
     args = parser.parse_args(argv)
     try:
+        if args.out != "-":
+            prepare_folder(args.out)
         doc = json.load(sys.stdin)
         body = measurement_html(doc)
+        if args.out == "-":
+            sys.stdout.write(page_html(body, "roughscope measurement"))
+            sys.stdout.flush()
+            return 0
         index = write_page(args.out, body, "roughscope measurement")
     except Exception as exc:  # one line, no traceback: this is a command-line tool
-        message = " ".join(str(exc).split()) or type(exc).__name__
-        print(f"roughscope.report_measure: error: {message}", file=sys.stderr)
+        print(f"roughscope.report_measure: error: {one_line_error(exc)}", file=sys.stderr)
         return 1
     print(index)
     return 0

@@ -154,10 +154,13 @@ def map_html(doc, maps_dir=None, truth=None):
         parts.append(f"<p>Registration of the pair (phase correlation): shift "
                      f"({reg['shift_x_px']:.3g}, {reg['shift_y_px']:.3g}) px, response "
                      f"{reg['response']:.3g}.</p>")
-    if maps_dir:
+    # `roughscope measure --maps DIR --report ...` hands over the map files before they are
+    # committed: "staged_files" maps each name to its temporary file.
+    staged = m.get("staged_files") or {}
+    if maps_dir or staged:
         figures = []
         for name in ("sigma_over_T_gaussian.png", "roughness_class.png"):
-            path = pathlib.Path(maps_dir) / name
+            path = pathlib.Path(staged[name]) if name in staged else pathlib.Path(maps_dir) / name
             if path.is_file():
                 figures.append(_img_tag(path.read_bytes(), name))
         if figures:

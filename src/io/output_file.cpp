@@ -14,6 +14,7 @@
 
 #include <fcntl.h>
 #include <sys/stat.h>
+#include <sys/types.h>
 #include <unistd.h>
 
 #include "roughscope/core/errors.hpp"
@@ -35,28 +36,44 @@ constexpr int kMaxSymlinks = 40;  // as the kernel's ELOOP limit
 constexpr std::size_t kCleanupSlots = 64;
 std::array<std::atomic<char*>, kCleanupSlots> g_pending{};
 
-int register_pending(const std::string& path) {
-    char* copy = static_cast<char*>(std::malloc(path.size() + 1));
-    if (copy == nullptr) return -1;
-    std::memcpy(copy, path.c_str(), path.size() + 1);
-    for (std::size_t k = 0; k < kCleanupSlots; ++k) {
-        char* expected = nullptr;
-        if (g_pending[k].compare_exchange_strong(expected, copy)) return static_cast<int>(k);
-    }
-    std::free(copy);  // registry full: this file is removed on errors, not on signals
-    return -1;
-}
+int register_in(std::array<std::atomic<char*>, kCleanupSlots>& registry, const std::string& path);
+
+// A full registry leaves the file to be removed on errors, not on signals.
+int register_pending(const std::string& path) { return register_in(g_pending, path); }
 
 void unregister_pending(int slot) {
     if (slot < 0) return;
     std::free(g_pending[static_cast<std::size_t>(slot)].exchange(nullptr));
 }
 
+// Folders created by an OutputDirectory and not yet kept: removed (rmdir: only when empty) after
+// the temporary files, innermost first.
+std::array<std::atomic<char*>, kCleanupSlots> g_pending_dirs{};
+// The helper process to kill on a signal (ChildProcessGuard), or 0.
+std::atomic<pid_t> g_child{0};
+
+int register_in(std::array<std::atomic<char*>, kCleanupSlots>& registry, const std::string& path) {
+    char* copy = static_cast<char*>(std::malloc(path.size() + 1));
+    if (copy == nullptr) return -1;
+    std::memcpy(copy, path.c_str(), path.size() + 1);
+    for (std::size_t k = 0; k < kCleanupSlots; ++k) {
+        char* expected = nullptr;
+        if (registry[k].compare_exchange_strong(expected, copy)) return static_cast<int>(k);
+    }
+    std::free(copy);
+    return -1;
+}
+
 extern "C" void remove_pending_and_reraise(int signal_number) {
     const int saved_errno = errno;
+    if (const pid_t child = g_child.load(); child > 0) ::kill(child, SIGKILL);
     for (auto& slot : g_pending) {
         const char* path = slot.load();
         if (path != nullptr) ::unlink(path);
+    }
+    for (std::size_t k = kCleanupSlots; k-- > 0;) {
+        const char* path = g_pending_dirs[k].load();
+        if (path != nullptr) ::rmdir(path);
     }
     errno = saved_errno;
     // SA_RESETHAND restored the default action; the re-raised signal is delivered on return.
@@ -268,6 +285,11 @@ void OutputFile::write(std::string_view chunk) {
     if (buffer_.size() >= kFlushBytes) flush_buffer();
 }
 
+void OutputFile::flush() {
+    if (!mode_) throw DataError("cannot write " + name_ + ": the output is not open");
+    flush_buffer();
+}
+
 void OutputFile::commit() {
     if (!mode_) throw DataError("cannot write " + name_ + ": the output is not open");
     flush_buffer();
@@ -307,6 +329,71 @@ void write_output(const std::optional<fs::path>& path, std::string_view content)
     out.write(content);
     out.commit();
 }
+
+// ---------------------------------------------------------------------------------------------
+// OutputDirectory, ChildProcessGuard
+
+OutputDirectory::OutputDirectory(const fs::path& path, const std::string& what) : path_(path) {
+    const auto fail = [&](const std::string& reason) {
+        remove_created();
+        throw DataError("cannot write " + (what.empty() ? std::string() : what + " ") +
+                        path.string() + ": " + reason);
+    };
+    if (path.empty()) fail("empty folder name");
+    // The missing components, outermost first (stat follows symbolic links: a link to a folder
+    // is written through).
+    std::vector<fs::path> missing;
+    for (fs::path p = path; !p.empty(); p = p.parent_path()) {
+        struct stat st {};
+        if (::stat(p.c_str(), &st) == 0) {
+            if (!S_ISDIR(st.st_mode))
+                fail(p == path ? std::string("is not a folder") : p.string() + " is not a folder");
+            break;
+        }
+        if (errno != ENOENT) fail(errno_text(errno));
+        missing.push_back(p);
+        if (p == p.parent_path()) break;
+    }
+    for (auto it = missing.rbegin(); it != missing.rend(); ++it) {
+        if (::mkdir(it->c_str(), 0777) != 0 && errno != EEXIST)
+            fail("cannot create " + it->string() + ": " + errno_text(errno));
+        created_.push_back(it->string());
+        cleanup_slots_.push_back(register_in(g_pending_dirs, it->string()));
+    }
+}
+
+OutputDirectory::~OutputDirectory() { remove_created(); }
+
+OutputDirectory::OutputDirectory(OutputDirectory&& other) noexcept
+    : path_(std::move(other.path_)),
+      created_(std::exchange(other.created_, {})),
+      cleanup_slots_(std::exchange(other.cleanup_slots_, {})) {}
+
+OutputDirectory& OutputDirectory::operator=(OutputDirectory&& other) noexcept {
+    if (this != &other) {
+        remove_created();
+        path_ = std::move(other.path_);
+        created_ = std::exchange(other.created_, {});
+        cleanup_slots_ = std::exchange(other.cleanup_slots_, {});
+    }
+    return *this;
+}
+
+void OutputDirectory::keep() noexcept {
+    for (const int slot : cleanup_slots_)
+        if (slot >= 0) std::free(g_pending_dirs[static_cast<std::size_t>(slot)].exchange(nullptr));
+    cleanup_slots_.clear();
+    created_.clear();
+}
+
+void OutputDirectory::remove_created() noexcept {
+    for (auto it = created_.rbegin(); it != created_.rend(); ++it) ::rmdir(it->c_str());
+    created_.clear();
+    keep();
+}
+
+ChildProcessGuard::ChildProcessGuard(int pid) noexcept { g_child.store(pid); }
+ChildProcessGuard::~ChildProcessGuard() { g_child.store(0); }
 
 void install_output_cleanup_handlers() {
     for (const int signal_number : {SIGINT, SIGTERM, SIGHUP, SIGQUIT}) {

@@ -17,13 +17,16 @@
 //    changed.
 // Temporary files are registered for install_output_cleanup_handlers(): a program that installs
 // them (the CLI does) removes its pending temporary files when killed by SIGINT, SIGTERM, SIGHUP
-// or SIGQUIT, then dies of the signal as usual.
+// or SIGQUIT, then dies of the signal as usual. The same handlers remove the folders an
+// OutputDirectory created and not yet kept (when empty) and kill the helper process registered
+// with ChildProcessGuard, so that a signal leaves nothing new behind.
 #pragma once
 
 #include <filesystem>
 #include <optional>
 #include <string>
 #include <string_view>
+#include <vector>
 
 namespace roughscope::io {
 
@@ -57,6 +60,11 @@ class OutputFile {
     // Writes out everything and makes the output visible (rename for Mode::Replace). Throws
     // DataError on failure, after removing the temporary file.
     void commit();
+    // Writes out what is pending without committing: the content so far can be read back from
+    // temporary_path() (Mode::Replace), e.g. by a helper process, before it is made visible.
+    void flush();
+    // Mode::Replace: the temporary file the content goes to until commit(); else empty.
+    const std::string& temporary_path() const { return temp_; }
     // Discards the output: removes the temporary file (Mode::Replace) or stops writing (Direct,
     // Stdout; what was already written stays). Never throws.
     void abort() noexcept;
@@ -90,6 +98,44 @@ void write_output(const std::optional<std::filesystem::path>& path, std::string_
 
 // Opens `path` when given, else standard output.
 OutputFile open_output(const std::optional<std::filesystem::path>& path);
+
+// The folder outputs go into, created (with its missing parents) when it does not exist. The
+// folders it created are removed again (only while empty: never a file or folder it did not
+// create) when it is destroyed without keep(), or when the program is killed by a signal handled
+// by install_output_cleanup_handlers(). An existing folder (or a symbolic link to one) is used as
+// it is; a path that exists and is not a folder is DataError "cannot write <what> <path>: is not a
+// folder", as is a folder that cannot be created. `what` names the output in messages (e.g.
+// "--maps").
+class OutputDirectory {
+  public:
+    OutputDirectory() = default;
+    OutputDirectory(const std::filesystem::path& path, const std::string& what);
+    ~OutputDirectory();
+    OutputDirectory(OutputDirectory&& other) noexcept;
+    OutputDirectory& operator=(OutputDirectory&& other) noexcept;
+    OutputDirectory(const OutputDirectory&) = delete;
+    OutputDirectory& operator=(const OutputDirectory&) = delete;
+
+    // The folders created stay (the outputs in them were committed).
+    void keep() noexcept;
+    const std::filesystem::path& path() const { return path_; }
+
+  private:
+    void remove_created() noexcept;
+    std::filesystem::path path_;
+    std::vector<std::string> created_;  // outermost first
+    std::vector<int> cleanup_slots_;
+};
+
+// While alive, a signal handled by install_output_cleanup_handlers() also kills (SIGKILL) the
+// process `pid` (a helper the program started and waits for), before the program dies itself.
+class ChildProcessGuard {
+  public:
+    explicit ChildProcessGuard(int pid) noexcept;
+    ~ChildProcessGuard();
+    ChildProcessGuard(const ChildProcessGuard&) = delete;
+    ChildProcessGuard& operator=(const ChildProcessGuard&) = delete;
+};
 
 // Installs handlers for SIGINT, SIGTERM, SIGHUP and SIGQUIT (those not ignored) that remove the
 // pending temporary files of every open OutputFile (async-signal-safe: unlink only), restore the

@@ -1,4 +1,5 @@
 // The output sink (roughscope/io/output_file.hpp): what each kind of destination becomes.
+#include <chrono>
 #include <csignal>
 #include <filesystem>
 #include <fstream>
@@ -260,5 +261,107 @@ TEST(OutputSink, WithoutTheHandlerASignalLeavesTheTemporaryFile) {
     ASSERT_TRUE(WIFSIGNALED(status));
     EXPECT_EQ(slurp(f), "old");
     EXPECT_EQ(entries(d), 2u);
+    fs::remove_all(d);
+}
+
+// ---------------------------------------------------------------------------------------------
+// OutputDirectory: the folders it makes go again unless kept; what was there is never touched.
+
+TEST(OutputFolder, CreatedFoldersAreRemovedUnlessKept) {
+    const fs::path d = fresh_dir("folder");
+    {
+        io::OutputDirectory out(d / "a" / "b" / "c", "--maps");
+        EXPECT_TRUE(fs::is_directory(d / "a" / "b" / "c"));
+    }
+    EXPECT_EQ(entries(d), 0u);
+    {
+        io::OutputDirectory out(d / "a" / "b", "--maps");
+        out.keep();
+    }
+    EXPECT_TRUE(fs::is_directory(d / "a" / "b"));
+    fs::remove_all(d);
+}
+
+TEST(OutputFolder, AnExistingFolderAndItsFilesAreLeftAsTheyWere) {
+    const fs::path d = fresh_dir("folder_existing");
+    put(d / "photo.png", "keep");
+    fs::create_directory(d / "sub");
+    { io::OutputDirectory out(d, "--report"); }  // not kept: still nothing removed
+    EXPECT_EQ(slurp(d / "photo.png"), "keep");
+    EXPECT_TRUE(fs::is_directory(d / "sub"));
+    // A created folder that is no longer empty stays (only empty folders are removed).
+    {
+        io::OutputDirectory out(d / "new", "--report");
+        put(d / "new" / "user.txt", "x");
+    }
+    EXPECT_EQ(slurp(d / "new" / "user.txt"), "x");
+    fs::remove_all(d);
+}
+
+TEST(OutputFolder, ASymlinkToAFolderIsWrittenThroughAndAFileIsRefused) {
+    const fs::path d = fresh_dir("folder_link");
+    fs::create_directory(d / "real");
+    fs::create_directory_symlink(d / "real", d / "link");
+    {
+        io::OutputDirectory out(d / "link", "--report");
+        out.keep();
+    }
+    EXPECT_TRUE(fs::is_symlink(d / "link"));
+    put(d / "file", "keep");
+    try {
+        io::OutputDirectory out(d / "file", "--report");
+        FAIL() << "a file accepted as a folder";
+    } catch (const DataError& e) {
+        const std::string what = e.what();
+        EXPECT_NE(what.find("--report"), std::string::npos) << what;
+        EXPECT_NE(what.find((d / "file").string()), std::string::npos) << what;
+        EXPECT_NE(what.find("not a folder"), std::string::npos) << what;
+    }
+    EXPECT_THROW(io::OutputDirectory(d / "file" / "sub", "--maps"), DataError);
+    EXPECT_EQ(slurp(d / "file"), "keep");
+    fs::remove_all(d);
+}
+
+TEST(OutputFolder, ASignalRemovesTheCreatedFoldersAndKillsTheHelperProcess) {
+    const fs::path d = fresh_dir("folder_signal");
+    int ready[2];
+    ASSERT_EQ(::pipe(ready), 0);
+    const pid_t child = ::fork();
+    ASSERT_GE(child, 0);
+    if (child == 0) {
+        io::install_output_cleanup_handlers();
+        io::OutputDirectory folder(d / "x" / "y", "--maps");
+        io::OutputFile out(d / "x" / "y" / "layer.npy");
+        out.write("data");
+        const pid_t helper = ::fork();
+        if (helper == 0) {
+            ::pause();
+            ::_exit(0);
+        }
+        const io::ChildProcessGuard guard(helper);
+        [[maybe_unused]] const ssize_t n = ::write(ready[1], &helper, sizeof helper);
+        ::pause();  // SIGTERM from the test
+        ::_exit(0);
+    }
+    ::close(ready[1]);
+    pid_t helper = 0;
+    ASSERT_EQ(::read(ready[0], &helper, sizeof helper), static_cast<ssize_t>(sizeof helper));
+    ::close(ready[0]);
+    ASSERT_EQ(::kill(child, SIGTERM), 0);
+    int status = 0;
+    ASSERT_EQ(::waitpid(child, &status, 0), child);
+    ASSERT_TRUE(WIFSIGNALED(status));
+    EXPECT_EQ(entries(d), 0u);  // the temporary file and both folders are gone
+    // The helper (now a child of init) was killed: it is gone or a zombie.
+    bool gone = false;
+    for (int k = 0; k < 200 && !gone; ++k) {
+        std::ifstream stat_file("/proc/" + std::to_string(helper) + "/stat");
+        std::string text;
+        std::getline(stat_file, text);
+        gone = !stat_file || text.find(") Z") != std::string::npos;
+        if (!gone) std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+    EXPECT_TRUE(gone);
+    if (!gone) ::kill(helper, SIGKILL);
     fs::remove_all(d);
 }
