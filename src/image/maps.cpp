@@ -1608,6 +1608,14 @@ RoughnessMap roughness_map(const std::vector<MapCapture>& captures, const MapOpt
                 warn(concat("roughness map: ", shift, ", but the peak-to-sidelobe ratio is below ",
                             check::format_number(o.min_peak_to_sidelobe),
                             ": the images share too little structure to tell"));
+            else if (!o.normal_map.empty())
+                // A curved object's shading moves with the light, and phase correlation reads
+                // that as a shift as confidently as a movement of the camera (docs/maps.md
+                // "Registration"): no evidence of a movement, so no refusal.
+                warn(concat("roughness map: ", shift,
+                            ", but with a normal map the shading moves with the light, which "
+                            "phase correlation cannot tell from a movement of the camera: not "
+                            "refused; the map assumes the camera did not move"));
             else if (!o.allow_misregistration)
                 throw DataError(concat("roughness map: ", shift,
                                        ": register the images (or allow the misregistration)"));

@@ -421,7 +421,10 @@ ObjectShape parse_object_shape(std::string_view name) {
 namespace {
 
 // The normals of a normal-map image (ObjectSpec::normal_map): 3 floats per pixel, NaN off the
-// object.
+// object. Every finite normal is used: the reader's flags for light (a component at or below 0
+// is "clipped low", at or above 1 "saturated") say nothing about a direction; only a missing
+// sample (NaN in a float file) and a vector shorter than 0.5 (the usual off-object marker, e.g.
+// (0, 0, 0)) are off the object.
 std::vector<float> decode_normal_map(const LinearImage& image, const std::string& src) {
     if (image.channels != 3)
         throw DataError(concat(src, ": normal map ", image.info.source, " has ",
@@ -437,7 +440,8 @@ std::vector<float> decode_normal_map(const LinearImage& image, const std::string
             v[c] = encoded ? 2.0 * x - 1.0 : x;
         }
         const double norm = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
-        const bool on = norm >= 0.5 && (image.flags.empty() || image.flags[k] == 0);
+        const bool missing = !image.flags.empty() && (image.flags[k] & kPixelMissing) != 0;
+        const bool on = !missing && norm >= 0.5;
         for (std::size_t c = 0; c < 3; ++c)
             normals[3 * k + c] =
                 on ? static_cast<float>(v[c] / norm) : std::numeric_limits<float>::quiet_NaN();
