@@ -46,16 +46,18 @@ struct Accumulator {
         sum += v;
         sum2 += v * v;
     }
+    // The mean and its standard error sd/√n; one value, or values without spread, give no
+    // standard error: unknown (NaN), not 0.
     std::optional<Estimate> mean() const {
         if (n == 0) return std::nullopt;
         const double m = sum / static_cast<double>(n);
-        double se = 0.0;
+        if (!std::isfinite(m)) return std::nullopt;
+        double se = std::numeric_limits<double>::quiet_NaN();
         if (n >= 2) {
             const double var =
                 std::max(0.0, (sum2 - static_cast<double>(n) * m * m) / static_cast<double>(n - 1));
-            se = std::sqrt(var / static_cast<double>(n));
+            if (var > 0.0 && std::isfinite(var)) se = std::sqrt(var / static_cast<double>(n));
         }
-        if (!std::isfinite(m) || !std::isfinite(se)) return std::nullopt;
         return Estimate{m, se};
     }
 };
@@ -1490,6 +1492,15 @@ void summarise(const Evaluator& tables, const MapOptions& o, RoughnessMap& map,
             table_e ? pooled_sigma_over_T(*table_e, ra.log_ratio) : ra.exponential.mean();
         s.mean_T_um = ra.T.mean();
         s.class_counts = ra.classes;
+        const auto unknown = [](const std::optional<Estimate>& e) {
+            return e && std::isnan(e->std_error);
+        };
+        if (unknown(s.mean_sigma_over_T_gaussian) || unknown(s.mean_sigma_over_T_exponential) ||
+            unknown(s.mean_T_um))
+            map.warnings.push_back(concat("roughness map: region '", s.name, "' has ",
+                                          std::to_string(s.count),
+                                          " valid cell(s) without spread between them: the "
+                                          "standard error of its mean is unknown (null)"));
         map.regions.push_back(std::move(s));
     }
 }

@@ -12,6 +12,7 @@
 #include <thread>
 #include <utility>
 
+#include "measure_notes.hpp"
 #include "roughscope/core/errors.hpp"
 #include "roughscope/core/names.hpp"
 #include "roughscope/core/text.hpp"
@@ -320,11 +321,52 @@ void estimate_specular(const CaptureMeasurement& capture, const MeasureRequest& 
     }
 }
 
+// σ known (given or from a specular capture); sigma_stderr_known false when the specular
+// capture could not give its standard error.
+struct KnownSigma {
+    std::optional<double> value;
+    double stderr_um = 0.0;
+    bool stderr_known = true;
+};
+
+// The standard errors that rest on a brightness whose noise the region cannot give (a standard
+// error of exactly 0: one pixel, or no spread between its pixels) are unknown, not 0
+// (measure.hpp): NaN, with a warning naming the capture.
+void mark_unknown_diffuse_errors(const CaptureMeasurement& c1, const CaptureMeasurement& c2,
+                                 const std::string& src, bool sigma_stderr_known,
+                                 MeasureResult& result) {
+    bool ratio_known = true;
+    for (const CaptureMeasurement* c : {&c1, &c2}) {
+        if (c->brightness_relative_stderr > 0.0) continue;
+        ratio_known = false;
+        result.warnings.push_back(
+            concat(src, ": ", c->spec.image, ": the region's brightness has no measurable noise (",
+                   std::to_string(c->region.average.count),
+                   " pixel(s) used, standard error 0): the standard errors of E1/E2, σ/T and T are "
+                   "unknown (null)"));
+    }
+    if (!ratio_known) {
+        detail::mark_unknown(result.E1_over_E2);
+        for (auto* e :
+             {&result.slope_gaussian, &result.slope_exponential, &result.correlation_length})
+            if (*e) detail::mark_unknown_errors(**e, false);
+    }
+    if (!sigma_stderr_known) {
+        // T = σ/(σ/T) and T given σ carry σ's unknown error.
+        for (auto* e : {&result.slope_gaussian, &result.slope_exponential})
+            if (*e) detail::mark_unknown((*e)->T_um);
+        if (result.correlation_length)
+            detail::mark_unknown_errors(*result.correlation_length, false);
+    }
+}
+
 void estimate_diffuse(const std::vector<const CaptureMeasurement*>& diffuse,
-                      const MeasureRequest& request, std::optional<double> sigma_um,
-                      double sigma_um_stderr, MeasureResult& result) {
+                      const MeasureRequest& request, const KnownSigma& known,
+                      MeasureResult& result) {
     const CaptureMeasurement& c1 = *diffuse[0];
     const CaptureMeasurement& c2 = *diffuse[1];
+    const std::optional<double>& sigma_um = known.value;
+    const double sigma_um_stderr = known.stderr_um;
     const double ratio = c1.brightness / c2.brightness;
     const double e1 = c1.brightness_relative_stderr;
     const double e2 = c2.brightness_relative_stderr;
@@ -334,7 +376,21 @@ void estimate_diffuse(const std::vector<const CaptureMeasurement*>& diffuse,
     options.factor = request.factor;
     options.radiometry = request.radiometry;
     options.wavelength_um = request.wavelength_um;
-    options.regime = request.regime;
+    if (sigma_um) {
+        options.regime = detail::correlation_length_regime(
+            request.regime, *sigma_um, c1.spec.geometry, c2.spec.geometry, request.wavelength_um);
+        result.correlation_length_regime = options.regime;
+        result.correlation_length_regime_given = request.regime.has_value();
+        const double g =
+            detail::largest_g(*sigma_um, c1.spec.geometry, c2.spec.geometry, request.wavelength_um);
+        if (!request.regime && options.regime != Regime::SlightlyRough)
+            result.warnings.push_back(concat(
+                "T given σ: g = ", check::format_number(g),
+                " (the larger of the two captures) is beyond the slightly rough range g < ",
+                check::format_number(kSlightlyRoughMaxG),
+                " of the paper's Eq. 15: T is from the exact series of the diffuse term (regime "
+                "\"series\"); \"regime\": \"slightly_rough\" in the capture file gives Eq. 15"));
+    }
     std::vector<std::string> failures;
     for (const Correlation correlation : {Correlation::Gaussian, Correlation::Exponential}) {
         SlopeInput input;
@@ -367,6 +423,7 @@ void estimate_diffuse(const std::vector<const CaptureMeasurement*>& diffuse,
             result.correlation_length = estimate_correlation_length(input);
         } catch (const NoSolution& e) {
             failures.push_back(concat("T given σ: ", e.what()));
+            result.correlation_length_regime.reset();
         }
     }
     if (!result.slope_gaussian && !result.slope_exponential && !result.correlation_length) {
@@ -377,6 +434,7 @@ void estimate_diffuse(const std::vector<const CaptureMeasurement*>& diffuse,
         throw NoSolution(message);
     }
     for (const auto& f : failures) result.warnings.push_back(concat(where(request), ": ", f));
+    mark_unknown_diffuse_errors(c1, c2, where(request), known.stderr_known, result);
     // The warnings of the estimates behind the headline values (σ/T Gaussian gives θK, ξK and
     // the slope; T given σ): the exponential estimate keeps its own in its object.
     const std::array<std::pair<const char*, const std::optional<RoughnessEstimate>*>, 2> estimates{
@@ -678,8 +736,7 @@ MeasureResult measure(const MeasureRequest& request) {
         }
     }
 
-    std::optional<double> sigma_um = request.sigma_um;
-    double sigma_um_stderr = request.sigma_um_stderr;
+    KnownSigma known{request.sigma_um, request.sigma_um_stderr, true};
     for (const CaptureMeasurement& c : result.captures) {
         if (c.spec.role != CaptureRole::Specular) continue;
         const Geometry& g = c.spec.geometry;
@@ -693,13 +750,32 @@ MeasureResult measure(const MeasureRequest& request) {
                        "°, theta_s = ", check::format_number(rad_to_deg(g.theta_s_rad)),
                        "°, phi_s = ", check::format_number(rad_to_deg(g.phi_s_rad)), "°"));
         estimate_specular(c, request, result);
+        // A highlight whose core or surround has no measurable noise gives σ with a standard
+        // error of 0: unknown (measure.hpp).
+        const auto zero_error = [](const RoughnessEstimate& e) {
+            return e.sigma_um && !(e.sigma_um->std_error > 0.0);
+        };
+        for (ChannelSigma& cs : result.specular_sigma)
+            if (zero_error(cs.estimate)) detail::mark_unknown_errors(cs.estimate, true);
+        if (result.sigma && zero_error(*result.sigma)) {
+            detail::mark_unknown_errors(*result.sigma, true);
+            result.warnings.push_back(concat(src, ": ", c.spec.image,
+                                             ": the highlight's core or surround has no "
+                                             "measurable noise (standard error 0): the standard "
+                                             "error of σ is unknown (null)"));
+        }
         break;  // the first specular capture gives σ
     }
-    if (!sigma_um && result.sigma && result.sigma->sigma_um) {
-        sigma_um = result.sigma->sigma_um->value;
-        sigma_um_stderr = result.sigma->sigma_um->std_error;
+    if (!known.value && result.sigma && result.sigma->sigma_um) {
+        known.value = result.sigma->sigma_um->value;
+        known.stderr_um = result.sigma->sigma_um->std_error;
+        // Not a number (unknown, measure.hpp): T's error leaves σ's out and is unknown too.
+        if (!(known.stderr_um > 0.0)) {
+            known.stderr_um = 0.0;
+            known.stderr_known = false;
+        }
     }
-    if (diffuse.size() >= 2) estimate_diffuse(diffuse, request, sigma_um, sigma_um_stderr, result);
+    if (diffuse.size() >= 2) estimate_diffuse(diffuse, request, known, result);
 
     if (request.maps) {
         MapOptions options = request.maps->options;
@@ -707,9 +783,9 @@ MeasureResult measure(const MeasureRequest& request) {
         options.radiometry = request.radiometry;
         options.wavelength_um = request.wavelength_um;
         options.correlation = request.correlation;
-        if (sigma_um) {
-            options.sigma_um = sigma_um;
-            options.sigma_um_stderr = sigma_um_stderr;
+        if (known.value) {
+            options.sigma_um = known.value;
+            options.sigma_um_stderr = known.stderr_um;
         }
         std::vector<float> normals;
         if (shape == ObjectShape::NormalMap) {
@@ -751,6 +827,8 @@ MeasureResult measure(const MeasureRequest& request) {
         result.map = roughness_map(captures, options);
         for (const auto& w : result.map->warnings) result.warnings.push_back(concat("map: ", w));
     }
+    if (detail::has_exponential_sigma_over_T(result))
+        result.warnings.push_back(detail::exponential_note());
     // Each warning once, in the order first given.
     std::vector<std::string> unique;
     for (auto& w : result.warnings)
