@@ -16,9 +16,11 @@
 #include <gtest/gtest.h>
 
 #include "../io/test_files.hpp"
+#include "map_captures.hpp"
 #include "roughscope/core/errors.hpp"
 #include "roughscope/core/text.hpp"
 #include "roughscope/estimation/estimation.hpp"
+#include "roughscope/image/maps.hpp"
 #include "roughscope/image/measure.hpp"
 #include "roughscope/io/output_file.hpp"
 #include "roughscope/scattering/factors.hpp"
@@ -225,6 +227,39 @@ TEST(MeasureStandardErrors, AOnePixelRegionHasUnknownErrors) {
     for (const auto& w : result.warnings) said += w.find("no measurable noise") != w.npos;
     EXPECT_EQ(said, 2u);
     fs::remove_all(dir);
+}
+
+// A map region of one tile: the mean over one cell has no standard error to give (unknown,
+// NaN), not 0, and a warning names the region; a region of fifteen tiles keeps a finite one.
+TEST(MapStandardErrors, ARegionOfOneCellHasAnUnknownError) {
+    sim::Scene scene;
+    scene.width = scene.height = 32;
+    const double t1 = deg_to_rad(30.0), t2 = deg_to_rad(45.0);
+    const roughscope::testing::LitPair p = roughscope::testing::render_lit_pair(
+        scene, {roughscope::testing::very_rough_truth(0.5)}, {}, {}, t1, t2, 7);
+    std::vector<MapCapture> captures(2);
+    captures[0].image = &p.a;
+    captures[0].geometry = normal_view_geometry(t1);
+    captures[1].image = &p.b;
+    captures[1].geometry = normal_view_geometry(t2);
+    std::vector<std::int32_t> labels(32 * 32, 1);
+    for (std::size_t r = 0; r < 8; ++r)
+        for (std::size_t c = 0; c < 8; ++c) labels[r * 32 + c] = 0;
+    MapOptions o;
+    o.window_px = 8;
+    o.region_labels = labels;
+    o.region_names = {"one", "rest"};
+    const RoughnessMap map = roughness_map(captures, o);
+    ASSERT_EQ(map.regions.size(), 2u);
+    ASSERT_EQ(map.regions[0].count, 1u);
+    ASSERT_TRUE(map.regions[0].mean_sigma_over_T_gaussian);
+    EXPECT_TRUE(std::isfinite(map.regions[0].mean_sigma_over_T_gaussian->value));
+    EXPECT_TRUE(std::isnan(map.regions[0].mean_sigma_over_T_gaussian->std_error));
+    ASSERT_EQ(map.regions[1].count, 15u);
+    EXPECT_GT(map.regions[1].mean_sigma_over_T_gaussian->std_error, 0.0);
+    bool said = false;
+    for (const auto& w : map.warnings) said |= w.find("region 'one'") != w.npos;
+    EXPECT_TRUE(said);
 }
 
 // ---------------------------------------------------------------------------------------------
