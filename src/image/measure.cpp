@@ -717,6 +717,8 @@ MeasureResult measure(const MeasureRequest& request) {
     assign_exposures(result.captures, result.warnings, src);
     if (is_profile(shape)) {
         for (CaptureMeasurement& c : result.captures) c.brightness_relative_stderr = 0.0;
+        if (detail::has_exponential_sigma_over_T(result))
+            result.warnings.push_back(detail::exponential_note());
         return result;
     }
     std::vector<const CaptureMeasurement*> diffuse;
