@@ -356,7 +356,7 @@ void mark_unknown_diffuse_errors(const CaptureMeasurement& c1, const CaptureMeas
         for (auto* e : {&result.slope_gaussian, &result.slope_exponential})
             if (*e) detail::mark_unknown((*e)->T_um);
         if (result.correlation_length)
-            detail::mark_unknown_errors(*result.correlation_length, false);
+            detail::mark_unknown_errors(*result.correlation_length, true);
     }
 }
 

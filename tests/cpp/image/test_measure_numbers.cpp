@@ -229,6 +229,70 @@ TEST(MeasureStandardErrors, AOnePixelRegionHasUnknownErrors) {
     fs::remove_all(dir);
 }
 
+// A specular photograph without noise (a uniform disc in a uniform surround, 64 px): its σ has
+// no standard error to give, nor has T given that σ; both are unknown (null), with a warning.
+TEST(MeasureStandardErrors, ANoiseFreeHighlightGivesSigmaWithAnUnknownError) {
+    const fs::path dir = roughscope::testing::fresh_dir("measure_numbers_highlight");
+    sim::Scene scene;
+    scene.width = scene.height = 64;
+    std::vector<std::int32_t> labels(64 * 64, 0);
+    for (std::size_t r = 0; r < 64; ++r)
+        for (std::size_t c = 0; c < 64; ++c) {
+            const double dx = static_cast<double>(c) + 0.5 - 32.0;
+            const double dy = static_cast<double>(r) + 0.5 - 32.0;
+            if (dx * dx + dy * dy <= 36.0) labels[r * 64 + c] = 1;
+        }
+    auto constant = [](double value) {
+        sim::SurfaceTruth t;
+        t.model = sim::BrightnessModel::Tabulated;
+        t.tabulated = [value](const Geometry&) { return value; };
+        return t;
+    };
+    scene.light = light_at(14.0);
+    scene.view = sim::direction_from_angles(deg_to_rad(14.0), 0.0);
+    sim::CaptureOptions options;
+    options.threads = 1;
+    const sim::Capture specular = sim::render_capture(scene, {constant(1.0), constant(2.0)}, labels,
+                                                      camera(2.0, 61, false), options);
+    const fs::path specular_file = dir / "specular.tiff";
+    io::write_file_atomic(specular_file, sim::encode_capture_tiff(specular));
+    sim::Scene plane;
+    plane.width = plane.height = 64;
+    // The pair: the exact diffuse brightness of the σ the highlight gives (Eq. 13, R_spec = 1/2)
+    // and T = 0.3 µm.
+    const double sigma =
+        0.555 / (4.0 * kPi * std::cos(deg_to_rad(14.0))) * std::sqrt(std::log(2.0));
+    const auto [a, b] = render_pair(dir, plane, light_at(30.0), light_at(45.0), exact(sigma, 0.3),
+                                    exact(sigma, 0.3), 62);
+    const std::string text = concat(
+        R"({"roi": {"rect": [8, 8, 48, 48]}, "highlight": {"core_radius_px": 4,
+        "annulus_inner_px": 9, "annulus_outer_px": 14}, "captures": [{"image": ")",
+        specular_file.string(),
+        R"(", "theta_i_deg": 14, "theta_s_deg": 14, "role": "specular", "exposure_s": 1},
+        {"image": ")",
+        a.file.string(), R"(", "theta_i_deg": 30, "exposure_s": 1}, {"image": ")", b.file.string(),
+        R"(", "theta_i_deg": 45, "exposure_s": 1}]})");
+    const MeasureRequest request = parse_capture_file(text, (dir / "c.json").string());
+    const MeasureResult result = measure(request);
+    ASSERT_TRUE(result.sigma && result.sigma->sigma_um);
+    EXPECT_GT(result.sigma->sigma_um->value, 0.0);
+    EXPECT_TRUE(std::isnan(result.sigma->sigma_um->std_error));
+    ASSERT_TRUE(result.correlation_length && result.correlation_length->T_um);
+    EXPECT_TRUE(std::isnan(result.correlation_length->T_um->std_error));
+    EXPECT_NEAR(result.correlation_length->T_um->value, 0.3, 0.01);
+    // σ/T from the noisy pair keeps its error.
+    EXPECT_GT(result.slope_gaussian->sigma_over_T->std_error, 0.0);
+    const serialize::Json json = serialize::to_json(result, request);
+    EXPECT_TRUE(json["sigma_um"].is_number());
+    EXPECT_TRUE(json["sigma_um_stderr"].is_null());
+    EXPECT_TRUE(json["T_um_stderr"].is_null());
+    bool said = false;
+    for (const auto& w : result.warnings)
+        said |= w.find("the standard error of σ is unknown") != w.npos;
+    EXPECT_TRUE(said);
+    fs::remove_all(dir);
+}
+
 // A map region of one tile: the mean over one cell has no standard error to give (unknown,
 // NaN), not 0, and a warning names the region; a region of fifteen tiles keeps a finite one.
 TEST(MapStandardErrors, ARegionOfOneCellHasAnUnknownError) {
