@@ -15,6 +15,7 @@
 #include "measure_notes.hpp"
 #include "roughscope/core/errors.hpp"
 #include "roughscope/core/names.hpp"
+#include "roughscope/core/numbers.hpp"
 #include "roughscope/core/text.hpp"
 #include "roughscope/image/radiometry.hpp"
 
@@ -385,7 +386,7 @@ void estimate_diffuse(const std::vector<const CaptureMeasurement*>& diffuse,
             detail::largest_g(*sigma_um, c1.spec.geometry, c2.spec.geometry, request.wavelength_um);
         if (!request.regime && options.regime != Regime::SlightlyRough)
             result.warnings.push_back(concat(
-                "T given σ: g = ", check::format_number(g),
+                "T given σ: g = ", format_significant(g, 4, "g"),
                 " (the larger of the two captures) is beyond the slightly rough range g < ",
                 check::format_number(kSlightlyRoughMaxG),
                 " of the paper's Eq. 15: T is from the exact series of the diffuse term (regime "
