@@ -943,9 +943,9 @@ TEST(RoughnessMap, LayersNotAskedForAreNotMadeAndTheRestIsTheSame) {
     };
     auto same_estimate = [](const std::optional<Estimate>& a, const std::optional<Estimate>& b) {
         return a.has_value() == b.has_value() &&
-               (!a || (a->value == b->value &&
-                       (a->std_error == b->std_error ||
-                        (std::isnan(a->std_error) && std::isnan(b->std_error)))));
+               (!a ||
+                (a->value == b->value && (a->std_error == b->std_error ||
+                                          (std::isnan(a->std_error) && std::isnan(b->std_error)))));
     };
     const MapInstructionSet before = map_instruction_set();
     for (const MapInstructionSet isa : kInstructionSets)
