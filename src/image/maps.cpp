@@ -804,27 +804,25 @@ class Evaluator {
                 const double g = std::max(roughness_g(*o.sigma_um, c1_.geometry, o.wavelength_um),
                                           roughness_g(*o.sigma_um, c2_.geometry, o.wavelength_um));
                 flat_g_class_ = roughness_class(g);
-                if (*flat_g_class_ != RoughnessClass::VeryRough) {
-                    // T from the diffuse term of the class's regime (Eq. 15 for slightly rough).
-                    TwoGeometryOptions m = model_;
-                    m.regime = *flat_g_class_ == RoughnessClass::SlightlyRough
-                                   ? Regime::SlightlyRough
-                                   : Regime::Series;
-                    try {
-                        table_t_ = std::make_shared<const RatioInverseTable>(
+                // T from the diffuse term valid at the sample's g: Eq. 3 (Eq. 15) for a
+                // slightly rough sample, the exact series at any other g (Eq. 4/5 leave it:
+                // at g = 18 Eq. 4 gives T 4 % high, Eq. 5 80 % low).
+                TwoGeometryOptions m = model_;
+                m.regime = *flat_g_class_ == RoughnessClass::SlightlyRough ? Regime::SlightlyRough
+                                                                           : Regime::Series;
+                try {
+                    table_t_ = std::make_shared<const RatioInverseTable>(
+                        RatioInverseTable::correlation_length(
+                            c1_.geometry, c2_.geometry, *o.sigma_um, o.correlation, m, o.table));
+                    if (o.sigma_um_stderr > 0.0) {
+                        sigma_step_ = *o.sigma_um * 1e-4;
+                        table_t2_ = std::make_shared<const RatioInverseTable>(
                             RatioInverseTable::correlation_length(c1_.geometry, c2_.geometry,
-                                                                  *o.sigma_um, o.correlation, m,
-                                                                  o.table));
-                        if (o.sigma_um_stderr > 0.0) {
-                            sigma_step_ = *o.sigma_um * 1e-4;
-                            table_t2_ = std::make_shared<const RatioInverseTable>(
-                                RatioInverseTable::correlation_length(c1_.geometry, c2_.geometry,
-                                                                      *o.sigma_um + sigma_step_,
-                                                                      o.correlation, m, o.table));
-                        }
-                    } catch (const NoSolution& e) {
-                        map_.warnings.push_back(concat("T given σ: ", e.what()));
+                                                                  *o.sigma_um + sigma_step_,
+                                                                  o.correlation, m, o.table));
                     }
+                } catch (const NoSolution& e) {
+                    map_.warnings.push_back(concat("T given σ: ", e.what()));
                 }
             }
         } else {
@@ -852,12 +850,7 @@ class Evaluator {
         const bool gaussian = o_.correlation == Correlation::Gaussian;
         const bool has_primary = gaussian ? g : e;
         if (!(gaussian ? e : g)) ++counts_.no_solution_other;
-        if (o_.sigma_um) {
-            const RatioInverseTable::Value& vp = gaussian ? vg : ve;
-            std::optional<Estimate> primary;
-            if (has_primary) primary = Estimate{vp.x, std::abs(vp.dx_dlog_ratio) * sd_lr};
-            estimate_T(index, std::log(ratio), sd_lr, primary, std::nullopt, std::nullopt);
-        }
+        if (o_.sigma_um) estimate_T(index, std::log(ratio), sd_lr, std::nullopt, std::nullopt);
         if (!has_primary) {
             ++counts_.no_solution;
             return;
@@ -969,7 +962,7 @@ class Evaluator {
         const std::optional<Estimate>& primary = o_.correlation == Correlation::Gaussian ? g : e;
         const std::optional<Estimate>& other = o_.correlation == Correlation::Gaussian ? e : g;
         if (!other) ++counts_.no_solution_other;
-        if (o_.sigma_um) estimate_T(index, lr, sd_lr, primary, geom1, geom2);
+        if (o_.sigma_um) estimate_T(index, lr, sd_lr, geom1, geom2);
         if (!primary) {
             ++counts_.no_solution;
             map_.roughness_class[index] = kClassNone;
@@ -980,11 +973,10 @@ class Evaluator {
             primary->value, o_.slightly_rough_max_sigma_over_T, o_.very_rough_min_sigma_over_T));
     }
 
-    // σ known: the class by g and T (Eq. 15 / the diffuse term of the class's regime; σ/(σ/T)
-    // for a very rough surface).
+    // σ known: the class by g and T from the diffuse term valid at the cell's g (Eq. 3, i.e.
+    // Eq. 15, for a slightly rough cell; the exact series otherwise).
     void estimate_T(std::size_t index, double lr, double sd_lr,
-                    const std::optional<Estimate>& primary, const std::optional<Geometry>& geom1,
-                    const std::optional<Geometry>& geom2) {
+                    const std::optional<Geometry>& geom1, const std::optional<Geometry>& geom2) {
         const double sigma = *o_.sigma_um;
         RoughnessClass gc = RoughnessClass::VeryRough;
         if (flat_) {
@@ -995,13 +987,7 @@ class Evaluator {
         }
         map_.roughness_class_g[index] = class_code(gc);
         std::optional<Estimate> T;
-        if (gc == RoughnessClass::VeryRough) {
-            if (primary) {
-                const double s = primary->value;
-                T = Estimate{sigma / s, std::hypot(sigma / (s * s) * primary->std_error,
-                                                   o_.sigma_um_stderr / s)};
-            }
-        } else if (flat_) {
+        if (flat_) {
             if (table_t_) {
                 if (auto v = table_t_->lookup(lr, hint_t_)) {
                     double dT_dsigma = 0.0;

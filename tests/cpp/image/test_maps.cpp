@@ -579,8 +579,8 @@ TEST(RoughnessMap, MisregisteredPairIsRefusedUnlessAllowed) {
     EXPECT_NO_THROW((void)roughness_map(flat_captures(q), o));
 }
 
-// T given σ: a very rough surface (T = σ/(σ/T)) and a slightly rough one (Eq. 15 through the
-// table of the slightly-rough diffuse term), each with its class by g.
+// T given σ: a very rough surface (the exact series, ≈ Eq. 4 at g ≈ 4000) and a slightly rough
+// one (Eq. 15 through the table of the slightly-rough diffuse term), each with its class by g.
 TEST(RoughnessMap, CorrelationLengthGivenSigma) {
     const std::size_t W = 64, H = 64;
     {

@@ -47,16 +47,17 @@ sim::SurfaceTruth very_rough(double sigma_over_T) {
 // The exact diffuse brightness of σ and T at 0.555 µm: the series of Eq. 2 (the coherent term
 // of Eq. 1, a finite patch's sinc² off the specular direction, is not what a photograph of a
 // large sample shows, and no estimator models it).
-sim::SurfaceTruth exact(double sigma_um, double T_um) {
+sim::SurfaceTruth exact(double sigma_um, double T_um,
+                        Correlation correlation = Correlation::Gaussian) {
     sim::SurfaceTruth truth;
     truth.model = sim::BrightnessModel::Tabulated;
     truth.sigma_um = sigma_um;
     truth.T_um = T_um;
-    truth.tabulated = [sigma_um, T_um](const Geometry& g) {
+    truth.tabulated = [sigma_um, T_um, correlation](const Geometry& g) {
         ModelOptions o;
         o.regime = Regime::Series;
         o.wavelength_um = 0.555;
-        const ScatteredPower p = mean_scattered_power(g, Surface{sigma_um, T_um}, o);
+        const ScatteredPower p = mean_scattered_power(g, Surface{sigma_um, T_um, correlation}, o);
         return p.diffuse * radiometric_factor(o.radiometry, g);
     };
     return truth;
@@ -195,6 +196,38 @@ TEST(MeasureCorrelationLength, SmallGUsesEq15ByDefault) {
     EXPECT_EQ(d.json["T_um_regime"], "slightly_rough");
     EXPECT_EQ(d.json["T_um_regime_source"], "g");
     fs::remove_all(dir);
+}
+
+// A map with σ known of a very rough flat sample (g = 18, σ = 0.2 µm, T = 1 µm, the exact
+// diffuse brightness): T from the exact series, the truth for both correlations (σ/(σ/T) of
+// Eq. 17 gave T 4 % high, of Eq. 19 81 % low or none).
+TEST(MapCorrelationLength, AVeryRoughSampleUsesTheExactSeries) {
+    sim::Scene scene;
+    scene.width = scene.height = 32;
+    const double t1 = deg_to_rad(30.0), t2 = deg_to_rad(45.0);
+    for (const Correlation c : {Correlation::Gaussian, Correlation::Exponential}) {
+        const roughscope::testing::LitPair p =
+            roughscope::testing::render_lit_pair(scene, {exact(0.2, 1.0, c)}, {}, {}, t1, t2, 71);
+        std::vector<MapCapture> captures(2);
+        captures[0].image = &p.a;
+        captures[0].geometry = normal_view_geometry(t1);
+        captures[1].image = &p.b;
+        captures[1].geometry = normal_view_geometry(t2);
+        MapOptions o;
+        o.sigma_um = 0.2;
+        o.correlation = c;
+        const RoughnessMap map = roughness_map(captures, o);
+        std::vector<float> T;
+        for (std::size_t i = 0; i < map.T_um.size(); ++i) {
+            EXPECT_EQ(map.roughness_class_g[i], kClassVeryRough);
+            if (std::isfinite(map.T_um[i])) T.push_back(map.T_um[i]);
+        }
+        ASSERT_EQ(T.size(), map.width * map.height) << to_string(c);
+        std::nth_element(T.begin(), T.begin() + T.size() / 2, T.end());
+        std::printf("%s, g = 18: median T = %.4f µm (truth 1)\n", std::string(to_string(c)).c_str(),
+                    T[T.size() / 2]);
+        EXPECT_NEAR(T[T.size() / 2], 1.0, 0.005) << to_string(c);
+    }
 }
 
 // ---------------------------------------------------------------------------------------------
