@@ -46,16 +46,18 @@ struct Accumulator {
         sum += v;
         sum2 += v * v;
     }
+    // The mean and its standard error sd/√n; one value, or values without spread, give no
+    // standard error: unknown (NaN), not 0.
     std::optional<Estimate> mean() const {
         if (n == 0) return std::nullopt;
         const double m = sum / static_cast<double>(n);
-        double se = 0.0;
+        if (!std::isfinite(m)) return std::nullopt;
+        double se = std::numeric_limits<double>::quiet_NaN();
         if (n >= 2) {
             const double var =
                 std::max(0.0, (sum2 - static_cast<double>(n) * m * m) / static_cast<double>(n - 1));
-            se = std::sqrt(var / static_cast<double>(n));
+            if (var > 0.0 && std::isfinite(var)) se = std::sqrt(var / static_cast<double>(n));
         }
-        if (!std::isfinite(m) || !std::isfinite(se)) return std::nullopt;
         return Estimate{m, se};
     }
 };
@@ -802,27 +804,25 @@ class Evaluator {
                 const double g = std::max(roughness_g(*o.sigma_um, c1_.geometry, o.wavelength_um),
                                           roughness_g(*o.sigma_um, c2_.geometry, o.wavelength_um));
                 flat_g_class_ = roughness_class(g);
-                if (*flat_g_class_ != RoughnessClass::VeryRough) {
-                    // T from the diffuse term of the class's regime (Eq. 15 for slightly rough).
-                    TwoGeometryOptions m = model_;
-                    m.regime = *flat_g_class_ == RoughnessClass::SlightlyRough
-                                   ? Regime::SlightlyRough
-                                   : Regime::Series;
-                    try {
-                        table_t_ = std::make_shared<const RatioInverseTable>(
+                // T from the diffuse term valid at the sample's g: Eq. 3 (Eq. 15) for a
+                // slightly rough sample, the exact series at any other g (Eq. 4/5 leave it:
+                // at g = 18 Eq. 4 gives T 4 % high, Eq. 5 80 % low).
+                TwoGeometryOptions m = model_;
+                m.regime = *flat_g_class_ == RoughnessClass::SlightlyRough ? Regime::SlightlyRough
+                                                                           : Regime::Series;
+                try {
+                    table_t_ = std::make_shared<const RatioInverseTable>(
+                        RatioInverseTable::correlation_length(
+                            c1_.geometry, c2_.geometry, *o.sigma_um, o.correlation, m, o.table));
+                    if (o.sigma_um_stderr > 0.0) {
+                        sigma_step_ = *o.sigma_um * 1e-4;
+                        table_t2_ = std::make_shared<const RatioInverseTable>(
                             RatioInverseTable::correlation_length(c1_.geometry, c2_.geometry,
-                                                                  *o.sigma_um, o.correlation, m,
-                                                                  o.table));
-                        if (o.sigma_um_stderr > 0.0) {
-                            sigma_step_ = *o.sigma_um * 1e-4;
-                            table_t2_ = std::make_shared<const RatioInverseTable>(
-                                RatioInverseTable::correlation_length(c1_.geometry, c2_.geometry,
-                                                                      *o.sigma_um + sigma_step_,
-                                                                      o.correlation, m, o.table));
-                        }
-                    } catch (const NoSolution& e) {
-                        map_.warnings.push_back(concat("T given σ: ", e.what()));
+                                                                  *o.sigma_um + sigma_step_,
+                                                                  o.correlation, m, o.table));
                     }
+                } catch (const NoSolution& e) {
+                    map_.warnings.push_back(concat("T given σ: ", e.what()));
                 }
             }
         } else {
@@ -850,12 +850,7 @@ class Evaluator {
         const bool gaussian = o_.correlation == Correlation::Gaussian;
         const bool has_primary = gaussian ? g : e;
         if (!(gaussian ? e : g)) ++counts_.no_solution_other;
-        if (o_.sigma_um) {
-            const RatioInverseTable::Value& vp = gaussian ? vg : ve;
-            std::optional<Estimate> primary;
-            if (has_primary) primary = Estimate{vp.x, std::abs(vp.dx_dlog_ratio) * sd_lr};
-            estimate_T(index, std::log(ratio), sd_lr, primary, std::nullopt, std::nullopt);
-        }
+        if (o_.sigma_um) estimate_T(index, std::log(ratio), sd_lr, std::nullopt, std::nullopt);
         if (!has_primary) {
             ++counts_.no_solution;
             return;
@@ -967,7 +962,7 @@ class Evaluator {
         const std::optional<Estimate>& primary = o_.correlation == Correlation::Gaussian ? g : e;
         const std::optional<Estimate>& other = o_.correlation == Correlation::Gaussian ? e : g;
         if (!other) ++counts_.no_solution_other;
-        if (o_.sigma_um) estimate_T(index, lr, sd_lr, primary, geom1, geom2);
+        if (o_.sigma_um) estimate_T(index, lr, sd_lr, geom1, geom2);
         if (!primary) {
             ++counts_.no_solution;
             map_.roughness_class[index] = kClassNone;
@@ -978,11 +973,10 @@ class Evaluator {
             primary->value, o_.slightly_rough_max_sigma_over_T, o_.very_rough_min_sigma_over_T));
     }
 
-    // σ known: the class by g and T (Eq. 15 / the diffuse term of the class's regime; σ/(σ/T)
-    // for a very rough surface).
+    // σ known: the class by g and T from the diffuse term valid at the cell's g (Eq. 3, i.e.
+    // Eq. 15, for a slightly rough cell; the exact series otherwise).
     void estimate_T(std::size_t index, double lr, double sd_lr,
-                    const std::optional<Estimate>& primary, const std::optional<Geometry>& geom1,
-                    const std::optional<Geometry>& geom2) {
+                    const std::optional<Geometry>& geom1, const std::optional<Geometry>& geom2) {
         const double sigma = *o_.sigma_um;
         RoughnessClass gc = RoughnessClass::VeryRough;
         if (flat_) {
@@ -993,13 +987,7 @@ class Evaluator {
         }
         map_.roughness_class_g[index] = class_code(gc);
         std::optional<Estimate> T;
-        if (gc == RoughnessClass::VeryRough) {
-            if (primary) {
-                const double s = primary->value;
-                T = Estimate{sigma / s, std::hypot(sigma / (s * s) * primary->std_error,
-                                                   o_.sigma_um_stderr / s)};
-            }
-        } else if (flat_) {
+        if (flat_) {
             if (table_t_) {
                 if (auto v = table_t_->lookup(lr, hint_t_)) {
                     double dT_dsigma = 0.0;
@@ -1490,6 +1478,15 @@ void summarise(const Evaluator& tables, const MapOptions& o, RoughnessMap& map,
             table_e ? pooled_sigma_over_T(*table_e, ra.log_ratio) : ra.exponential.mean();
         s.mean_T_um = ra.T.mean();
         s.class_counts = ra.classes;
+        const auto unknown = [](const std::optional<Estimate>& e) {
+            return e && std::isnan(e->std_error);
+        };
+        if (unknown(s.mean_sigma_over_T_gaussian) || unknown(s.mean_sigma_over_T_exponential) ||
+            unknown(s.mean_T_um))
+            map.warnings.push_back(concat("roughness map: region '", s.name, "' has ",
+                                          std::to_string(s.count),
+                                          " valid cell(s) without spread between them: the "
+                                          "standard error of its mean is unknown (null)"));
         map.regions.push_back(std::move(s));
     }
 }
@@ -1608,6 +1605,14 @@ RoughnessMap roughness_map(const std::vector<MapCapture>& captures, const MapOpt
                 warn(concat("roughness map: ", shift, ", but the peak-to-sidelobe ratio is below ",
                             check::format_number(o.min_peak_to_sidelobe),
                             ": the images share too little structure to tell"));
+            else if (!o.normal_map.empty())
+                // A curved object's shading moves with the light, and phase correlation reads
+                // that as a shift as confidently as a movement of the camera (docs/maps.md
+                // "Registration"): no evidence of a movement, so no refusal.
+                warn(concat("roughness map: ", shift,
+                            ", but with a normal map the shading moves with the light, which "
+                            "phase correlation cannot tell from a movement of the camera: not "
+                            "refused; the map assumes the camera did not move"));
             else if (!o.allow_misregistration)
                 throw DataError(concat("roughness map: ", shift,
                                        ": register the images (or allow the misregistration)"));

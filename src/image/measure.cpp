@@ -12,8 +12,10 @@
 #include <thread>
 #include <utility>
 
+#include "measure_notes.hpp"
 #include "roughscope/core/errors.hpp"
 #include "roughscope/core/names.hpp"
+#include "roughscope/core/numbers.hpp"
 #include "roughscope/core/text.hpp"
 #include "roughscope/image/radiometry.hpp"
 
@@ -320,11 +322,52 @@ void estimate_specular(const CaptureMeasurement& capture, const MeasureRequest& 
     }
 }
 
+// σ known (given or from a specular capture); sigma_stderr_known false when the specular
+// capture could not give its standard error.
+struct KnownSigma {
+    std::optional<double> value;
+    double stderr_um = 0.0;
+    bool stderr_known = true;
+};
+
+// The standard errors that rest on a brightness whose noise the region cannot give (a standard
+// error of exactly 0: one pixel, or no spread between its pixels) are unknown, not 0
+// (measure.hpp): NaN, with a warning naming the capture.
+void mark_unknown_diffuse_errors(const CaptureMeasurement& c1, const CaptureMeasurement& c2,
+                                 const std::string& src, bool sigma_stderr_known,
+                                 MeasureResult& result) {
+    bool ratio_known = true;
+    for (const CaptureMeasurement* c : {&c1, &c2}) {
+        if (c->brightness_relative_stderr > 0.0) continue;
+        ratio_known = false;
+        result.warnings.push_back(
+            concat(src, ": ", c->spec.image, ": the region's brightness has no measurable noise (",
+                   std::to_string(c->region.average.count),
+                   " pixel(s) used, standard error 0): the standard errors of E1/E2, σ/T and T are "
+                   "unknown (null)"));
+    }
+    if (!ratio_known) {
+        detail::mark_unknown(result.E1_over_E2);
+        for (auto* e :
+             {&result.slope_gaussian, &result.slope_exponential, &result.correlation_length})
+            if (*e) detail::mark_unknown_errors(**e, false);
+    }
+    if (!sigma_stderr_known) {
+        // T = σ/(σ/T) and T given σ carry σ's unknown error.
+        for (auto* e : {&result.slope_gaussian, &result.slope_exponential})
+            if (*e) detail::mark_unknown((*e)->T_um);
+        if (result.correlation_length)
+            detail::mark_unknown_errors(*result.correlation_length, true);
+    }
+}
+
 void estimate_diffuse(const std::vector<const CaptureMeasurement*>& diffuse,
-                      const MeasureRequest& request, std::optional<double> sigma_um,
-                      double sigma_um_stderr, MeasureResult& result) {
+                      const MeasureRequest& request, const KnownSigma& known,
+                      MeasureResult& result) {
     const CaptureMeasurement& c1 = *diffuse[0];
     const CaptureMeasurement& c2 = *diffuse[1];
+    const std::optional<double>& sigma_um = known.value;
+    const double sigma_um_stderr = known.stderr_um;
     const double ratio = c1.brightness / c2.brightness;
     const double e1 = c1.brightness_relative_stderr;
     const double e2 = c2.brightness_relative_stderr;
@@ -334,7 +377,21 @@ void estimate_diffuse(const std::vector<const CaptureMeasurement*>& diffuse,
     options.factor = request.factor;
     options.radiometry = request.radiometry;
     options.wavelength_um = request.wavelength_um;
-    options.regime = request.regime;
+    if (sigma_um) {
+        options.regime = detail::correlation_length_regime(
+            request.regime, *sigma_um, c1.spec.geometry, c2.spec.geometry, request.wavelength_um);
+        result.correlation_length_regime = options.regime;
+        result.correlation_length_regime_given = request.regime.has_value();
+        const double g =
+            detail::largest_g(*sigma_um, c1.spec.geometry, c2.spec.geometry, request.wavelength_um);
+        if (!request.regime && options.regime != Regime::SlightlyRough)
+            result.warnings.push_back(concat(
+                "T given σ: g = ", format_significant(g, 4, "g"),
+                " (the larger of the two captures) is beyond the slightly rough range g < ",
+                check::format_number(kSlightlyRoughMaxG),
+                " of the paper's Eq. 15: T is from the exact series of the diffuse term (regime "
+                "\"series\"); \"regime\": \"slightly_rough\" in the capture file gives Eq. 15"));
+    }
     std::vector<std::string> failures;
     for (const Correlation correlation : {Correlation::Gaussian, Correlation::Exponential}) {
         SlopeInput input;
@@ -367,6 +424,7 @@ void estimate_diffuse(const std::vector<const CaptureMeasurement*>& diffuse,
             result.correlation_length = estimate_correlation_length(input);
         } catch (const NoSolution& e) {
             failures.push_back(concat("T given σ: ", e.what()));
+            result.correlation_length_regime.reset();
         }
     }
     if (!result.slope_gaussian && !result.slope_exponential && !result.correlation_length) {
@@ -377,6 +435,7 @@ void estimate_diffuse(const std::vector<const CaptureMeasurement*>& diffuse,
         throw NoSolution(message);
     }
     for (const auto& f : failures) result.warnings.push_back(concat(where(request), ": ", f));
+    mark_unknown_diffuse_errors(c1, c2, where(request), known.stderr_known, result);
     // The warnings of the estimates behind the headline values (σ/T Gaussian gives θK, ξK and
     // the slope; T given σ): the exponential estimate keeps its own in its object.
     const std::array<std::pair<const char*, const std::optional<RoughnessEstimate>*>, 2> estimates{
@@ -421,7 +480,10 @@ ObjectShape parse_object_shape(std::string_view name) {
 namespace {
 
 // The normals of a normal-map image (ObjectSpec::normal_map): 3 floats per pixel, NaN off the
-// object.
+// object. Every finite normal is used: the reader's flags for light (a component at or below 0
+// is "clipped low", at or above 1 "saturated") say nothing about a direction; only a missing
+// sample (NaN in a float file) and a vector shorter than 0.5 (the usual off-object marker, e.g.
+// (0, 0, 0)) are off the object.
 std::vector<float> decode_normal_map(const LinearImage& image, const std::string& src) {
     if (image.channels != 3)
         throw DataError(concat(src, ": normal map ", image.info.source, " has ",
@@ -437,7 +499,8 @@ std::vector<float> decode_normal_map(const LinearImage& image, const std::string
             v[c] = encoded ? 2.0 * x - 1.0 : x;
         }
         const double norm = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
-        const bool on = norm >= 0.5 && (image.flags.empty() || image.flags[k] == 0);
+        const bool missing = !image.flags.empty() && (image.flags[k] & kPixelMissing) != 0;
+        const bool on = !missing && norm >= 0.5;
         for (std::size_t c = 0; c < 3; ++c)
             normals[3 * k + c] =
                 on ? static_cast<float>(v[c] / norm) : std::numeric_limits<float>::quiet_NaN();
@@ -655,6 +718,8 @@ MeasureResult measure(const MeasureRequest& request) {
     assign_exposures(result.captures, result.warnings, src);
     if (is_profile(shape)) {
         for (CaptureMeasurement& c : result.captures) c.brightness_relative_stderr = 0.0;
+        if (detail::has_exponential_sigma_over_T(result))
+            result.warnings.push_back(detail::exponential_note());
         return result;
     }
     std::vector<const CaptureMeasurement*> diffuse;
@@ -674,8 +739,7 @@ MeasureResult measure(const MeasureRequest& request) {
         }
     }
 
-    std::optional<double> sigma_um = request.sigma_um;
-    double sigma_um_stderr = request.sigma_um_stderr;
+    KnownSigma known{request.sigma_um, request.sigma_um_stderr, true};
     for (const CaptureMeasurement& c : result.captures) {
         if (c.spec.role != CaptureRole::Specular) continue;
         const Geometry& g = c.spec.geometry;
@@ -689,13 +753,32 @@ MeasureResult measure(const MeasureRequest& request) {
                        "°, theta_s = ", check::format_number(rad_to_deg(g.theta_s_rad)),
                        "°, phi_s = ", check::format_number(rad_to_deg(g.phi_s_rad)), "°"));
         estimate_specular(c, request, result);
+        // A highlight whose core or surround has no measurable noise gives σ with a standard
+        // error of 0: unknown (measure.hpp).
+        const auto zero_error = [](const RoughnessEstimate& e) {
+            return e.sigma_um && !(e.sigma_um->std_error > 0.0);
+        };
+        for (ChannelSigma& cs : result.specular_sigma)
+            if (zero_error(cs.estimate)) detail::mark_unknown_errors(cs.estimate, true);
+        if (result.sigma && zero_error(*result.sigma)) {
+            detail::mark_unknown_errors(*result.sigma, true);
+            result.warnings.push_back(concat(src, ": ", c.spec.image,
+                                             ": the highlight's core or surround has no "
+                                             "measurable noise (standard error 0): the standard "
+                                             "error of σ is unknown (null)"));
+        }
         break;  // the first specular capture gives σ
     }
-    if (!sigma_um && result.sigma && result.sigma->sigma_um) {
-        sigma_um = result.sigma->sigma_um->value;
-        sigma_um_stderr = result.sigma->sigma_um->std_error;
+    if (!known.value && result.sigma && result.sigma->sigma_um) {
+        known.value = result.sigma->sigma_um->value;
+        known.stderr_um = result.sigma->sigma_um->std_error;
+        // Not a number (unknown, measure.hpp): T's error leaves σ's out and is unknown too.
+        if (!(known.stderr_um > 0.0)) {
+            known.stderr_um = 0.0;
+            known.stderr_known = false;
+        }
     }
-    if (diffuse.size() >= 2) estimate_diffuse(diffuse, request, sigma_um, sigma_um_stderr, result);
+    if (diffuse.size() >= 2) estimate_diffuse(diffuse, request, known, result);
 
     if (request.maps) {
         MapOptions options = request.maps->options;
@@ -703,9 +786,9 @@ MeasureResult measure(const MeasureRequest& request) {
         options.radiometry = request.radiometry;
         options.wavelength_um = request.wavelength_um;
         options.correlation = request.correlation;
-        if (sigma_um) {
-            options.sigma_um = sigma_um;
-            options.sigma_um_stderr = sigma_um_stderr;
+        if (known.value) {
+            options.sigma_um = known.value;
+            options.sigma_um_stderr = known.stderr_um;
         }
         std::vector<float> normals;
         if (shape == ObjectShape::NormalMap) {
@@ -747,6 +830,8 @@ MeasureResult measure(const MeasureRequest& request) {
         result.map = roughness_map(captures, options);
         for (const auto& w : result.map->warnings) result.warnings.push_back(concat("map: ", w));
     }
+    if (detail::has_exponential_sigma_over_T(result))
+        result.warnings.push_back(detail::exponential_note());
     // Each warning once, in the order first given.
     std::vector<std::string> unique;
     for (auto& w : result.warnings)

@@ -57,7 +57,9 @@ Json capture_json(const image::CaptureMeasurement& c) {
     out["f_number_metadata"] = number(c.info.f_number);
     if (c.spec.role == image::CaptureRole::Diffuse) {
         out["brightness"] = number(c.brightness);
-        out["brightness_relative_stderr"] = number(c.brightness_relative_stderr);
+        // 0: the region gives no noise (one pixel, no spread): unknown (image/measure.hpp).
+        out["brightness_relative_stderr"] =
+            c.brightness_relative_stderr > 0.0 ? number(c.brightness_relative_stderr) : Json();
     } else {
         out["brightness"] = Json();
         out["brightness_relative_stderr"] = Json();
@@ -324,11 +326,23 @@ Json to_json(const image::MeasureResult& r, const image::MeasureRequest& request
         sigma = r.sigma->sigma_um;
     put(out, "sigma_um", sigma);
     std::optional<Estimate> T;
-    if (r.correlation_length && r.correlation_length->T_um)
+    // The form T comes from: the regime of T given σ (given in the capture file, or chosen by
+    // the sample's g), or σ/(σ/T) of Eq. 17 (very rough) when T given σ has no solution.
+    Json T_regime, T_regime_source;
+    if (r.correlation_length && r.correlation_length->T_um) {
         T = r.correlation_length->T_um;
-    else if (r.slope_gaussian && r.slope_gaussian->T_um)
+        if (r.correlation_length_regime) {
+            T_regime = std::string(to_string(*r.correlation_length_regime));
+            T_regime_source = r.correlation_length_regime_given ? "capture_file" : "g";
+        }
+    } else if (r.slope_gaussian && r.slope_gaussian->T_um) {
         T = r.slope_gaussian->T_um;
+        T_regime = std::string(to_string(Regime::VeryRough));
+        T_regime_source = "sigma_over_T";
+    }
     put(out, "T_um", T);
+    out["T_um_regime"] = T_regime;
+    out["T_um_regime_source"] = T_regime_source;
     // Derived quantities (§3.5) and the class: from the Gaussian σ/T when there is one, else from
     // T given σ, else from the specular σ.
     const RoughnessEstimate* derived = r.slope_gaussian       ? &*r.slope_gaussian

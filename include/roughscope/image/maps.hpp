@@ -240,7 +240,9 @@ struct MapOptions {
     Correlation correlation = Correlation::Gaussian;
     // Registration of capture 2 against capture 1 (registration.hpp): a shift above max_shift_px
     // (with a peak-to-sidelobe ratio ≥ min_peak_to_sidelobe: the images share structure) is
-    // refused (DataError) unless allow_misregistration; a lower PSR only warns.
+    // refused (DataError) unless allow_misregistration; a lower PSR only warns. With a normal
+    // map a shift only warns: a curved object's shading moves with the light, which phase
+    // correlation cannot tell from a movement of the camera.
     double max_shift_px = 1.0;
     bool allow_misregistration = false;
     double min_peak_to_sidelobe = 8.0;
@@ -346,10 +348,10 @@ inline Correlation other_correlation(Correlation c) {
 // Throws InvalidArgument (fewer than 2 captures, a null image, images of different sizes, a
 // non-finite value in either of the two images (checked as the map reads them), window_px or
 // other options out of range, a normal map or region labels of the wrong size,
-// missing light/view for a normal map) or DataError (capture 2 moved against capture 1 by more
-// than max_shift_px: the message gives the shift and the threshold). With more than two captures
-// the first two are used and a warning says so (a per-tile least-squares fit is left to
-// image/measure.hpp's region measurement).
+// missing light/view for a normal map) or DataError (a flat sample whose capture 2 moved against
+// capture 1 by more than max_shift_px: the message gives the shift and the threshold). With more
+// than two captures the first two are used and a warning says so (a per-tile least-squares fit is
+// left to image/measure.hpp's region measurement).
 RoughnessMap roughness_map(const std::vector<MapCapture>& captures, const MapOptions& options);
 
 // The per-pixel map's row loops and RatioInverseTable::find_ratio_bins come in builds for three

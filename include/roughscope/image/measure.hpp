@@ -108,8 +108,11 @@ struct MeasureRequest {
     std::vector<CaptureSpec> captures;
     Correlation correlation = Correlation::Gaussian;  // for T given σ
     // The diffuse term's regime for T given σ: SlightlyRough is the paper's Eq. 15 (§4.1.2,
-    // Table 1); Series the exact sum at any g; Auto chosen by g (scattering/beckmann.hpp).
-    Regime regime = Regime::SlightlyRough;
+    // Table 1); Series the exact sum at any g; Auto as scattering/beckmann.hpp; VeryRough Eq. 4/5.
+    // Unset: the form valid at the sample's g (the larger g = σ² v_z² of the two geometries):
+    // SlightlyRough where g < kSlightlyRoughMaxG (0.1, validity.hpp), else Series
+    // (MeasureResult::correlation_length_regime says which).
+    std::optional<Regime> regime;
     std::optional<double> sigma_um;  // known σ, µm (else from a specular capture)
     double sigma_um_stderr = 0.0;
     double R0 = kDefaultSmoothReflectanceR0;  // Eq. 13's smooth-surface reflectance
@@ -122,6 +125,10 @@ struct MeasureRequest {
     // image, so the peak memory grows with the number.
     std::size_t threads = 0;
 };
+
+// Standard errors: a standard error that the captures cannot give (a region of one pixel, or no
+// spread between its pixels: the noise of its mean is unknown, not 0) is NaN in the result, with a
+// warning; the JSON writes it as null.
 
 // One capture as measured.
 struct CaptureMeasurement {
@@ -157,6 +164,9 @@ struct MeasureResult {
     std::optional<RoughnessEstimate> slope_gaussian;
     std::optional<RoughnessEstimate> slope_exponential;
     std::optional<RoughnessEstimate> correlation_length;
+    // The regime T given σ was computed in, and whether the request gave it (else chosen by g).
+    std::optional<Regime> correlation_length_regime;
+    bool correlation_length_regime_given = false;
     // More than two diffuse captures: the least-squares fits (both correlations).
     std::optional<CorrelationComparison> fit;
     // Curved objects and maps (one photograph for a cylinder or a sphere).

@@ -103,11 +103,12 @@ TEST(RoughnessMap, ThreeRegionsOneClassEach) {
         EXPECT_EQ(s.class_counts[k],
                   *std::max_element(s.class_counts.begin(), s.class_counts.end()));
     }
-    // Summaries never hold a NaN.
+    // Summaries hold no NaN but the standard error of a class of one cell (unknown).
     for (const auto& c : map.classes) {
         EXPECT_TRUE(std::isfinite(c.fraction));
         if (c.mean_sigma_over_T) {
-            EXPECT_TRUE(std::isfinite(c.mean_sigma_over_T->std_error));
+            EXPECT_TRUE(std::isfinite(c.mean_sigma_over_T->value));
+            EXPECT_TRUE(std::isfinite(c.mean_sigma_over_T->std_error) || c.count < 2);
         }
     }
     EXPECT_EQ(map.valid + map.missing + map.no_solution, map.width * map.height);
@@ -578,8 +579,8 @@ TEST(RoughnessMap, MisregisteredPairIsRefusedUnlessAllowed) {
     EXPECT_NO_THROW((void)roughness_map(flat_captures(q), o));
 }
 
-// T given σ: a very rough surface (T = σ/(σ/T)) and a slightly rough one (Eq. 15 through the
-// table of the slightly-rough diffuse term), each with its class by g.
+// T given σ: a very rough surface (the exact series, ≈ Eq. 4 at g ≈ 4000) and a slightly rough
+// one (Eq. 15 through the table of the slightly-rough diffuse term), each with its class by g.
 TEST(RoughnessMap, CorrelationLengthGivenSigma) {
     const std::size_t W = 64, H = 64;
     {
@@ -942,7 +943,9 @@ TEST(RoughnessMap, LayersNotAskedForAreNotMadeAndTheRestIsTheSame) {
     };
     auto same_estimate = [](const std::optional<Estimate>& a, const std::optional<Estimate>& b) {
         return a.has_value() == b.has_value() &&
-               (!a || (a->value == b->value && a->std_error == b->std_error));
+               (!a ||
+                (a->value == b->value && (a->std_error == b->std_error ||
+                                          (std::isnan(a->std_error) && std::isnan(b->std_error)))));
     };
     const MapInstructionSet before = map_instruction_set();
     for (const MapInstructionSet isa : kInstructionSets)

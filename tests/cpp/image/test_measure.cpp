@@ -330,6 +330,8 @@ TEST(MeasurePaperTables, Table1SpecularAndPairGiveThePrintedSigmaAndT) {
         spec.role = CaptureRole::Specular;
         request.captures.insert(request.captures.begin(), spec);
         request.R0 = 1.0;
+        // The printed T are Eq. 15's (g = 3–6 here: by default the exact series).
+        request.regime = Regime::SlightlyRough;
         request.highlight.core_radius_px = 4.0;
         request.highlight.annulus_inner_px = 9.0;
         request.highlight.annulus_outer_px = 14.0;
