@@ -182,9 +182,10 @@ struct AcfShape {
 // Standard error of the 1/e T: var ρ̂(T) from Bartlett's sums over the central lobe, over the
 // n_T pairs T apart, through the ACF's slope there: s.e. = √(sh / n_T) / |C'(T)|, with C' by
 // central differences over ±max(dx, T/4).
-std::optional<double> T_stderr_from(const Acf2d& acf2, const Curve& acf_x,
-                                    const std::vector<double>& pairs, std::size_t window_x,
-                                    std::size_t window_y, double T_um, double dx_um) {
+std::optional<double> correlation_length_stderr(const Acf2d& acf2, const Curve& acf_x,
+                                                const std::vector<double>& pairs,
+                                                std::size_t window_x, std::size_t window_y,
+                                                double T_um, double dx_um) {
     const auto shift = static_cast<std::size_t>(std::max(1.0, std::round(T_um / dx_um)));
     if (shift >= pairs.size() || !(pairs[shift] > 0)) return std::nullopt;
     const double inv_e = std::exp(-1.0);
@@ -208,8 +209,8 @@ AcfShape acf_shape(const Acf2d& acf2, const Curve& acf_x, const Curve& acf_y,
         acf_y.x.empty() ? 0
                         : detail::central_lobe_samples(acf_y, levelled.dy_um, T_y_um, kLobeOverT);
     if (T_um)
-        out.T_stderr_um =
-            T_stderr_from(acf2, acf_x, row_pairs, window_x, window_y, *T_um, levelled.dx_um);
+        out.T_stderr_um = correlation_length_stderr(acf2, acf_x, row_pairs, window_x, window_y,
+                                                    *T_um, levelled.dx_um);
     // Periodicity: swings beyond kMinSwing and kSwingSigmas standard deviations of the noise a
     // random surface leaves in its ACF at half the length, √(s0 / n), s0 over the lobe up to
     // kNoiseLobeOverT · T in x and y (T_y, or T when there is none along y: a random surface's

@@ -116,7 +116,7 @@ TEST(SurfaceTStandardError, CoversTheTruthOnNarrowMaps) {
             GenerationOptions g;
             g.correlation = c;
             g.T_um = kTrueT;
-            g.nx = 4 * 2048;
+            g.nx = std::size_t{4} * 2048;
             g.ny = 128;
             g.seed = seed;
             const HeightMap big = generate_surface(g);
