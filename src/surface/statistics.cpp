@@ -98,9 +98,8 @@ double sample_sd(const std::vector<double>& v) {
 // The 1/e T (samples) of the segments of `seg` samples of the given rows, each segment minus
 // its own mean line, the sums pooled over the segments.
 std::optional<double> segment_T_samples(const HeightMap& map, const std::vector<std::size_t>& rows,
-                                        std::size_t seg, AcfEstimator estimator,
-                                        std::vector<double>* per_segment) {
-    detail::LineAcf acc(seg, estimator, per_segment != nullptr);
+                                        std::size_t seg, AcfEstimator estimator) {
+    detail::LineAcf acc(seg, estimator, false);
     std::vector<double> buf(seg);
     for (std::size_t iy : rows)
         for (std::size_t s = 0; s + seg <= map.nx; s += seg) {
@@ -109,7 +108,6 @@ std::optional<double> segment_T_samples(const HeightMap& map, const std::vector<
             if (remove_line(buf.data(), seg)) acc.add(buf.data());
         }
     acc.finish();
-    if (per_segment != nullptr) *per_segment = acc.line_crossing;
     return detail::crossing_1e_samples(acc.sums, acc.pairs, estimator);
 }
 
@@ -124,7 +122,7 @@ std::optional<double> extrapolated_T_um(const HeightMap& map, AcfEstimator estim
     std::size_t seg = map.nx;
     for (int level = 0; level < kMaxExtrapolationLevels; ++level, seg /= 2) {
         if (seg < 16 || static_cast<double>(seg) < kMinLineOverT * T_samples) break;
-        if (const auto T = segment_T_samples(map, rows, seg, estimator, nullptr)) {
+        if (const auto T = segment_T_samples(map, rows, seg, estimator)) {
             inv_length.push_back(1.0 / (static_cast<double>(seg) * map.dx_um));
             T_um.push_back(*T * map.dx_um);
         }
@@ -288,26 +286,24 @@ void add_length_warnings(SurfaceStatistics& st, const HeightMap& levelled, bool 
 }
 
 void add_period_warnings(SurfaceStatistics& st, const AcfShape& shape, bool profile) {
-    const auto warn = [&](const detail::AcfSwing& s, const char* direction) {
+    const auto warn = [&](const detail::AcfSwing& s, const char* direction, const char* key) {
         st.warnings.push_back(concat(
             "the ACF along ", direction, " is periodic: it falls to ", number(s.low), " at ",
             number(s.low_lag_um), " um and rises again to ", number(s.high), " at ",
-            number(s.period_um),
-            " um: the surface has a periodic component (a lay, machining or grinding marks) of "
-            "period ~",
-            number(s.period_um),
-            " um, which the random-surface model (Gaussian heights, Gaussian or exponential "
-            "correlation) does not describe; T and sigma mix the period with the roughness "
-            "(a Gaussian filter with a cutoff below the period, --cutoff-um, keeps the "
-            "roughness only)"));
+            number(s.period_um), " um (", key,
+            "): the surface has a periodic component (a lay, machining or "
+            "grinding marks), which the random-surface model (Gaussian heights, Gaussian or "
+            "exponential correlation) does not describe; T and sigma mix the period with the "
+            "roughness (a Gaussian filter with a cutoff below the period, --cutoff-um, keeps "
+            "the roughness only)"));
     };
     if (shape.swing_x) {
         st.period_um = shape.swing_x->period_um;
-        warn(*shape.swing_x, "x");
+        warn(*shape.swing_x, "x", "period_um");
     }
     if (!profile && shape.swing_y) {
         st.period_y_um = shape.swing_y->period_um;
-        warn(*shape.swing_y, "y");
+        warn(*shape.swing_y, "y", "period_y_um");
     }
 }
 
