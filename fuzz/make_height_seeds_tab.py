@@ -31,6 +31,9 @@ write("height_csv", "matrix_ragged.csv", "1,2\n3\n")
 write("height_csv", "xyz_grid.xyz",
       "# unit = mm\n2 0.5 6\n0 0 1\n1 0 2\n2 0 3\n0 0.5 NaN\n")
 write("height_csv", "xyz_offgrid.xyz", "0 0 1\n1 0 2\n2.5 0 3\n")
+# A UTF-8 byte-order mark at the start is skipped (docs/input-files.md).
+write("height_csv", "matrix_bom.csv", "\ufeff# dx_um = 2\r\n1,2\r\n3,NaN\r\n")
+write("height_csv", "xyz_bom.xyz", "\ufeff0 0 1\n1 0 2\n0 1 3\n1 1 4\n")
 
 # ---- SDF -------------------------------------------------------------------------------------
 
@@ -57,6 +60,10 @@ write("height_sdf", "ascii_int16.sdf",
 write("height_sdf", "ascii_double.sdf",
       "aISO-1.0\nNumPoints = 2\nNumProfiles = 2\nXscale = 1e-06\nYscale = 1e-06\n"
       "Zscale = 1e-06\nDataType = 7\n*\n0.5 NaN\n-1 2\n*\ndx_um = 1\ny_offset_um = 3\n*\n")
+
+write("height_sdf", "ascii_bom.sdf",
+      "\ufeffaISO-1.0\nNumPoints = 2\nNumProfiles = 1\nXscale = 1e-06\nYscale = 1e-06\n"
+      "Zscale = 1e-06\nDataType = 7\n*\n0.5 -1\n*\n")
 
 # ---- PNG -------------------------------------------------------------------------------------
 

@@ -118,6 +118,8 @@ surface::SurfaceStatistics statistics_from_dict(py::handle stats) {
     s.T_um = get("T_um");
     s.T_fit_gaussian_um = get("T_fit_gaussian_um");
     s.T_fit_exponential_um = get("T_fit_exponential_um");
+    s.period_um = get("period_um");
+    s.period_y_um = get("period_y_um");
     if (d.contains("correlation") && !d["correlation"].is_none())
         s.correlation =
             parse_correlation(normalize_name(py::str(d["correlation"]).cast<std::string>()));

@@ -102,9 +102,14 @@ Json to_json(const StatisticsInput& input, const surface::SurfaceStatistics& s, 
     j["T_fit_exponential_um"] = number(s.T_fit_exponential_um);
     j["correlation"] = s.correlation ? Json(std::string(to_string(*s.correlation))) : Json(nullptr);
     j["T_extrapolated_um"] = number(s.T_extrapolated_um);
+    j["period_um"] = number(s.period_um);
+    j["period_y_um"] = number(s.period_y_um);
     j["Sal_um"] = number(s.Sal_um);
     j["Str"] = number(s.Str);
+    j["Str_note"] = text_or_null(s.Str_note);
     j["rms_slope"] = number(s.rms_slope);
+    j["rms_slope_y"] = number(s.rms_slope_y);
+    j["Sdq"] = number(s.Sdq);
     j["m_from_T"] = number(s.m_from_T);
     j["warnings"] = strings(s.warnings);
     if (with_curves) {
@@ -136,6 +141,9 @@ std::string to_text(const StatisticsInput& input, const surface::SurfaceStatisti
         sigma.append(" +- ").append(with_unit(j["sigma_stderr_um"], "um"));
     std::string T = with_unit(j["T_um"], "um");
     if (!j["T_stderr_um"].is_null()) T.append(" +- ").append(with_unit(j["T_stderr_um"], "um"));
+    std::string Str = text_of(j["Str"]);
+    if (!j["Str_note"].is_null())
+        Str.append(" (").append(j["Str_note"].get<std::string>()).append(")");
     print_lines(out, {
                          {"points", text_of(j["points"])},
                          {"sigma (Sq)", sigma},
@@ -151,9 +159,13 @@ std::string to_text(const StatisticsInput& input, const surface::SurfaceStatisti
                          {"T (exponential fit)", with_unit(j["T_fit_exponential_um"], "um")},
                          {"correlation (AIC)", text_of(j["correlation"])},
                          {"T (extrapolated)", with_unit(j["T_extrapolated_um"], "um")},
+                         {"period (ACF, x)", with_unit(j["period_um"], "um")},
+                         {"period (ACF, y)", with_unit(j["period_y_um"], "um")},
                          {"Sal (s = 0.2)", with_unit(j["Sal_um"], "um")},
-                         {"Str", text_of(j["Str"])},
-                         {"RMS slope (Sdq)", text_of(j["rms_slope"])},
+                         {"Str", Str},
+                         {"RMS slope along x (Rdq)", text_of(j["rms_slope"])},
+                         {"RMS slope along y (Rdq)", text_of(j["rms_slope_y"])},
+                         {"RMS gradient (Sdq)", text_of(j["Sdq"])},
                          {"m = sigma*sqrt(2)/T", text_of(j["m_from_T"])},
                      });
     for (const std::string& w : s.warnings) out << "warning: " << w << '\n';

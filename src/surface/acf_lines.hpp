@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "roughscope/core/text.hpp"
+#include "roughscope/surface/spectral.hpp"
 #include "roughscope/surface/statistics.hpp"
 
 namespace roughscope::surface::detail {
@@ -68,5 +69,40 @@ void accumulate_columns(const HeightMap& map, LineAcf& acc);
 
 // The curve C(j·spacing) for the lags with pairs; empty when S_0 = 0.
 Curve acf_curve(const LineAcf& acc, AcfEstimator estimator, double spacing_um);
+
+// ---- The ACF's shape beyond the 1/e crossing (acf_shape.cpp) ---------------------------------
+// C at `lag_um` interpolated linearly between the curve's lags; NaN outside them.
+double curve_value(const Curve& acf, double lag_um);
+
+// The last lag (samples) before the ACF first falls to 0 — its central lobe — capped at
+// lobe_over_T · T when T is known; the curve's last lag when it never falls to 0.
+std::size_t central_lobe_samples(const Curve& acf, double spacing_um, std::optional<double> T_um,
+                                 double lobe_over_T);
+
+// A profile's ACF curve on a 1-row lag grid (C(−τ) = C(τ); NaN at lags without pairs).
+Acf2d profile_lag_grid(const Curve& acf, double spacing_um);
+
+// Bartlett's sums over the lags Δ of the window |Δx| ≤ window_x, |Δy| ≤ window_y (ρ = 0 outside
+// it), for the shift h = (shift_x, 0) where ρ(h) = rho_shift:
+//   s0 = Σ ρ(Δ)²
+//   sh = Σ [ρ(Δ)² + ρ(Δ+h) ρ(Δ−h) − 4 ρ(h) ρ(Δ) ρ(Δ−h) + 2 ρ(h)² ρ(Δ)²]
+// each term weighted by (1 − |Δx|/nx)(1 − |Δy|/ny), the share of the map's pairs Δ apart (nx, ny:
+// the map's size, from the lag grid's), so that var ρ̂(h) ≈ sh / n_h over n_h pairs, and ≈ s0 / n_h
+// where ρ ≈ 0 around h.
+struct BartlettSums {
+    double s0 = 0;
+    double sh = 0;
+};
+BartlettSums bartlett_sums(const Acf2d& rho, std::size_t window_x, std::size_t window_y,
+                           std::size_t shift_x, double rho_shift);
+
+// A periodic ACF: after its first zero crossing τ0 it falls to `low` ≤ −threshold (the minimum
+// over [τ0, 3 τ0]) and rises again to `high` ≥ threshold at period_um, an interior maximum over
+// [1.5, 2.5] × the minimum's lag (≤ max_lag_um; parabolic refinement); none otherwise.
+struct AcfSwing {
+    double low = 0, low_lag_um = 0;
+    double high = 0, period_um = 0;
+};
+std::optional<AcfSwing> find_period(const Curve& acf, double max_lag_um, double threshold);
 
 }  // namespace roughscope::surface::detail

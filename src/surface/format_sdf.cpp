@@ -469,6 +469,10 @@ std::string trailer_text(const HeightMap& map) {
 
 HeightMap decode_sdf(std::string_view bytes, const std::string& name, const HeightReadOptions&) {
     if (bytes.empty()) throw tab::error_at_offset(name, 0, "empty file (not an SDF file)");
+    // ASCII SDF is text: a UTF-8 byte-order mark before its "aISO-1.0" is skipped.
+    if (bytes.starts_with("\xEF\xBB\xBF"
+                          "a"))
+        return tab::finish(decode_text(bytes.substr(3), name), name);
     if (bytes.front() == 'b') return tab::finish(decode_binary(bytes, name), name);
     if (bytes.front() == 'a') return tab::finish(decode_text(bytes, name), name);
     throw tab::error_at_offset(

@@ -177,6 +177,7 @@ double cell_value(const std::string& name, const Line& line, std::string_view ce
 // Walks the lines: header comments into `header`, data lines (split into cells) to `on_row`.
 template <class OnRow>
 void walk(std::string_view bytes, const std::string& name, Header& header, OnRow&& on_row) {
+    bytes = tab::skip_utf8_bom(bytes);
     std::vector<std::string_view> cells;
     bool have_sep = false;
     char sep = 0;

@@ -3,6 +3,7 @@
 
 #include <cmath>
 #include <string>
+#include <utility>
 
 #include "roughscope/core/errors.hpp"
 #include "roughscope/core/numbers.hpp"
@@ -49,6 +50,14 @@ SurfaceFromStatistics surface_from_statistics(const SurfaceStatistics& stats,
             "the height statistics have no correlation length T (the ACF does not fall to 1/e "
             "within the map and no fit succeeded): give a longer map or sigma and T directly");
     }
+    for (const auto& [period, axis] :
+         {std::pair{stats.period_um, "x"}, std::pair{stats.period_y_um, "y"}})
+        if (period)
+            out.warnings.push_back(
+                "the height statistics show a periodic component along " + std::string(axis) +
+                " (period " + format_significant(*period, 3) +
+                " um): the model assumes a random rough surface; a periodic one also diffracts "
+                "light into orders the prediction leaves out");
     return out;
 }
 

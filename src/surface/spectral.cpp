@@ -281,6 +281,7 @@ TextureParameters texture_parameters(const Acf2d& acf, double s) {
     }
     // Rays at kDirections angles over [0, π) (C(−τ) = C(τ) covers the other half).
     constexpr int kDirections = 360;
+    out.directions = kDirections;
     std::optional<double> shortest;
     double longest = 0;
     bool all_cross = true;
@@ -289,6 +290,9 @@ TextureParameters texture_parameters(const Acf2d& acf, double s) {
         const std::optional<double> r = first_crossing(acf, std::cos(theta), std::sin(theta), s);
         if (!r) {
             all_cross = false;
+            ++out.directions_without_crossing;
+            if (!out.first_without_crossing_deg)
+                out.first_without_crossing_deg = 180.0 * k / kDirections;
             continue;
         }
         shortest = shortest ? std::min(*shortest, *r) : *r;

@@ -49,6 +49,15 @@ constexpr int kMaxExtrapolationLevels = 3;  // L, L/2, L/4: where T(1/L) is near
 constexpr double kFitLagOverT = 3.0;
 // Below this L/T the 1/e estimate of T is biased low.
 constexpr double kMinLengthOverT = 50.0;
+// One-sided 95 % normal quantile: the upper bound of T for the L/T test.
+constexpr double kUpperBoundZ = 1.645;
+// Bartlett's sums run over the ACF's central lobe, at most this many T from the origin.
+constexpr double kLobeOverT = 10.0;
+// A periodic ACF swings below −threshold and back above +threshold, threshold = the larger of
+// kMinSwing and kSwingSigmas standard deviations of the ACF estimator's noise.
+constexpr double kMinSwing = 0.2;
+constexpr double kSwingSigmas = 4.0;
+constexpr double kNoiseLobeOverT = 3.0;
 
 std::string number(double value) { return format_significant(value, 3); }
 
@@ -89,9 +98,8 @@ double sample_sd(const std::vector<double>& v) {
 // The 1/e T (samples) of the segments of `seg` samples of the given rows, each segment minus
 // its own mean line, the sums pooled over the segments.
 std::optional<double> segment_T_samples(const HeightMap& map, const std::vector<std::size_t>& rows,
-                                        std::size_t seg, AcfEstimator estimator,
-                                        std::vector<double>* per_segment) {
-    detail::LineAcf acc(seg, estimator, per_segment != nullptr);
+                                        std::size_t seg, AcfEstimator estimator) {
+    detail::LineAcf acc(seg, estimator, false);
     std::vector<double> buf(seg);
     for (std::size_t iy : rows)
         for (std::size_t s = 0; s + seg <= map.nx; s += seg) {
@@ -100,7 +108,6 @@ std::optional<double> segment_T_samples(const HeightMap& map, const std::vector<
             if (remove_line(buf.data(), seg)) acc.add(buf.data());
         }
     acc.finish();
-    if (per_segment != nullptr) *per_segment = acc.line_crossing;
     return detail::crossing_1e_samples(acc.sums, acc.pairs, estimator);
 }
 
@@ -115,7 +122,7 @@ std::optional<double> extrapolated_T_um(const HeightMap& map, AcfEstimator estim
     std::size_t seg = map.nx;
     for (int level = 0; level < kMaxExtrapolationLevels; ++level, seg /= 2) {
         if (seg < 16 || static_cast<double>(seg) < kMinLineOverT * T_samples) break;
-        if (const auto T = segment_T_samples(map, rows, seg, estimator, nullptr)) {
+        if (const auto T = segment_T_samples(map, rows, seg, estimator)) {
             inv_length.push_back(1.0 / (static_cast<double>(seg) * map.dx_um));
             T_um.push_back(*T * map.dx_um);
         }
@@ -164,13 +171,184 @@ Slopes rms_slopes(const HeightMap& map) {
     return out;
 }
 
+// The ACF's shape beyond T: the standard errors and the periodicity test (docs/surface.md).
+struct AcfShape {
+    std::optional<double> T_stderr_um;
+    std::optional<detail::AcfSwing> swing_x, swing_y;
+};
+
+// Standard error of the 1/e T: var ρ̂(T) from Bartlett's sums over the central lobe, over the
+// n_T pairs T apart, through the ACF's slope there: s.e. = √(sh / n_T) / |C'(T)|, with C' by
+// central differences over ±max(dx, T/4).
+std::optional<double> correlation_length_stderr(const Acf2d& acf2, const Curve& acf_x,
+                                                const std::vector<double>& pairs,
+                                                std::size_t window_x, std::size_t window_y,
+                                                double T_um, double dx_um) {
+    const auto shift = static_cast<std::size_t>(std::max(1.0, std::round(T_um / dx_um)));
+    if (shift >= pairs.size() || !(pairs[shift] > 0)) return std::nullopt;
+    const double inv_e = std::exp(-1.0);
+    const detail::BartlettSums b = detail::bartlett_sums(acf2, window_x, window_y, shift, inv_e);
+    const double delta = std::min(std::max(dx_um, 0.25 * T_um), T_um);
+    const double slope =
+        (detail::curve_value(acf_x, T_um - delta) - detail::curve_value(acf_x, T_um + delta)) /
+        (2.0 * delta);
+    if (!(b.sh > 0) || !(slope > 0)) return std::nullopt;
+    return std::sqrt(b.sh / pairs[shift]) / slope;
+}
+
+AcfShape acf_shape(const Acf2d& acf2, const Curve& acf_x, const Curve& acf_y,
+                   const std::vector<double>& row_pairs, const std::vector<double>& column_pairs,
+                   const HeightMap& levelled, std::optional<double> T_um,
+                   std::optional<double> T_y_um) {
+    AcfShape out;
+    const std::size_t window_x =
+        detail::central_lobe_samples(acf_x, levelled.dx_um, T_um, kLobeOverT);
+    const std::size_t window_y =
+        acf_y.x.empty() ? 0
+                        : detail::central_lobe_samples(acf_y, levelled.dy_um, T_y_um, kLobeOverT);
+    if (T_um)
+        out.T_stderr_um = correlation_length_stderr(acf2, acf_x, row_pairs, window_x, window_y,
+                                                    *T_um, levelled.dx_um);
+    // Periodicity: swings beyond kMinSwing and kSwingSigmas standard deviations of the noise a
+    // random surface leaves in its ACF at half the length, √(s0 / n), s0 over the lobe up to
+    // kNoiseLobeOverT · T in x and y (T_y, or T when there is none along y: a random surface's
+    // ACF has decayed there; a periodic component must not inflate its own noise level).
+    const std::size_t noise_x = std::min(
+        window_x, detail::central_lobe_samples(acf_x, levelled.dx_um, T_um, kNoiseLobeOverT));
+    const std::size_t noise_y =
+        acf_y.x.empty() ? 0
+                        : detail::central_lobe_samples(acf_y, levelled.dy_um,
+                                                       T_y_um ? T_y_um : T_um, kNoiseLobeOverT);
+    const double s0 = detail::bartlett_sums(acf2, noise_x, noise_y, 0, 0.0).s0;
+    const auto threshold = [&](const std::vector<double>& pairs) {
+        const double n = pairs.empty() ? 0.0 : pairs[pairs.size() / 2];
+        return n > 0 ? std::max(kMinSwing, kSwingSigmas * std::sqrt(s0 / n)) : 1.0;
+    };
+    out.swing_x = detail::find_period(acf_x, 0.5 * levelled.length_x_um(), threshold(row_pairs));
+    if (!acf_y.x.empty())
+        out.swing_y =
+            detail::find_period(acf_y, 0.5 * levelled.length_y_um(), threshold(column_pairs));
+    return out;
+}
+
+// "L/T < 50": decided with T at its upper 95 % bound T·exp(1.645 s.e./T) (T > 0 and its
+// scatter is skewed to large values: a log-normal bound), so that a length bias that pulls the 1/e
+// T low cannot hide a short profile. T_extrapolated_um is pointed to only when its correction is
+// upward (the length bias only lowers T) and larger than twice the standard error of T: otherwise
+// its own noise makes it worse than the 1/e value (docs/surface.md).
 void length_warning(std::vector<std::string>& warnings, const char* direction, double L_um,
-                    double T_um) {
+                    double T_um, std::optional<double> T_stderr_um,
+                    std::optional<double> T_extrapolated_um) {
     const double ratio = L_um / T_um;
-    if (ratio < kMinLengthOverT)
-        warnings.push_back(concat("L/T = ", number(ratio), " along ", direction,
-                                  " is below 50: the 1/e correlation length is biased low (see "
-                                  "T_extrapolated_um)"));
+    // (The exponent capped so that a huge s.e. gives a huge bound, not an overflow.)
+    const double T_upper =
+        T_stderr_um ? T_um * std::exp(std::min(kUpperBoundZ * *T_stderr_um / T_um, 50.0)) : T_um;
+    const double ratio_upper = L_um / T_upper;
+    std::string what = concat("L/T = ", number(ratio), " along ", direction);
+    if (ratio < kMinLengthOverT) {
+        what.append(" is below 50");
+    } else if (ratio_upper < kMinLengthOverT) {
+        what.append(" may be below 50 (L/T = ")
+            .append(number(ratio_upper))
+            .append(" with T at its upper 95 % bound)");
+    } else {
+        return;
+    }
+    what.append(": the 1/e correlation length is biased low");
+    if (T_extrapolated_um && T_stderr_um) {
+        if (*T_extrapolated_um - T_um > 2.0 * *T_stderr_um)
+            what.append(" (see T_extrapolated_um)");
+        else
+            what.append(
+                " (T_extrapolated_um does not correct it here: its correction is downward or "
+                "within the noise of T)");
+    }
+    warnings.push_back(std::move(what));
+}
+
+void add_length_warnings(SurfaceStatistics& st, const HeightMap& levelled, bool profile) {
+    if (st.T_um)
+        length_warning(st.warnings, "x", levelled.length_x_um(), *st.T_um, st.T_stderr_um,
+                       st.T_extrapolated_um);
+    else
+        st.warnings.emplace_back(
+            "the ACF along x does not fall to 1/e within the profile: no correlation length "
+            "(the profile is too short, or a long-wavelength component is left: level or "
+            "filter it)");
+    if (profile) return;
+    if (st.T_y_um)
+        length_warning(st.warnings, "y", levelled.length_y_um(), *st.T_y_um, std::nullopt,
+                       std::nullopt);
+    else
+        st.warnings.emplace_back(
+            "the ACF along y does not fall to 1/e within the map: no correlation length "
+            "along y");
+}
+
+void add_period_warnings(SurfaceStatistics& st, const AcfShape& shape, bool profile) {
+    const auto warn = [&](const detail::AcfSwing& s, const char* direction, const char* key) {
+        st.warnings.push_back(concat(
+            "the ACF along ", direction, " is periodic: it falls to ", number(s.low), " at ",
+            number(s.low_lag_um), " um and rises again to ", number(s.high), " at ",
+            number(s.period_um), " um (", key,
+            "): the surface has a periodic component (a lay, machining or "
+            "grinding marks), which the random-surface model (Gaussian heights, Gaussian or "
+            "exponential correlation) does not describe; T and sigma mix the period with the "
+            "roughness (a Gaussian filter with a cutoff below the period, --cutoff-um, keeps "
+            "the roughness only)"));
+    };
+    if (shape.swing_x) {
+        st.period_um = shape.swing_x->period_um;
+        warn(*shape.swing_x, "x", "period_um");
+    }
+    if (!profile && shape.swing_y) {
+        st.period_y_um = shape.swing_y->period_um;
+        warn(*shape.swing_y, "y", "period_y_um");
+    }
+}
+
+// The spread of σ over rows (maps, over n_eff = min(rows, L_y / (2 T_y)) independent rows) or
+// over blocks of a profile (B = min(16, L/(10 T)) ≥ 4).
+std::optional<double> sigma_stderr(const HeightMap& levelled, const detail::LineAcf& rows,
+                                   std::optional<double> T_um, std::optional<double> T_y_um) {
+    if (!levelled.is_profile()) {
+        if (rows.line_rms_um.size() < 2) return std::nullopt;
+        double n_eff = static_cast<double>(rows.line_rms_um.size());
+        if (T_y_um) n_eff = std::min(n_eff, levelled.length_y_um() / (2.0 * *T_y_um));
+        return sample_sd(rows.line_rms_um) / std::sqrt(std::max(n_eff, 1.0));
+    }
+    if (!T_um) return std::nullopt;
+    const double T_samples = *T_um / levelled.dx_um;
+    const auto blocks = static_cast<std::size_t>(
+        std::min(16.0, std::floor(static_cast<double>(levelled.nx) / (kMinLineOverT * T_samples))));
+    if (blocks < 4) return std::nullopt;
+    const std::size_t len = levelled.nx / blocks;
+    std::vector<double> block_rms;
+    for (std::size_t b = 0; b < blocks; ++b) {
+        double ss = 0;
+        std::size_t c = 0;
+        for (std::size_t k = b * len; k < (b + 1) * len; ++k) {
+            const double z = levelled.heights_um[k];
+            if (std::isnan(z)) continue;
+            ss += z * z;
+            ++c;
+        }
+        if (c > 0) block_rms.push_back(std::sqrt(ss / static_cast<double>(c)));
+    }
+    if (block_rms.size() < 2) return std::nullopt;
+    return sample_sd(block_rms) / std::sqrt(static_cast<double>(block_rms.size()));
+}
+
+// Why ISO 25178-2's Str is undefined for this map.
+std::string str_note(const TextureParameters& tp) {
+    if (tp.directions_without_crossing == 0) return "undefined";
+    std::string note = concat("the ACF stays above 0.2 to the edge of the map in ",
+                              std::to_string(tp.directions_without_crossing), " of ",
+                              std::to_string(tp.directions), " directions");
+    if (tp.first_without_crossing_deg)
+        note.append(" (from ").append(number(*tp.first_without_crossing_deg)).append(" deg)");
+    note.append(": a lay or a map too small across it; ISO 25178-2 leaves Str undefined");
+    return note;
 }
 
 }  // namespace
@@ -286,23 +464,24 @@ SurfaceStatistics surface_statistics(HeightMap map, const StatisticsOptions& opt
         return st;
     }
 
-    // ACF along rows (and columns), per row σ and T for the uncertainties.
+    // ACF along rows (and columns), per row σ for its uncertainty.
     detail::LineAcf rows(levelled.nx, estimator, !profile);
     detail::accumulate_rows(levelled, rows);
     rows.finish();
     const Curve acf_x = detail::acf_curve(rows, estimator, levelled.dx_um);
     st.T_um = correlation_length_1e(acf_x);
     Curve acf_y;
+    std::vector<double> column_pairs;
     if (!profile) {
         detail::LineAcf columns(levelled.ny, estimator, false);
         detail::accumulate_columns(levelled, columns);
         columns.finish();
         acf_y = detail::acf_curve(columns, estimator, levelled.dy_um);
         st.T_y_um = correlation_length_1e(acf_y);
+        column_pairs = std::move(columns.pairs);
     }
 
     if (st.T_um) {
-        length_warning(st.warnings, "x", levelled.length_x_um(), *st.T_um);
         const double max_lag = std::min(kFitLagOverT * *st.T_um, 0.5 * levelled.length_x_um());
         const AcfModelFit fit = fit_acf_models(acf_x, max_lag);
         st.T_fit_gaussian_um = fit.T_gaussian_um;
@@ -310,80 +489,46 @@ SurfaceStatistics surface_statistics(HeightMap map, const StatisticsOptions& opt
         st.correlation = fit.better;
         st.T_extrapolated_um = extrapolated_T_um(levelled, estimator, *st.T_um / levelled.dx_um);
         st.m_from_T = st.sigma_um * std::sqrt(2.0) / *st.T_um;
-    } else {
-        st.warnings.emplace_back(
-            "the ACF along x does not fall to 1/e within the profile: no correlation length "
-            "(the profile is too short, or a long-wavelength component is left: level or "
-            "filter it)");
-    }
-    if (!profile) {
-        if (st.T_y_um)
-            length_warning(st.warnings, "y", levelled.length_y_um(), *st.T_y_um);
-        else
-            st.warnings.emplace_back(
-                "the ACF along y does not fall to 1/e within the map: no correlation length "
-                "along y");
     }
 
     // Slopes.
     const Slopes slopes = rms_slopes(levelled);
     st.rms_slope = slopes.along_x;
+    st.rms_slope_y = slopes.along_y;
     if (!profile && slopes.along_x && slopes.along_y)
         st.Sdq = std::sqrt(*slopes.along_x * *slopes.along_x + *slopes.along_y * *slopes.along_y);
 
-    // Uncertainties of σ and T: spread over rows (maps) or blocks (profiles).
+    // The 2-D ACF (a profile's on one row of lags): Bartlett's sums for the uncertainty of T and
+    // the noise level of the periodicity test; Sal/Str.
+    std::optional<Acf2d> acf2;
     if (!profile) {
-        // Rows closer than ~2 T_y are not independent: n_eff = min(rows, L_y / (2 T_y)).
-        const auto n_eff = [&](std::size_t n) {
-            double eff = static_cast<double>(n);
-            if (st.T_y_um) eff = std::min(eff, levelled.length_y_um() / (2.0 * *st.T_y_um));
-            return std::max(eff, 1.0);
-        };
-        if (rows.line_rms_um.size() >= 2)
-            st.sigma_stderr_um =
-                sample_sd(rows.line_rms_um) / std::sqrt(n_eff(rows.line_rms_um.size()));
-        if (rows.line_crossing.size() >= 2)
-            st.T_stderr_um = sample_sd(rows.line_crossing) * levelled.dx_um /
-                             std::sqrt(n_eff(rows.line_crossing.size()));
-    } else if (st.T_um) {
-        const double T_samples = *st.T_um / levelled.dx_um;
-        const auto blocks = static_cast<std::size_t>(std::min(
-            16.0, std::floor(static_cast<double>(levelled.nx) / (kMinLineOverT * T_samples))));
-        if (blocks >= 4) {
-            const std::size_t len = levelled.nx / blocks;
-            std::vector<double> block_rms;
-            for (std::size_t b = 0; b < blocks; ++b) {
-                double ss = 0;
-                std::size_t c = 0;
-                for (std::size_t k = b * len; k < (b + 1) * len; ++k) {
-                    const double z = levelled.heights_um[k];
-                    if (std::isnan(z)) continue;
-                    ss += z * z;
-                    ++c;
-                }
-                if (c > 0) block_rms.push_back(std::sqrt(ss / static_cast<double>(c)));
-            }
-            if (block_rms.size() >= 2)
-                st.sigma_stderr_um =
-                    sample_sd(block_rms) / std::sqrt(static_cast<double>(block_rms.size()));
-            std::vector<double> block_T;
-            segment_T_samples(levelled, {0}, len, estimator, &block_T);
-            if (block_T.size() >= 2)
-                st.T_stderr_um = sample_sd(block_T) * levelled.dx_um /
-                                 std::sqrt(static_cast<double>(block_T.size()));
-        }
+        Acf2d a = acf_2d(levelled, estimator);
+        if (!a.values.empty()) acf2 = std::move(a);
+    } else if (!acf_x.x.empty()) {
+        acf2 = detail::profile_lag_grid(acf_x, levelled.dx_um);
     }
+    const AcfShape shape = acf2 ? acf_shape(*acf2, acf_x, acf_y, rows.pairs, column_pairs, levelled,
+                                            st.T_um, st.T_y_um)
+                                : AcfShape{};
+    st.T_stderr_um = shape.T_stderr_um;
+    add_length_warnings(st, levelled, profile);
+    add_period_warnings(st, shape, profile);
 
-    // The FFT side (spectral.hpp): Sal/Str and the report's curves; empty results are "none".
+    // Uncertainty of σ: spread over rows (maps) or blocks (profiles).
+    st.sigma_stderr_um = sigma_stderr(levelled, rows, st.T_um, st.T_y_um);
+
     if (!profile) {
-        const Acf2d acf2 = acf_2d(levelled, estimator);
-        if (!acf2.values.empty()) {
-            const TextureParameters tp = texture_parameters(acf2, 0.2);
+        if (acf2) {
+            const TextureParameters tp = texture_parameters(*acf2, 0.2);
             st.Sal_um = tp.Sal_um;
             st.Str = tp.Str;
-            if (options.keep_curves) st.acf_radial = radial_acf(acf2);
+            if (!tp.Str) st.Str_note = str_note(tp);
+            if (options.keep_curves) st.acf_radial = radial_acf(*acf2);
         }
+    } else {
+        st.Str_note = "an areal parameter: a profile has none";
     }
+    acf2.reset();
     if (options.keep_curves) {
         st.acf_x = acf_x;
         st.acf_y = acf_y;

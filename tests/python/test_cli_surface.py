@@ -27,7 +27,8 @@ STATS_KEYS = ["file", "format", "nx", "ny", "dx_um", "dy_um", "leveling", "polyn
               "cutoff_um", "acf_estimator", "points", "sigma_um", "sigma_stderr_um", "Sa_um",
               "Ssk", "Sku", "Sp_um", "Sv_um", "Sz_um", "T_um", "T_y_um", "T_stderr_um",
               "T_fit_gaussian_um", "T_fit_exponential_um", "correlation", "T_extrapolated_um",
-              "Sal_um", "Str", "rms_slope", "m_from_T", "warnings"]
+              "period_um", "period_y_um", "Sal_um", "Str", "Str_note", "rms_slope",
+              "rms_slope_y", "Sdq", "m_from_T", "warnings"]
 
 
 def run(*args, check=True, cwd=None):
@@ -124,6 +125,46 @@ def test_stats_exponential_round_trip(tmp_path):
     assert abs(doc["sigma_um"] - 0.3) < 0.04
     assert abs(doc["T_um"] - 6.0) < 1.2
     assert doc["correlation"] == "exponential"
+
+
+def test_stats_text_labels_each_slope_for_what_it_is(tmp_path):
+    # A sinusoid along x plus a weaker one along y, not levelled, sampled finely: Rdq along x and
+    # along y and the areal Sdq of ISO 25178-2 = √(Rdq_x² + Rdq_y²) are three different numbers,
+    # each printed on its own line under its own name (no longer Rdq labelled "Sdq").
+    dx, lx, ly = 0.25, 64.0, 40.0
+    x = np.arange(1024) * dx
+    y = np.arange(640) * dx
+    z = 0.8 * np.sin(2 * np.pi * x / lx)[None, :] + 0.5 * np.sin(2 * np.pi * y / ly)[:, None]
+    path = tmp_path / "sines.gsf"
+    rs.write_height_map(z, dx, path=str(path))
+    doc = json.loads(run("surface", "stats", path, "--level", "none", "--json").stdout)
+    kx, ky = 2 * np.pi / lx, 2 * np.pi / ly
+    assert doc["rms_slope"] == pytest.approx(0.8 * kx / math.sqrt(2), rel=2e-3)
+    assert doc["rms_slope_y"] == pytest.approx(0.5 * ky / math.sqrt(2), rel=2e-3)
+    assert doc["Sdq"] == pytest.approx(math.hypot(0.8 * kx, 0.5 * ky) / math.sqrt(2), rel=2e-3)
+    text = run("surface", "stats", path, "--level", "none").stdout
+    lines = {line.split("  ")[0]: line.split()[-1] for line in text.splitlines() if "  " in line}
+    assert float(lines["RMS slope along x (Rdq)"]) == pytest.approx(doc["rms_slope"], rel=1e-5)
+    assert float(lines["RMS slope along y (Rdq)"]) == pytest.approx(doc["rms_slope_y"], rel=1e-5)
+    assert float(lines["RMS gradient (Sdq)"]) == pytest.approx(doc["Sdq"], rel=1e-5)
+    assert "RMS slope (Sdq)" not in text
+
+
+def test_stats_periodic_surface_reports_its_period_and_why_str_is_missing(tmp_path):
+    # Ridges along y with a 32 um period on a random surface: the period is found along x,
+    # the text says so, Str is missing with its reason, and a warning says what was assumed.
+    z = rs.generate_surface(sigma_um=1.0, T_um=8.0, nx=256, ny=256, dx_um=1.0, seed=5)
+    z = z + 1.5 * np.sin(2 * np.pi * np.arange(256) / 32.0)[None, :]
+    path = tmp_path / "lay.gsf"
+    rs.write_height_map(z, 1.0, path=str(path))
+    doc = json.loads(run("surface", "stats", path, "--json").stdout)
+    assert doc["period_um"] == pytest.approx(32.0, rel=0.03)
+    assert doc["period_y_um"] is None
+    assert doc["Str"] is None and "stays above 0.2" in doc["Str_note"]
+    assert any("periodic" in w for w in doc["warnings"])
+    text = run("surface", "stats", path).stdout
+    assert re.search(r"period \(ACF, x\)\s+32\.\d+ um", text), text
+    assert re.search(r"Str\s+- \(the ACF stays above 0\.2", text), text
 
 
 def test_stats_text_and_options(gaussian_x3p, tmp_path):

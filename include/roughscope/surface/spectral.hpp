@@ -36,6 +36,11 @@ Curve radial_acf(const Acf2d& acf);
 struct TextureParameters {
     std::optional<double> Sal_um;  // shortest lag at which C falls to s
     std::optional<double> Str;     // Sal / longest such lag (0..1)
+    // Of the directions searched (a map: 360 over [0°, 180°) from +x), those whose ACF stays above
+    // s to the edge of the lag grid (then Str is undefined), and the first of them (degrees).
+    int directions = 0;
+    int directions_without_crossing = 0;
+    std::optional<double> first_without_crossing_deg;
 };
 TextureParameters texture_parameters(const Acf2d& acf, double s = 0.2);
 

@@ -76,6 +76,8 @@ struct SurfaceStatistics {
     // Correlation length: 1/e crossing of the ACF, interpolated between lags.
     std::optional<double> T_um;    // along x (rows)
     std::optional<double> T_y_um;  // along y (columns); none for a profile
+    // Standard error of T_um from the variance of the ACF estimator at the crossing (Bartlett's
+    // formula over the 2-D lags of the central lobe, delta method: docs/surface.md).
     std::optional<double> T_stderr_um;
     // Least-squares fits of exp(−τ²/T²) and exp(−|τ|/T) to the ACF; the better by AIC.
     std::optional<double> T_fit_gaussian_um;
@@ -83,11 +85,18 @@ struct SurfaceStatistics {
     std::optional<Correlation> correlation;  // scattering/beckmann.hpp
     // T against 1/L over sub-profiles, extrapolated to 1/L = 0.
     std::optional<double> T_extrapolated_um;
+    // A periodic component: the lag of the ACF's first maximum after a significant negative
+    // swing (along x, along y); none when the ACF shows no period (docs/surface.md).
+    std::optional<double> period_um;
+    std::optional<double> period_y_um;
     // ISO 25178-2 with s = 0.2: fastest-decay length of the 2-D ACF and texture aspect ratio.
     std::optional<double> Sal_um;
     std::optional<double> Str;
-    // RMS slope by finite differences (Rdq/Sdq) and m = σ√2/T from the 1/e T.
+    std::string Str_note;  // why Str is not given (empty when it is)
+    // RMS slopes by forward differences: Rdq along x and along y (ISO 4287, one profile
+    // direction each), and m = σ√2/T from the 1/e T.
     std::optional<double> rms_slope;
+    std::optional<double> rms_slope_y;
     std::optional<double> m_from_T;
 
     std::vector<std::string> warnings;  // e.g. L/T < 50: the 1/e T is biased low

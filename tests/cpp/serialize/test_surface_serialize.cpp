@@ -78,9 +78,14 @@ TEST(SerializeSurface, StatisticsKeysInOrderAndNulls) {
                                                "T_fit_exponential_um",
                                                "correlation",
                                                "T_extrapolated_um",
+                                               "period_um",
+                                               "period_y_um",
                                                "Sal_um",
                                                "Str",
+                                               "Str_note",
                                                "rms_slope",
+                                               "rms_slope_y",
+                                               "Sdq",
                                                "m_from_T",
                                                "warnings"};
     EXPECT_EQ(keys_of(j), expected);
@@ -118,6 +123,32 @@ TEST(SerializeSurface, StatisticsText) {
     EXPECT_NE(t.find("0.5 um"), std::string::npos);
     EXPECT_NE(t.find("warning: L/T < 50"), std::string::npos);
     EXPECT_EQ(t.find("nan"), std::string::npos);
+}
+
+TEST(SerializeSurface, StatisticsTextLabelsEachSlopeAndSaysWhyStrIsMissing) {
+    const surface::HeightMap map = surface::make_height_map(10, 10, 0.5, 0.5);
+    surface::SurfaceStatistics s = some_stats();
+    s.rms_slope = 0.25;
+    s.rms_slope_y = 0.125;
+    s.Sdq = 0.375;
+    s.period_um = 32.5;
+    s.Str_note = "the ACF stays above 0.2";
+    const auto in = serialize::statistics_input(map, {}, "a.csv", "csv_matrix");
+    const Json j = serialize::to_json(in, s);
+    EXPECT_EQ(j["Sdq"], 0.375);
+    EXPECT_EQ(j["rms_slope_y"], 0.125);
+    EXPECT_EQ(j["period_um"], 32.5);
+    EXPECT_TRUE(j["period_y_um"].is_null());
+    EXPECT_EQ(j["Str_note"], "the ACF stays above 0.2");
+    EXPECT_TRUE(serialize::to_json(in, some_stats())["Str_note"].is_null());
+    const std::string t = serialize::to_text(in, s);
+    EXPECT_NE(t.find("RMS slope along x (Rdq)  0.25\n"), std::string::npos) << t;
+    EXPECT_NE(t.find("RMS slope along y (Rdq)  0.125\n"), std::string::npos) << t;
+    EXPECT_NE(t.find("RMS gradient (Sdq)       0.375\n"), std::string::npos) << t;
+    EXPECT_NE(t.find("period (ACF, x)          32.5 um\n"), std::string::npos) << t;
+    EXPECT_NE(t.find("Str                      - (the ACF stays above 0.2)\n"), std::string::npos)
+        << t;
+    EXPECT_EQ(t.find("RMS slope (Sdq)"), std::string::npos);
 }
 
 TEST(SerializeSurface, PredictionDocumentMatchesThePrediction) {
