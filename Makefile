@@ -15,12 +15,12 @@ REPORT_DIR ?= out/report
 ROUGHSCOPE_WERROR ?= OFF
 
 # ccache (installed by scripts/install-deps) makes rebuilds of unchanged sources cheap, also from
-# another clone on the same machine (paths are taken relative to the clone).
-CCACHE := $(shell command -v ccache 2>/dev/null)
-ifneq ($(CCACHE),)
+# another clone on the same machine (paths are taken relative to the clone). It is looked up by
+# the shell when each configure step runs — after scripts/install-deps — so that the very first
+# build on a fresh machine already goes through it (a lookup when make reads this file would
+# find nothing there, and the next configure would then rebuild everything).
 export CCACHE_BASEDIR ?= $(CURDIR)
-LAUNCHER_FLAGS = -DCMAKE_CXX_COMPILER_LAUNCHER=$(CCACHE)
-endif
+LAUNCHER_FLAGS = $$(command -v ccache >/dev/null 2>&1 && echo -DCMAKE_CXX_COMPILER_LAUNCHER=$$(command -v ccache))
 
 CONFIGURE_FLAGS = -G Ninja $(LAUNCHER_FLAGS) \
 	-DCMAKE_BUILD_TYPE=Release \
