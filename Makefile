@@ -83,7 +83,9 @@ build: configure
 test: build
 	$(CTEST) --test-dir $(BUILD) --output-on-failure -j $(JOBS) --no-tests=error
 
-demo: build
+# The demo needs only the CLI and the Python module (not the tests, benchmarks or fuzz replays).
+demo: configure
+	$(CMAKE) --build $(BUILD) -j $(JOBS) --target roughscope_cli _core roughscope_python_package
 	PYTHONPATH=$(BUILD)/python ROUGHSCOPE_CLI=$(BUILD)/bin/roughscope MPLBACKEND=Agg \
 		$(PYTHON) -m roughscope.report --out $(REPORT_DIR)
 	@echo "Report: $(REPORT_DIR)/index.html"
