@@ -14,6 +14,7 @@
 #include "roughscope/core/memory.hpp"
 #include "roughscope/core/names.hpp"
 #include "roughscope/core/text.hpp"
+#include "roughscope/io/input_file.hpp"
 #include "roughscope/io/output_file.hpp"
 
 namespace roughscope::surface {
@@ -86,6 +87,7 @@ std::string read_whole_file(const std::filesystem::path& path) {
     if (std::filesystem::is_directory(status)) {
         throw DataError("cannot read " + quote_input(path.string()) + ": it is a directory");
     }
+    io::check_input_file(path, "cannot read " + quote_input(path.string()));
     std::ifstream in(path, std::ios::binary);
     if (!in) {
         std::string message = "cannot read " + quote_input(path.string());
