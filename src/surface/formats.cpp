@@ -188,6 +188,41 @@ HeightMap read_height_map(const std::filesystem::path& path, const HeightReadOpt
     return decode_height_map(bytes, path.string(), format, options);
 }
 
+double encoded_size_estimate(std::size_t points, HeightFormat format,
+                             const HeightWriteOptions& options) {
+    // Bytes a point: the encoders' own reservations (text: up to 20 characters a number), one
+    // copy of the samples for the binary formats that convert them first.
+    double per_point = 8.0;
+    switch (format) {
+        case HeightFormat::CsvMatrix:
+            per_point = 20.0;
+            break;
+        case HeightFormat::Xyz:
+            per_point = 40.0;
+            break;
+        case HeightFormat::Sdf:
+            per_point = options.sdf_binary ? 8.0 : 20.0;
+            break;
+        case HeightFormat::X3p:
+            per_point = 16.0;  // the samples and the zip archive
+            break;
+        case HeightFormat::Png:
+            per_point = 4.0;
+            break;
+        case HeightFormat::Tiff:
+            per_point = 8.0;
+            break;
+        case HeightFormat::Raw:
+            per_point = options.raw_type == RawSampleType::Float32 ? 4.0 : 8.0;
+            break;
+        case HeightFormat::Gwy:
+        case HeightFormat::Gsf:
+            per_point = 8.0;
+            break;
+    }
+    return per_point * static_cast<double>(points);
+}
+
 void write_height_map(const HeightMap& map, const std::filesystem::path& path,
                       const HeightWriteOptions& options) {
     const HeightFormat format = format_for(path, options.format);
