@@ -204,7 +204,7 @@ double encoded_size_estimate(std::size_t points, HeightFormat format,
             per_point = options.sdf_binary ? 8.0 : 20.0;
             break;
         case HeightFormat::X3p:
-            per_point = 16.0;  // the samples and the zip archive
+            per_point = 24.0;  // the samples, the point data's copy and the zip archive
             break;
         case HeightFormat::Png:
             per_point = 4.0;

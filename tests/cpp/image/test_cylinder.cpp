@@ -286,8 +286,7 @@ TEST(CylinderProfile, BinsBeyondTheMemoryLimitAreRefusedBeforeAllocating) {
     o.bin_width_deg = 0.5;
     EXPECT_NO_THROW((void)measure_cylinder_profile(img, nullptr, o));
     ::unsetenv("ROUGHSCOPE_MEMORY_LIMIT_GB");
-    EXPECT_NE(message.find("cylinder bin_width_deg = 1e-06 ("), std::string::npos)
-        << message;
+    EXPECT_NE(message.find("cylinder bin_width_deg = 1e-06 ("), std::string::npos) << message;
     EXPECT_NE(message.find("GB of memory, above the limit of 1 GB"), std::string::npos) << message;
     EXPECT_NE(message.find("give a wider bin_width_deg"), std::string::npos) << message;
 }
