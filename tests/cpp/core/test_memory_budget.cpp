@@ -1,5 +1,6 @@
 // The memory budget (core/memory.hpp): half the physical memory unless ROUGHSCOPE_MEMORY_LIMIT_GB
 // says otherwise, and check_memory's message.
+#include <algorithm>
 #include <cstdlib>
 #include <fstream>
 #include <optional>
