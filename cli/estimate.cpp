@@ -345,9 +345,10 @@ struct FitArgs {
 // An upper bound of the data rows of a measurements file: its line count, and at most one row per
 // 10 bytes (the shortest row, "0,0,0,0,1\n"). 0 if it cannot be read (the reader reports that).
 std::size_t max_rows(const std::filesystem::path& path) {
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(path, ec)) return 0;
     std::ifstream in(path, std::ios::binary);
     if (!in) return 0;
-    std::error_code ec;
     const auto size = std::filesystem::file_size(path, ec);
     if (ec) return 0;
     std::vector<char> buffer(std::size_t{1} << 16);

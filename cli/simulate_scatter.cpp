@@ -167,8 +167,9 @@ void add_simulate_scatter(CLI::App& simulate) {
                      "8..11 for exponential, docs/simulation.md)")
         ->group(gm);
     cmd->add_option("--realisations", c.options.realisations,
-                    "Surfaces per geometry, 2..10000000 (default 100)")
-        ->transform(integer_validator(2, 10'000'000))
+                    "Surfaces per geometry, 10..10000000 (default 100; fewer give no usable "
+                    "standard error)")
+        ->transform(integer_validator(10, 10'000'000))
         ->group(gm);
     cmd->add_option("--seed", c.options.seed, "Seed of the surfaces (default 1)")
         ->transform(integer_validator(0, 9'223'372'036'854'775'807LL))

@@ -21,6 +21,8 @@
 #include "common.hpp"
 #include "python_runner.hpp"
 #include "roughscope/core/errors.hpp"
+#include "roughscope/core/memory.hpp"
+#include "roughscope/core/text.hpp"
 #include "roughscope/scattering/beckmann.hpp"
 #include "roughscope/scattering/geometry.hpp"
 #include "roughscope/serialize/json.hpp"
@@ -276,9 +278,21 @@ void add_write_options(CLI::App& cmd, std::optional<HeightFormat>& format, doubl
 
 void run_generate(GenerateCommand& c) {
     if (!given(c.o_dy)) c.gen.dy_um = c.gen.dx_um;
+    const surface::HeightWriteOptions w =
+        write_options(c.out_format, c.o_z, c.z_scale_um, c.sdf_ascii);
+    // The surface and its file, made in memory before it is written: checked together first.
+    const auto format =
+        c.out_format ? c.out_format : surface::height_format_from_extension(c.out_path);
+    if (format && c.gen.nx * c.gen.ny <= surface::kMaxHeightMapPoints) {
+        check_memory(surface::generation_memory_bytes(c.gen) +
+                         surface::encoded_size_estimate(c.gen.nx * c.gen.ny, *format, w),
+                     concat("surface generate --nx ", std::to_string(c.gen.nx), " --ny ",
+                            std::to_string(c.gen.ny), " (a ", surface::to_string(*format),
+                            " file of ", std::to_string(c.gen.nx * c.gen.ny), " heights)"),
+                     "give a smaller --nx or --ny, or a binary --out-format (raw, tiff)");
+    }
     const surface::HeightMap map = surface::generate_surface(c.gen);
-    surface::write_height_map(map, c.out_path,
-                              write_options(c.out_format, c.o_z, c.z_scale_um, c.sdf_ascii));
+    surface::write_height_map(map, c.out_path, w);
     if (c.json_output && c.out_path != "-")
         write_output(std::nullopt,
                      serialize::dump(serialize::versioned(serialize::summary_json(map))));

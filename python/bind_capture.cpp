@@ -287,6 +287,7 @@ void bind_capture(py::module_& m) {
         "write_capture",
         [](const std::string& out_dir, const std::string& format, const std::string& stem,
            const py::kwargs& kw) {
+            path_argument("out_dir", out_dir);
             Request r = request_from(kw);
             const CaptureFormat f = simulation::parse_capture_format(format);
             // Only what the file and the sidecar need (the same bytes as a full render).

@@ -263,7 +263,8 @@ void bind_curet(py::module_& m) {
     m.def(
         "curet_find_directory",
         [](std::optional<std::string> data_dir) {
-            return find_curet_directory(data_dir ? std::optional<std::filesystem::path>(*data_dir)
+            return find_curet_directory(data_dir ? std::optional<std::filesystem::path>(
+                                                       path_argument("data_dir", *data_dir))
                                                  : std::nullopt)
                 .string();
         },
@@ -275,7 +276,9 @@ void bind_curet(py::module_& m) {
         "curet_load",
         [](std::optional<std::string> data_dir, const std::string& channel) {
             const auto dir = find_curet_directory(
-                data_dir ? std::optional<std::filesystem::path>(*data_dir) : std::nullopt);
+                data_dir
+                    ? std::optional<std::filesystem::path>(path_argument("data_dir", *data_dir))
+                    : std::nullopt);
             return load_curet(dir, parse_curet_channel(channel));
         },
         py::arg("data_dir") = py::none(), py::arg("channel") = "mean",
@@ -298,7 +301,7 @@ void bind_curet(py::module_& m) {
         [](const std::string& path, std::optional<std::string> channel) {
             BrdfCsvOptions o;
             o.channel = channel;
-            return table_dict(read_brdf_csv(path, o));
+            return table_dict(read_brdf_csv(path_argument("path", path), o));
         },
         py::arg("path"), py::arg("channel") = py::none(),
         "Read a BRDF table (CSV: theta_i, phi_i, theta_s, phi_s in degrees, value; optional "
@@ -312,7 +315,8 @@ void bind_curet(py::module_& m) {
             co.channel = channel;
             const ComparisonOptions o = make_options(theta1_deg, theta2_deg, pair, on_sigma_rad,
                                                      on_albedo, fits, radiometry, py::none());
-            return to_python(serialize::to_json(compare_brdf(read_brdf_csv(path, co), o), series));
+            return to_python(serialize::to_json(
+                compare_brdf(read_brdf_csv(path_argument("path", path), co), o), series));
         },
         py::arg("path"), py::kw_only(), py::arg("channel") = py::none(),
         py::arg("theta1_deg") = py::none(), py::arg("theta2_deg") = py::none(),

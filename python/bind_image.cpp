@@ -140,7 +140,7 @@ void bind_image(py::module_& m) {
             image::LinearImage image;
             {
                 py::gil_scoped_release release;
-                image = image::read_image(path, options);
+                image = image::read_image(path_argument("path", path), options);
             }
             return image_dict(image);
         },
@@ -192,7 +192,8 @@ void bind_image(py::module_& m) {
             std::optional<image::RoughnessMap> map;
             {
                 py::gil_scoped_release release;
-                const image::MeasureRequest request = image::read_capture_file(capture_file);
+                const image::MeasureRequest request =
+                    image::read_capture_file(path_argument("capture_file", capture_file));
                 image::MeasureResult result = image::measure(request);
                 doc = serialize::to_json(result, request);
                 if (layers) map = std::move(result.map);

@@ -59,7 +59,7 @@ std::uint64_t seed_from(py::handle value) {
     const unsigned long long s = PyLong_AsUnsignedLongLong(v.ptr());
     if (PyErr_Occurred() != nullptr) {
         PyErr_Clear();
-        throw InvalidArgument(concat("seed = ", py::str(py::handle(v)).cast<std::string>(),
+        throw InvalidArgument(concat("seed = ", int_text(v),
                                      " is out of range: it must be an integer in [0, 2^64 - 1]"));
     }
     return static_cast<std::uint64_t>(s);
@@ -86,9 +86,10 @@ simulation::ScatterOptions scatter_options(py::handle sigma_um, py::handle T_um,
     o.dx_um = optional_real("dx_um", dx_um).value_or(0.0);
     o.patch_over_T = optional_real("patch_over_T", patch_over_T).value_or(0.0);
     const long long r = integer_scalar("realisations", realisations);
-    if (r < 2 || r > 10'000'000)
+    if (r < 10 || r > 10'000'000)
         throw InvalidArgument(concat("realisations = ", std::to_string(r),
-                                     " is out of range: it must be in [2, 1e7]"));
+                                     " is out of range: it must be in [10, 1e7] (fewer give no "
+                                     "usable standard error)"));
     o.realisations = static_cast<std::size_t>(r);
     o.seed = seed_from(seed);
     o.layout = simulation::parse_patch_layout(normalize_name(layout));

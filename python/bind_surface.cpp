@@ -136,6 +136,7 @@ void bind_surface(py::module_& m) {
         [](const std::string& path, std::optional<std::string> format, py::handle dx_um,
            py::handle dy_um, std::optional<std::string> unit, py::handle z_scale_um, py::handle nx,
            py::handle ny, const std::string& raw_type, bool big_endian, bool verify_checksums) {
+            path_argument("path", path);
             surface::HeightReadOptions o;
             if (format) o.format = surface::parse_height_format(normalize_name(*format));
             o.dx_um = optional_real("dx_um", dx_um);
@@ -191,7 +192,7 @@ void bind_surface(py::module_& m) {
             if (o.z_scale_um) o.tiff_float = false;
             o.sdf_binary = !sdf_ascii;
             o.raw_type = raw_type_of(raw_type);
-            surface::write_height_map(map, *path, o);
+            surface::write_height_map(map, path_argument("path", *path), o);
         },
         arg("heights_um"), arg("dx_um"), arg("dy_um") = py::none(), arg("path") = py::none(),
         py::kw_only(), arg("format") = py::none(), arg("z_scale_um") = py::none(),

@@ -44,6 +44,12 @@ double real_scalar(const char* name, pybind11::handle value);
 std::optional<double> optional_real(const char* name, pybind11::handle value);
 // A Python or NumPy integer (not bool, not float); TypeError otherwise.
 long long integer_scalar(const char* name, pybind11::handle value);
+// A Python int for a message: its digits, or its size in bits when it is too long to show (Python
+// refuses to convert an int of more than 4300 digits to text).
+std::string int_text(pybind11::handle value);
+// `path` unchanged, or ValueError "<name>: embedded null byte" as Python's open() raises (the C
+// library would read the name only up to the NUL: another file).
+std::string path_argument(const char* name, const std::string& path);
 // Checks an option value that must be a real number (or, with `pair`, a pair of real numbers) —
 // or None when `none_allowed` (None: "not given") — before it becomes JSON: TypeError otherwise.
 // Returns the value as float (list of floats).

@@ -82,8 +82,34 @@ py::object to_python(const serialize::Json& value) {
     throw Error("to_python: unsupported JSON value");
 }
 
+std::string int_text(py::handle value) {
+    const auto bits = value.attr("bit_length")().cast<long long>();
+    if (bits <= 256) return py::str(value).cast<std::string>();
+    return concat("an integer of ", std::to_string(bits), " bits");
+}
+
+namespace {
+
+// Deepest nesting of dicts and sequences from_python follows: a self-referencing dict or list
+// (d['rect'] = d) or a list nested 100,000 deep is refused with ValueError instead of
+// exhausting the C++ stack. No option of the library nests more than a few levels.
+constexpr int kMaxNesting = 32;
+
+serialize::Json from_python_at(py::handle value, const std::string& where, int depth);
+
+}  // namespace
+
 serialize::Json from_python(py::handle value, const std::string& where) {
+    return from_python_at(value, where, 0);
+}
+
+namespace {
+
+serialize::Json from_python_at(py::handle value, const std::string& where, int depth) {
     using Json = serialize::Json;
+    if (depth > kMaxNesting)
+        throw py::value_error(concat(where, " is nested more than ", std::to_string(kMaxNesting),
+                                     " levels deep (a dict or list that contains itself?)"));
     if (value.is_none()) return nullptr;
     if (py::isinstance<py::bool_>(value)) return value.cast<bool>();
     if (py::isinstance<py::int_>(value)) {
@@ -97,7 +123,7 @@ serialize::Json from_python(py::handle value, const std::string& where) {
             if (!PyErr_Occurred()) return static_cast<std::uint64_t>(unsigned_value);
             PyErr_Clear();
         }
-        throw InvalidArgument(concat(where, " = ", py::str(value).cast<std::string>(),
+        throw InvalidArgument(concat(where, " = ", int_text(value),
                                      " is out of range for an integer: it must be in "
                                      "[-2^63, 2^64)"));
     }
@@ -111,20 +137,23 @@ serialize::Json from_python(py::handle value, const std::string& where) {
         Json out = Json::object();
         for (const auto& [k, v] : value.cast<py::dict>())
             out[py::str(k).cast<std::string>()] =
-                from_python(v, where + " '" + py::str(k).cast<std::string>() + "'");
+                from_python_at(v, where + " '" + py::str(k).cast<std::string>() + "'", depth + 1);
         return out;
     }
     if (py::hasattr(value, "tolist") && !py::isinstance<py::str>(value))  // numpy
-        return from_python(value.attr("tolist")(), where);
+        return from_python_at(value.attr("tolist")(), where, depth + 1);
     if (py::isinstance<py::sequence>(value)) {
         Json out = Json::array();
-        for (py::handle item : value.cast<py::sequence>()) out.push_back(from_python(item, where));
+        for (py::handle item : value.cast<py::sequence>())
+            out.push_back(from_python_at(item, where, depth + 1));
         return out;
     }
     throw py::type_error(where + " has an unsupported type " +
                          py::str(py::type::of(value).attr("__name__")).cast<std::string>() +
                          " (expected None, bool, an int or float, a string or a sequence)");
 }
+
+}  // namespace
 
 namespace {
 
@@ -155,8 +184,17 @@ py::object real_array(const char* name, py::handle value) {
     }
     if (value.is_none()) not_real(name, "None");
     if (PyBool_Check(value.ptr())) not_real(name, "bool");
-    if (PyFloat_Check(value.ptr()) || PyLong_Check(value.ptr()))
+    if (PyLong_Check(value.ptr())) {
+        // An int beyond the double range (10**400) has no real value: named, not converted.
+        (void)PyLong_AsDouble(value.ptr());
+        if (PyErr_Occurred() != nullptr) {
+            PyErr_Clear();
+            throw InvalidArgument(concat(name, " = ", int_text(value),
+                                         " is out of range for a real number (beyond 1.8e308)"));
+        }
         return py::reinterpret_borrow<py::object>(value);
+    }
+    if (PyFloat_Check(value.ptr())) return py::reinterpret_borrow<py::object>(value);
     if (py::isinstance<py::str>(value) || py::isinstance<py::bytes>(value) ||
         PyComplex_Check(value.ptr()))
         not_real(name, type_name(value));
@@ -210,7 +248,22 @@ long long integer_scalar(const char* name, py::handle value) {
         throw py::type_error(std::string(name) +
                              " must be an integer (int or a NumPy integer), not " +
                              (value.is_none() ? std::string("None") : type_name(value)));
-    return py::int_(py::reinterpret_borrow<py::object>(value)).cast<long long>();
+    const py::int_ v(py::reinterpret_borrow<py::object>(value));
+    int overflow = 0;
+    const long long n = PyLong_AsLongLongAndOverflow(v.ptr(), &overflow);
+    if (overflow != 0 || (n == -1 && PyErr_Occurred() != nullptr)) {
+        PyErr_Clear();
+        throw InvalidArgument(concat(name, " = ", int_text(v),
+                                     " is out of range for an integer: it must be in "
+                                     "[-2^63, 2^63 - 1] (and in the argument's own range)"));
+    }
+    return n;
+}
+
+std::string path_argument(const char* name, const std::string& path) {
+    if (path.find('\0') != std::string::npos)
+        throw py::value_error(concat(name, ": embedded null byte"));
+    return path;
 }
 
 py::object real_option(const char* name, py::object value, bool pair, bool none_allowed) {

@@ -12,6 +12,7 @@
 #include "roughscope/core/numbers.hpp"
 #include "roughscope/core/text.hpp"
 #include "roughscope/io/csv.hpp"
+#include "roughscope/io/input_file.hpp"
 
 namespace roughscope {
 namespace {
@@ -131,6 +132,7 @@ BrdfTable read_brdf_csv(const std::filesystem::path& path, const BrdfCsvOptions&
     std::error_code ec;
     if (std::filesystem::is_directory(path, ec))
         throw DataError("cannot read BRDF table " + path.string() + ": is a directory");
+    io::check_input_file(path, "cannot read BRDF table " + path.string());
     std::ifstream in(path, std::ios::binary);
     if (!in)
         throw DataError("cannot read BRDF table " + path.string() +

@@ -12,6 +12,7 @@
 #include "roughscope/core/errors.hpp"
 #include "roughscope/core/text.hpp"
 #include "roughscope/image/measure.hpp"
+#include "roughscope/io/input_file.hpp"
 #include "roughscope/scattering/beckmann.hpp"
 #include "roughscope/scattering/factors.hpp"
 #include "roughscope/scattering/geometry.hpp"
@@ -596,12 +597,19 @@ MeasureRequest read_capture_file(const std::string& path) {
     std::error_code ec;
     if (std::filesystem::is_directory(path, ec))
         throw DataError(concat(path, ": is a directory, not a capture file"));
+    io::check_input_file(path, path);
+    constexpr std::size_t kMaxCaptureFileBytes = std::size_t{16} << 20;
+    const auto too_large = [&] {
+        return DataError(concat(path, ": larger than 16 MiB: not a capture file"));
+    };
+    std::error_code size_ec;
+    if (std::filesystem::file_size(path, size_ec) > kMaxCaptureFileBytes && !size_ec)
+        throw too_large();
     std::ifstream in(path, std::ios::binary);
     if (!in) throw DataError(concat(path, ": cannot open the capture file"));
     std::ostringstream text;
     text << in.rdbuf();
-    if (text.str().size() > (std::size_t{16} << 20))
-        throw DataError(concat(path, ": larger than 16 MiB: not a capture file"));
+    if (text.str().size() > kMaxCaptureFileBytes) throw too_large();
     return parse_capture_file(text.str(), path);
 }
 

@@ -13,6 +13,7 @@
 
 #include "object_profile.hpp"
 #include "roughscope/core/errors.hpp"
+#include "roughscope/core/memory.hpp"
 #include "roughscope/core/text.hpp"
 #include "roughscope/scattering/validity.hpp"
 
@@ -283,6 +284,14 @@ CylinderProfile measure_cylinder_profile(const LinearImage& image,
             t_max = std::max(t_max, t);
         }
     const auto n_slices = static_cast<std::size_t>(std::ceil(t_max - t_min)) + 1;
+    const std::size_t n_bands = std::clamp<std::size_t>(h / kRowsPerBand, 1, kMaxBands);
+    // The pass's accumulators, at most: every band's bins and its slices of each bin.
+    check_memory(static_cast<double>(n_bands) * static_cast<double>(n_bins) *
+                     (sizeof(BinSums) + 12.0 * static_cast<double>(n_slices)),
+                 concat("cylinder bin_width_deg = ", format_number(options.bin_width_deg), " (",
+                        std::to_string(n_bins), " bins of the normal angle over ",
+                        std::to_string(n_slices), " slices along the axis)"),
+                 "give a wider bin_width_deg (default 2)");
 
     // The single pass, over bands of rows (a fixed number, whatever the number of threads: the
     // sums do not depend on it). Each band sums into its own accumulators over the ranges of
@@ -321,7 +330,6 @@ CylinderProfile measure_cylinder_profile(const LinearImage& image,
                     bin_lo,           n_band_slices,      slice_lo};
         }
     };
-    const std::size_t n_bands = std::clamp<std::size_t>(h / kRowsPerBand, 1, kMaxBands);
     std::vector<Band> bands(n_bands);
     // Ranges from the band's corners, one sub-bin and one slice of margin for rounding.
     const auto prepare_band = [&](Band& band, std::size_t r0, std::size_t r1) {

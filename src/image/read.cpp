@@ -24,6 +24,7 @@
 #include "roughscope/core/errors.hpp"
 #include "roughscope/core/memory.hpp"
 #include "roughscope/core/text.hpp"
+#include "roughscope/io/input_file.hpp"
 
 namespace roughscope::image {
 
@@ -43,8 +44,9 @@ std::string response_name(Response response, double gamma) {
 }
 
 // A whole file's bytes: a read-only memory map of a regular file (no copy: the page cache's pages
-// are the bytes), else (a pipe, a device, a file system that cannot map) the bytes read into
-// memory. DataError naming the file when it cannot be read. (As with any memory-mapped reader, a
+// are the bytes), else (a file system that cannot map) the bytes read into memory. DataError
+// naming the file when it cannot be read or is not a regular file (io/input_file.hpp: a device
+// or a FIFO is refused before it is opened). (As with any memory-mapped reader, a
 // file truncated by another process while it is being decoded ends the process with SIGBUS.)
 class FileBytes {
   public:
@@ -56,11 +58,16 @@ class FileBytes {
             throw DataError(concat("cannot read ", quote_input(path), ": no such file"));
         if (fs::is_directory(status))
             throw DataError(concat("cannot read ", quote_input(path), ": it is a directory"));
+        io::check_input_file(path, concat("cannot read ", quote_input(path)));
         const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
         if (fd < 0)
             throw DataError(concat("cannot read ", quote_input(path), ": ", std::strerror(errno)));
         struct stat info {};
-        if (::fstat(fd, &info) == 0 && S_ISREG(info.st_mode) && info.st_size > 0) {
+        if (::fstat(fd, &info) != 0 || !S_ISREG(info.st_mode)) {  // replaced since the check
+            ::close(fd);
+            throw DataError(concat("cannot read ", quote_input(path), ": not a regular file"));
+        }
+        if (info.st_size > 0) {
             void* map = ::mmap(nullptr, static_cast<std::size_t>(info.st_size), PROT_READ,
                                MAP_PRIVATE | MAP_POPULATE, fd, 0);
             if (map != MAP_FAILED) {

@@ -12,6 +12,7 @@
 #include "roughscope/core/errors.hpp"
 #include "roughscope/core/numbers.hpp"
 #include "roughscope/core/text.hpp"
+#include "roughscope/io/input_file.hpp"
 
 namespace roughscope::io {
 namespace {
@@ -58,6 +59,7 @@ LineReader::LineReader(const std::filesystem::path& path) : source_(path.string(
     std::error_code ec;
     if (std::filesystem::is_directory(path, ec))
         throw DataError(source_ + ": is a directory, not a file");
+    check_input_file(path, source_);
     auto file = std::make_unique<std::ifstream>(path, std::ios::binary);
     if (!*file) throw DataError(source_ + ": cannot open: " + std::strerror(errno));
     owned_ = std::move(file);

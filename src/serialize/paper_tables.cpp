@@ -15,6 +15,7 @@
 
 #include "roughscope/core/errors.hpp"
 #include "roughscope/estimation/estimation.hpp"
+#include "roughscope/io/input_file.hpp"
 #include "roughscope/scattering/geometry.hpp"
 #include "roughscope/scattering/validity.hpp"
 
@@ -232,6 +233,7 @@ Json read_paper_tables_reference(const std::filesystem::path& path) {
     if (!std::filesystem::exists(path, ec)) throw DataError(name + ": does not exist");
     if (std::filesystem::is_directory(path, ec))
         throw DataError(name + ": is a directory, not a file");
+    io::check_input_file(path, name);
     std::ifstream in(path, std::ios::binary);
     if (!in) throw DataError(name + ": cannot open: " + std::strerror(errno));
     std::string text{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};

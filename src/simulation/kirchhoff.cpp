@@ -16,6 +16,7 @@
 
 #include "phasor.hpp"
 #include "roughscope/core/errors.hpp"
+#include "roughscope/core/memory.hpp"
 #include "roughscope/core/names.hpp"
 #include "roughscope/core/numbers.hpp"
 #include "roughscope/core/text.hpp"
@@ -31,6 +32,11 @@ using cd = std::complex<double>;
 constexpr std::size_t kMinGridSide = 8;
 constexpr std::size_t kMaxGridSide = 4096;  // 2^24 points: 128 MB of heights
 constexpr std::size_t kMaxRealisations = 10'000'000;
+// Fewest realisations for a standard error worth the name: with 2 the samples d_r are equal (the
+// two fields are ±(ρ1 − ρ2)/2 from their mean) and the error is 0; the interval ±3 standard
+// errors covers the exact series in 94-95 % of runs from 10 realisations (docs/simulation.md,
+// "Realisations"), 67-78 % at 3.
+constexpr std::size_t kMinRealisations = 10;
 // The automatic spacing resolves the diffuse kernel until the nearest alias of its spectrum is
 // below kAliasTolerance of the value at v_xy (times ~9, the lattice sum Σ 1/|a|³ of all aliases
 // of an algebraic tail); the spacing never goes below 2π·T/kMaxKT. The automatic patch keeps the
@@ -108,6 +114,38 @@ double dirichlet(double u, std::size_t n, double d) {
         return 1.0;  // on a multiple of the lattice's period: every sample in phase
     }
     return std::sin(static_cast<double>(n) * h) / (static_cast<double>(n) * s);
+}
+
+// Whether the sampling frequency K = 2π/dx (as K·T) resolves the diffuse kernel at g and T·|v_xy|:
+// the nearest alias of its spectrum, at K − |v_xy|, times the lattice sum of all aliases, is
+// below kAliasTolerance of the spectrum at v_xy.
+bool kernel_resolved(Correlation c, double g, double wT, double KT) {
+    const double target = series_shape(c, g, wT * wT);
+    const double a = KT - wT;
+    return a > 0.0 && kAliasLatticeSum * series_shape(c, g, a * a) <= kAliasTolerance * target;
+}
+
+// InvalidArgument for a surface too rough for the finest automatic grid (K·T = kMaxKT): at large
+// g the Gaussian kernel's spectrum is about exp(−T²v²/(4g))/g, a width 2√g/T that the spacing
+// 2π·T/kMaxKT no longer samples (docs/simulation.md, "Choosing the grid"); the aliased Riemann sum
+// would be a confident wrong number. The message gives the largest g (and σ) resolved at this
+// geometry.
+[[noreturn]] void refuse_unresolved(const ScatterOptions& o, double g, const ScatteringVector& v,
+                                    double wT) {
+    double lo = std::log(std::min(g, 1e-6)), hi = std::log(g);  // resolved at lo, not at hi
+    for (int it = 0; it < 60; ++it) {
+        const double mid = 0.5 * (lo + hi);
+        (kernel_resolved(o.correlation, std::exp(mid), wT, kMaxKT) ? lo : hi) = mid;
+    }
+    const double g_max = std::exp(lo);
+    throw InvalidArgument(concat(
+        "sigma_um = ", format_message(o.sigma_um), " is too rough for the simulation at this ",
+        "geometry: g = ", format_message(g), " (sigma_um = ", format_message(o.sigma_um),
+        ", wavelength_um = ", format_message(o.wavelength_um), ") needs a grid spacing below T/",
+        format_message(kMaxKT / (2.0 * kPi)), " to sample the diffuse kernel (",
+        to_string(o.correlation), " correlation) without aliasing; valid: g up to ",
+        format_message(g_max), " here, sigma_um up to about ",
+        format_message(std::sqrt(g_max) / std::abs(v.vz)), " um (or give dx_um and nx)"));
 }
 
 // What one geometry needs: the directions evaluated per realisation and the constants.
@@ -378,10 +416,11 @@ void check_scatter_options(const ScatterOptions& o) {
             concat("simulation option patch_over_T = ", format_message(o.patch_over_T),
                    " is out of range: it must be 0 (chosen) or in [1, 1e4]"));
     }
-    if (o.realisations < 2 || o.realisations > kMaxRealisations) {
+    if (o.realisations < kMinRealisations || o.realisations > kMaxRealisations) {
         throw InvalidArgument(
             concat("simulation option realisations = ", std::to_string(o.realisations),
-                   " is out of range: it must be an integer in [2, 1e7]"));
+                   " is out of range: it must be an integer in [10, 1e7] (fewer give no "
+                   "usable standard error: docs/simulation.md, \"Realisations\")"));
     }
     if (o.n != 0 && o.dx_um != 0.0 && !(o.T_um <= static_cast<double>(o.n) * o.dx_um)) {
         throw InvalidArgument(concat(
@@ -398,20 +437,18 @@ ScatterGrid choose_scatter_grid(const Geometry& geom, const ScatterOptions& o) {
     const double T = o.T_um;
     const double g = roughness_g(o.sigma_um, v.vz);
     ScatterGrid grid;
+    bool unresolved = false;
     if (o.dx_um != 0.0) {
         grid.dx_um = o.dx_um;
     } else {
         // Smallest sampling frequency K = 2π/dx (in steps of 10 %) at which the nearest alias
         // of the kernel's spectrum, at K − |v_xy|, is below kAliasTolerance of its value at v_xy.
-        const double target = series_shape(o.correlation, g, T * T * v.vxy2());
         double KT = std::max(2.5 * w * T, 4.0);
-        while (KT < kMaxKT) {
-            const double a = KT - w * T;
-            const double alias = series_shape(o.correlation, g, a * a);
-            if (kAliasLatticeSum * alias <= kAliasTolerance * target) break;
-            KT *= 1.1;
-        }
+        while (KT < kMaxKT && !kernel_resolved(o.correlation, g, w * T, KT)) KT *= 1.1;
         KT = std::min(KT, kMaxKT);
+        // (At w·T ≥ K·T/2 the direction itself is beyond the grid's Nyquist frequency, which
+        // make_plan reports.) Refused below, after a patch too large for the grid is.
+        unresolved = 2.0 * w * T < KT && !kernel_resolved(o.correlation, g, w * T, KT);
         grid.dx_um = 2.0 * kPi * T / KT;
     }
     if (o.n != 0) {
@@ -435,6 +472,7 @@ ScatterGrid choose_scatter_grid(const Geometry& geom, const ScatterOptions& o) {
         grid.n = surface::fft::good_size(std::max(kMinGridSide, static_cast<std::size_t>(want)));
         grid.n = std::min(grid.n, kMaxGridSide);
     }
+    if (unresolved) refuse_unresolved(o, g, v, w * T);
     if (!(T <= static_cast<double>(grid.n) * grid.dx_um)) {
         throw InvalidArgument(concat(
             "simulation patch nx*dx_um = ", std::to_string(grid.n), " x ",
@@ -449,6 +487,42 @@ ScatterGrid choose_scatter_grid(const Geometry& geom, const ScatterOptions& o) {
     return grid;
 }
 
+ScatterMemory scatter_memory(const std::vector<ScatterPlanSummary>& plans,
+                             const ScatterOptions& o) {
+    ScatterMemory m;
+    for (const ScatterPlanSummary& p : plans) {
+        const double gn = static_cast<double>(p.generated_n);
+        const double half = std::floor(gn / 2.0) + 1.0;
+        const double directions =
+            p.layout == PatchLayout::LatticeAligned && p.lattice_index != 0 ? 4.0 : 1.0;
+        // The generator's filter (surface/generate.cpp: the half spectrum's rows ky >= 0) and
+        // the fields of every realisation (16 bytes a direction).
+        m.fixed_bytes +=
+            8.0 * half * half + 16.0 * static_cast<double>(o.realisations) * directions;
+        // A surface in its in-place FFT buffer (ny rows of 2·(nx/2 + 1) doubles), per worker.
+        m.per_thread_bytes = std::max(m.per_thread_bytes, 8.0 * gn * 2.0 * half);
+    }
+    return m;
+}
+
+namespace {
+
+// The worker threads of a run: the option's (0 = the hardware's), at most the hardware's and the
+// number of realisations, and at most what the memory budget holds (at least one).
+unsigned scatter_threads(const ScatterOptions& o, const ScatterMemory& memory, std::size_t jobs) {
+    const unsigned hardware = std::max(1U, std::thread::hardware_concurrency());
+    std::size_t threads = o.threads != 0 ? std::min(o.threads, hardware) : hardware;
+    threads = std::min(threads, std::max<std::size_t>(jobs, 1));
+    const double room = memory_budget().bytes - memory.fixed_bytes;
+    if (memory.per_thread_bytes > 0.0) {
+        const double fit = std::floor(room / memory.per_thread_bytes);
+        threads = std::min(threads, static_cast<std::size_t>(std::max(1.0, std::min(fit, 1e6))));
+    }
+    return static_cast<unsigned>(threads);
+}
+
+}  // namespace
+
 std::vector<ScatterPlanSummary> check_scattering_run(const std::vector<Geometry>& geometries,
                                                      const ScatterOptions& o) {
     check_scatter_options(o);
@@ -458,13 +532,25 @@ std::vector<ScatterPlanSummary> check_scattering_run(const std::vector<Geometry>
         const Plan p = make_plan(geom, o);
         out.push_back({p.n, p.dx_um, p.generated_n, p.layout, p.m});
     }
+    const ScatterMemory memory = scatter_memory(out, o);
+    std::size_t largest = 0;
+    for (const ScatterPlanSummary& p : out) largest = std::max(largest, p.generated_n);
+    check_memory(
+        memory.fixed_bytes + memory.per_thread_bytes,
+        concat("the simulation (nx up to ", std::to_string(largest), ": a generated surface of ",
+               std::to_string(largest), " x ", std::to_string(largest), " points, ",
+               format_gigabytes(memory.per_thread_bytes), " a worker thread; ",
+               std::to_string(o.realisations), " realisations at ",
+               std::to_string(geometries.size()), " geometries)"),
+        "give a smaller nx (or patch_over_T, or a larger dx_um), fewer realisations or "
+        "fewer geometries");
     return out;
 }
 
 std::vector<ScatterResult> simulate_scattering(const std::vector<Geometry>& geometries,
                                                const ScatterOptions& o,
                                                const ProgressCallback& progress) {
-    check_scatter_options(o);
+    const ScatterMemory memory = scatter_memory(check_scattering_run(geometries, o), o);
     std::vector<Plan> plans;
     plans.reserve(geometries.size());
     for (const Geometry& geom : geometries) plans.push_back(make_plan(geom, o));
@@ -510,9 +596,7 @@ std::vector<ScatterResult> simulate_scattering(const std::vector<Geometry>& geom
             if (!failure) failure = std::current_exception();
         }
     };
-    unsigned threads =
-        o.threads != 0 ? o.threads : std::max(1U, std::thread::hardware_concurrency());
-    threads = static_cast<unsigned>(std::min<std::size_t>(threads, total));
+    const unsigned threads = scatter_threads(o, memory, total);
     std::vector<std::thread> pool;
     for (unsigned t = 1; t < threads; ++t) pool.emplace_back(work, false);
     work(true);

@@ -14,6 +14,7 @@
 #include "roughscope/core/memory.hpp"
 #include "roughscope/core/names.hpp"
 #include "roughscope/core/text.hpp"
+#include "roughscope/io/input_file.hpp"
 #include "roughscope/io/output_file.hpp"
 
 namespace roughscope::surface {
@@ -86,6 +87,7 @@ std::string read_whole_file(const std::filesystem::path& path) {
     if (std::filesystem::is_directory(status)) {
         throw DataError("cannot read " + quote_input(path.string()) + ": it is a directory");
     }
+    io::check_input_file(path, "cannot read " + quote_input(path.string()));
     std::ifstream in(path, std::ios::binary);
     if (!in) {
         std::string message = "cannot read " + quote_input(path.string());
@@ -184,6 +186,41 @@ HeightMap read_height_map(const std::filesystem::path& path, const HeightReadOpt
     const HeightFormat format = format_for(path, options.format);
     const std::string bytes = read_whole_file(path);
     return decode_height_map(bytes, path.string(), format, options);
+}
+
+double encoded_size_estimate(std::size_t points, HeightFormat format,
+                             const HeightWriteOptions& options) {
+    // Bytes a point: the encoders' own reservations (text: up to 20 characters a number), one
+    // copy of the samples for the binary formats that convert them first.
+    double per_point = 8.0;
+    switch (format) {
+        case HeightFormat::CsvMatrix:
+            per_point = 20.0;
+            break;
+        case HeightFormat::Xyz:
+            per_point = 40.0;
+            break;
+        case HeightFormat::Sdf:
+            per_point = options.sdf_binary ? 8.0 : 20.0;
+            break;
+        case HeightFormat::X3p:
+            per_point = 24.0;  // the samples, the point data's copy and the zip archive
+            break;
+        case HeightFormat::Png:
+            per_point = 4.0;
+            break;
+        case HeightFormat::Tiff:
+            per_point = 8.0;
+            break;
+        case HeightFormat::Raw:
+            per_point = options.raw_type == RawSampleType::Float32 ? 4.0 : 8.0;
+            break;
+        case HeightFormat::Gwy:
+        case HeightFormat::Gsf:
+            per_point = 8.0;
+            break;
+    }
+    return per_point * static_cast<double>(points);
 }
 
 void write_height_map(const HeightMap& map, const std::filesystem::path& path,

@@ -20,6 +20,7 @@
 #include "roughscope/core/errors.hpp"
 #include "roughscope/core/memory.hpp"
 #include "roughscope/core/numbers.hpp"
+#include "roughscope/core/text.hpp"
 
 namespace roughscope::surface {
 
@@ -83,6 +84,10 @@ void check_grid_options(const GenerationOptions& o) {
         throw InvalidArgument(
             size_message("ny", o.ny, "it must be >= 1 (1 = a profile) with nx·ny <= 2^28 points"));
     }
+    check_memory(generation_memory_bytes(o),
+                 concat("a generated surface of nx x ny = ", std::to_string(o.nx), " x ",
+                        std::to_string(o.ny), " points"),
+                 "give a smaller nx or ny");
 }
 
 void check_options(const GenerationOptions& o) {
@@ -304,6 +309,13 @@ HeightMap titled(HeightMap map, const GenerationOptions& o) {
 }
 
 }  // namespace
+
+double generation_memory_bytes(const GenerationOptions& o) {
+    // The in-place FFT buffer that becomes the map (ny rows of 2·(nx/2 + 1) doubles) and the
+    // filter's half spectrum (gain_rows(ny) rows of nx/2 + 1).
+    const double cols = static_cast<double>(o.nx / 2 + 1);
+    return 8.0 * cols * (2.0 * static_cast<double>(o.ny) + static_cast<double>(gain_rows(o.ny)));
+}
 
 SurfaceGenerator::SurfaceGenerator(const GenerationOptions& options) : options_(options) {
     check_options(options);

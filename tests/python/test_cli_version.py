@@ -68,7 +68,7 @@ def _documents(tmp_path):
         ["estimate", "fit", "--measurements", _measurements(tmp_path)],
         ["surface", "stats", surface],
         ["simulate", "scatter", "--sigma-um", "0.04", "--T-um", "1", "--wavelength-um", "0.5",
-         "--theta-i", "20", "--theta-s", "20", "--phi-s", "0", "--realisations", "2"],
+         "--theta-i", "20", "--theta-s", "20", "--phi-s", "0", "--realisations", "10"],
         ["measure", EXAMPLES / "capture-file.json"],
     ]
     for args in commands:

@@ -239,9 +239,9 @@ def test_simulate_scatter_flags_at_the_extremes(tmp_path):
     # A small fixed grid keeps every accepted extreme fast (the grid is what costs).
     runs = sweep(["simulate", "scatter"], [
         ["--sigma-um", "0.05", "--T-um", "1", "--theta-i", "30", "--theta-s", "10", "--phi-s",
-         "45", "--nx", "16", "--realisations", "3", "--json"],
+         "45", "--nx", "16", "--realisations", "10", "--json"],
         ["--sigma-um", "0.05", "--T-um", "1", "--correlation", "exponential", "--theta-i", "20",
          "--theta-s", "20", "--phi-s", "0", "--nx", "16", "--dx-um", "0.2", "--realisations",
-         "3", "--layout", "fixed"],
+         "10", "--layout", "fixed"],
     ])
     assert runs >= 20  # 2 bases x 11 numeric flags

@@ -138,9 +138,9 @@ def test_python_failures_raise_the_library_errors():
 
 def test_python_progress_reports_and_can_stop_the_run():
     seen = []
-    rs.simulate_scatter(30, 0, 0, sigma_um=0.04, T_um=1, realisations=6,
+    rs.simulate_scatter(30, 0, 0, sigma_um=0.04, T_um=1, realisations=10,
                         progress=lambda done, total: seen.append((done, total)))
-    assert seen[-1] == (6, 6) and all(t == 6 for _, t in seen)
+    assert seen[-1] == (10, 10) and all(t == 10 for _, t in seen)
 
     class Stop(Exception):
         pass
@@ -180,7 +180,7 @@ print(p.returncode, resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss)
 def test_a_1024_squared_ensemble_stays_below_200_mb():
     p = subprocess.run([sys.executable, "-c", MEASURE, cli_path(), *BASE, "--theta-i", "30",
                         "--theta-s", "0", "--phi-s", "0", "--nx", "1024", "--dx-um", "0.05",
-                        "--realisations", "4", "--threads", "2"],
+                        "--realisations", "10", "--threads", "2"],
                        capture_output=True, text=True, timeout=300)
     assert p.returncode == 0, p.stderr
     code, peak_kb = (int(v) for v in p.stdout.split())

@@ -22,11 +22,11 @@ import pytest
 import roughscope as rs
 from roughscope import sweep
 
-# Small and fast: 2 correlations x 2 sigma x 3 geometries = 12 points of 4 realisations on
+# Small and fast: 2 correlations x 2 sigma x 3 geometries = 12 points of 10 realisations on
 # patches of 2 T (n = 8 .. 40).
 GRID = dict(sigma_um=[0.05, 0.1], T_um=1.0, wavelength_um=0.5,
             correlation=["gaussian", "exponential"],
-            geometries=[(30, 0, 0), (45, 20, 90), (10, 10, 0)], realisations=4, patch_over_T=2,
+            geometries=[(30, 0, 0), (45, 20, 90), (10, 10, 0)], realisations=10, patch_over_T=2,
             seed=7)
 
 
@@ -209,7 +209,7 @@ def test_the_refusal_is_simulate_scatters_own(points):
 
 
 def test_check_simulate_scatter_accepts_what_runs_and_refuses_what_does_not():
-    good = dict(sigma_um=0.05, T_um=1.0, wavelength_um=0.5, realisations=2)
+    good = dict(sigma_um=0.05, T_um=1.0, wavelength_um=0.5, realisations=10)
     plans = rs.check_simulate_scatter([30, 45, 10], [0, 0, 10], [0, 0, 0], **good)
     fixed = rs.check_simulate_scatter(30, 0, 0, layout="fixed", **good)
     # The grid announced is the grid the run reports.
@@ -295,7 +295,7 @@ def test_ctrl_c_cancels_the_pending_dask_tasks(cluster):
 # --- simulate_scatter options the sweeps rely on -----------------------------------------------
 
 def test_simulate_scatter_takes_seeds_over_the_whole_64_bit_range():
-    small = dict(sigma_um=0.05, T_um=1.0, wavelength_um=0.5, realisations=2, n=16)
+    small = dict(sigma_um=0.05, T_um=1.0, wavelength_um=0.5, realisations=10, n=16)
     diffuse = {}
     for seed in (2**63 - 1, 2**63, 2**64 - 1):
         doc = rs.simulate_scatter(30, 0, 0, seed=seed, **small)
@@ -312,7 +312,7 @@ def test_simulate_scatter_takes_seeds_over_the_whole_64_bit_range():
 @pytest.mark.parametrize("key,value", [("realisations", 4.0), ("seed", 1.5), ("threads", True),
                                        ("n", 16.0), ("sigma_um", "0.05"), ("sigma_um", None)])
 def test_simulate_scatter_option_types(key, value):
-    options = dict(sigma_um=0.05, T_um=1.0, wavelength_um=0.5, realisations=2)
+    options = dict(sigma_um=0.05, T_um=1.0, wavelength_um=0.5, realisations=10)
     options[key] = value
     for f in (rs.simulate_scatter, rs.check_simulate_scatter):
         with pytest.raises(TypeError, match=key):

@@ -8,11 +8,34 @@
 #include <cstddef>
 #include <memory>
 #include <new>
+#include <string>
+#include <string_view>
 #include <type_traits>
 #include <utility>
 #include <vector>
 
 namespace roughscope {
+
+// ---- The memory budget (docs/cli.md, "Memory limit") ----------------------------------------
+// Options that set a size (a grid's side, a number of threads, bins, realisations) are checked
+// against the memory they imply before anything is allocated, so that a typing slip is a named
+// error instead of a machine brought down by swapping or a bad_alloc from deep inside.
+
+// The memory one computation may ask for: ROUGHSCOPE_MEMORY_LIMIT_GB when it is set (a number
+// > 0; GB = 1e9 bytes), else half the physical memory (of the cgroup's memory.max when that is
+// lower). InvalidArgument naming the variable for a value that is not a number > 0.
+struct MemoryBudget {
+    double bytes = 0.0;
+    std::string source;  // "ROUGHSCOPE_MEMORY_LIMIT_GB" or "half the physical memory"
+};
+MemoryBudget memory_budget();
+
+// `bytes` as "N GB" with two significant digits at least (0.0034 GB, 1.5 GB, 150 GB).
+std::string format_gigabytes(double bytes);
+
+// Throws InvalidArgument "<what> needs about N GB of memory, above the limit of M GB (<source>;
+// ROUGHSCOPE_MEMORY_LIMIT_GB sets it); <valid>" when `bytes` exceed memory_budget().
+void check_memory(double bytes, std::string_view what, std::string_view valid);
 
 // Buffers smaller than this are left alone (a few huge pages at most).
 inline constexpr std::size_t kHugePageHintBytes = std::size_t{8} << 20;

@@ -91,11 +91,12 @@ struct ScatterOptions {
     // for exponential max(8, ln(4·max(g, 1)/0.003)), where the periodic surface's images change
     // the kernel e^{−g(1−C)} by less than 0.3 %. Otherwise in [1, 1e4].
     double patch_over_T = 0.0;
-    std::size_t realisations = 100;  // ≥ 2
+    std::size_t realisations = 100;  // ≥ 10 (a standard error needs them; docs/simulation.md)
     std::uint64_t seed = 1;
     PatchLayout layout = PatchLayout::LatticeAligned;
-    // Worker threads (0 = the hardware's). Results do not depend on it: realisation r of
-    // geometry k always uses the surface of seed (seed, k, r) and sums run in a fixed order.
+    // Worker threads (0 = the hardware's); at most the hardware's and what the memory budget
+    // holds (scatter_memory) are run. Results do not depend on it: realisation r of geometry k
+    // always uses the surface of seed (seed, k, r) and sums run in a fixed order.
     unsigned threads = 0;
 };
 
@@ -132,7 +133,7 @@ using ProgressCallback = std::function<void(std::size_t done, std::size_t total)
 
 // Validates the options (InvalidArgument naming the option and its valid range): σ, T, λ in the
 // library's length range; n = 0 or 8 ≤ n ≤ 4096; dx = 0 or in the length range with T ≤ n·dx;
-// patch_over_T = 0 or in [1, 1e4]; realisations in [2, 1e7].
+// patch_over_T = 0 or in [1, 1e4]; realisations in [10, 1e7].
 void check_scatter_options(const ScatterOptions& options);
 
 // The grid (n, dx) simulate_scattering uses at `geom` (before lattice alignment).
@@ -155,11 +156,25 @@ struct ScatterPlanSummary {
 
 // Everything simulate_scattering validates before the first realisation, without generating a
 // surface: the options (check_scatter_options), each geometry (check::geometry) and the grid
-// chosen or given there (n ≤ 4096, dx below the Nyquist limit π/|v_xy|, n·dx ≥ T). Throws the
-// same InvalidArgument simulate_scattering would; a run that passes it fails only on memory or
-// interruption. Returns the grid of each geometry. Cheap (no surface, no FFT).
+// chosen or given there (n ≤ 4096, dx below the Nyquist limit π/|v_xy|, n·dx ≥ T) and the memory
+// of the run with one worker thread (scatter_memory). Throws the same InvalidArgument
+// simulate_scattering would; a run that passes it fails only on interruption. Returns the grid of
+// each geometry. Cheap (no surface, no FFT).
 std::vector<ScatterPlanSummary> check_scattering_run(const std::vector<Geometry>& geometries,
                                                      const ScatterOptions& options);
+
+// The memory a run of simulate_scattering needs (docs/simulation.md, "Memory and threads"):
+// fixed_bytes whatever the threads (each geometry's filter and the fields of its realisations)
+// and per_thread_bytes for each worker thread (the surface it generates, in its FFT buffer).
+// check_scattering_run refuses a run whose fixed part and one thread exceed the memory budget
+// (core/memory.hpp); simulate_scattering runs at most as many threads as the hardware has and
+// the budget holds.
+struct ScatterMemory {
+    double fixed_bytes = 0.0;
+    double per_thread_bytes = 0.0;
+};
+ScatterMemory scatter_memory(const std::vector<ScatterPlanSummary>& plans,
+                             const ScatterOptions& options);
 
 // The ensemble at each geometry (validated as by check::geometry).
 std::vector<ScatterResult> simulate_scattering(const std::vector<Geometry>& geometries,

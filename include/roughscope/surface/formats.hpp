@@ -77,6 +77,11 @@ void write_height_map(const HeightMap& map, const std::filesystem::path& path,
                       const HeightWriteOptions& options = {});
 
 // Per-format decoders and encoders (bytes in, value out; `name` only for messages).
+// About how many bytes write_height_map holds in memory to write `points` heights in `format`
+// (the encoded file is made in memory, then written): for memory checks (core/memory.hpp).
+double encoded_size_estimate(std::size_t points, HeightFormat format,
+                             const HeightWriteOptions& options = {});
+
 HeightMap decode_height_map(std::string_view bytes, const std::string& name, HeightFormat format,
                             const HeightReadOptions& options = {});
 // Throws InvalidArgument for a format that cannot be written (gwy) or a map it cannot hold.

@@ -27,8 +27,13 @@ struct GenerationOptions {
     std::uint64_t seed = 1;
 };
 
-// InvalidArgument naming the option and its range for anything out of range.
+// InvalidArgument naming the option and its range for anything out of range, and for a grid
+// whose memory (generation_memory_bytes) is above the memory budget (core/memory.hpp).
 HeightMap generate_surface(const GenerationOptions& options);
+
+// The memory one surface of the options' grid takes while it is made, in bytes (about 10 bytes a
+// point: the map in its FFT buffer and the filter).
+double generation_memory_bytes(const GenerationOptions& options);
 
 // Many surfaces of the same statistics: the filter (the periodised ACF's spectrum, the costly part
 // for exponential correlation) is computed once; generate(seed) then draws one surface, equal bit

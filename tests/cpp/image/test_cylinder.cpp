@@ -10,6 +10,7 @@
 #include <vector>
 
 #include <gtest/gtest.h>
+#include <stdlib.h>
 
 #include "object_captures.hpp"
 #include "roughscope/core/errors.hpp"
@@ -263,6 +264,31 @@ TEST(CylinderProfile, DetectedAxisOnADarkLimbWarns) {
     CylinderOptions given;
     given.axis = true_axis();
     EXPECT_FALSE(warned(measure_cylinder_profile(img, nullptr, given)));
+}
+
+TEST(CylinderProfile, BinsBeyondTheMemoryLimitAreRefusedBeforeAllocating) {
+    // 1e-6 degree bins on a 160-pixel image: 9e7 bins of the normal angle, each with its sums
+    // and its slices along the axis — about 180 GB of accumulators. Refused with the estimate
+    // (core/memory.hpp) instead of a bad_alloc from deep inside; 0.5 degree bins are measured.
+    ::setenv("ROUGHSCOPE_MEMORY_LIMIT_GB", "1", 1);
+    sim::SurfaceTruth lambert;
+    lambert.model = sim::BrightnessModel::Lambert;
+    const LinearImage img = noisy_capture(cylinder_scene(Eigen::Vector3d(0, 0, 1)), lambert, 12, 2);
+    CylinderOptions o;
+    o.axis = true_axis();
+    o.bin_width_deg = 1e-6;
+    std::string message = "no error";
+    try {
+        (void)measure_cylinder_profile(img, nullptr, o);
+    } catch (const InvalidArgument& e) {
+        message = e.what();
+    }
+    o.bin_width_deg = 0.5;
+    EXPECT_NO_THROW((void)measure_cylinder_profile(img, nullptr, o));
+    ::unsetenv("ROUGHSCOPE_MEMORY_LIMIT_GB");
+    EXPECT_NE(message.find("cylinder bin_width_deg = 1e-06 ("), std::string::npos) << message;
+    EXPECT_NE(message.find("GB of memory, above the limit of 1 GB"), std::string::npos) << message;
+    EXPECT_NE(message.find("give a wider bin_width_deg"), std::string::npos) << message;
 }
 
 TEST(CylinderProfile, BadInputIsAnError) {

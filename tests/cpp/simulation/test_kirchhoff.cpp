@@ -267,7 +267,7 @@ TEST(KirchhoffEnsemble, SameSeedSameNumbersWhateverTheThreads) {
 TEST(KirchhoffEnsemble, LatticeAlignedPutsTheDirectionOnTheLattice) {
     const Case c{Correlation::Gaussian, 40.0, 25.0, 70.0, 0.05};
     const Geometry geom = make_geometry(deg_to_rad(40.0), deg_to_rad(25.0), deg_to_rad(70.0));
-    const ScatterResult r = simulate_scattering(geom, options_for(c, 4));
+    const ScatterResult r = simulate_scattering(geom, options_for(c, 10));
     ASSERT_GT(r.lattice_index, 0);
     const double w = std::sqrt(scattering_vector(geom, 0.5).vxy2());
     EXPECT_NEAR(
@@ -347,7 +347,7 @@ TEST(KirchhoffEnsemble, CheckScatteringRunRaisesWhatTheRunRaisesWithoutRunning) 
     }
     // A bad geometry (θi beyond 90°) is refused as check::geometry does.
     ScatterOptions good;
-    good.realisations = 2;
+    good.realisations = 10;
     Geometry beyond = normal;
     beyond.theta_i_rad = deg_to_rad(95.0);
     const std::string checked = message([&] { check_scattering_run({normal, beyond}, good); });
