@@ -66,10 +66,10 @@ ReadOptions code_scale() {
 
 Loader::Loader(const MeasureRequest& request) : request_(request) {
     if (!request.response_bracket.empty()) {
-        const auto [images, times] =
-            read_bracket(request, request.response_bracket, "response.bracket");
+        // (Not a structured binding: clang before 16 cannot capture one in a lambda.)
+        const auto bracket = read_bracket(request, request.response_bracket, "response.bracket");
         curve_ = keyed(request, "response.bracket",
-                       [&] { return recover_response_debevec(images, times); });
+                       [&] { return recover_response_debevec(bracket.first, bracket.second); });
     }
 }
 
@@ -89,12 +89,13 @@ LinearImage Loader::capture(const CaptureSpec& spec, std::size_t k) const {
     const std::string key = concat("captures[", std::to_string(k), "]");
     if (spec.bracket.empty()) return image(spec.image, concat(key, ".image"));
     const std::string bracket_key = concat(key, ".bracket");
-    const auto [images, times] = read_bracket(request_, spec.bracket, bracket_key);
+    const auto bracket = read_bracket(request_, spec.bracket, bracket_key);
     const ResponseCurve curve = curve_ ? *curve_ : keyed(request_, "response", [&] {
         return response_curve_of(request_.read.response.value_or(Response::Srgb),
-                                 request_.read.gamma, images.front().channels);
+                                 request_.read.gamma, bracket.first.front().channels);
     });
-    return keyed(request_, bracket_key, [&] { return merge_hdr(images, times, curve); });
+    return keyed(request_, bracket_key,
+                 [&] { return merge_hdr(bracket.first, bracket.second, curve); });
 }
 
 void check_same_size_pixels(const LinearImage& image, const LinearImage& first,
