@@ -408,8 +408,8 @@ std::array<double, 3> parse_capture_geometry(const Context& ctx, const Json& c,
         for (const auto& [name, v] : {std::pair{"light", L}, std::pair{"view", V}})
             if (!(v.z() > kGrazingCos))
                 ctx.fail(concat(key, ".", name),
-                         "is at or below the sample's plane (z ≤ 0, or grazing); the normal of "
-                         "the sample is +z");
+                         "points at or below the sample's plane (z ≤ 0, or grazing); the "
+                         "normal of the sample is +z");
         const auto g = geometry_from_vectors(Eigen::Vector3d::UnitZ(), L, V);
         if (!g)
             ctx.fail(key,
