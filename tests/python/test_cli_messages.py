@@ -155,3 +155,8 @@ def test_control_characters_of_a_file_name_are_escaped_in_text_output(tmp_path):
                tmp_path / "out\x1b]0;x\x07")
     assert proc.returncode == 0 and b"\x1b" not in proc.stdout, proc.stdout
     assert b"out\\x1b]0;x\\x07" in proc.stdout
+    heights = tmp_path / "h\x1b[31m.x3p"
+    assert run("surface", "generate", "--sigma-um", "1", "--T-um", "5", "--nx", "32", "--out",
+               heights).returncode == 0
+    out = run("surface", "stats", heights).stdout
+    assert b"\x1b" not in out and b"h\\x1b[31m.x3p (x3p): " in out, out
