@@ -2,6 +2,7 @@
 #include "common.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <exception>
@@ -33,6 +34,59 @@ std::string one_line(std::string_view message) {
 
 // Shortest form of a limit for messages ("90", "0.5").
 std::string fmt_limit(double value) { return roughscope::format_message(value, 15); }
+
+// The long names ("--theta-i") of every option of `app` and its subcommands that takes a
+// comma-separated list.
+void collect_list_flags(const CLI::App& app, std::vector<std::string>& flags) {
+    for (const CLI::Option* option : app.get_options())
+        if (option->get_delimiter() != '\0')
+            for (const std::string& name : option->get_lnames()) flags.push_back("--" + name);
+    for (const CLI::App* sub : app.get_subcommands([](const CLI::App*) { return true; }))
+        collect_list_flags(*sub, flags);
+}
+
+// CLI11 drops the empty elements of a delimited list ("30,,40" reads as 30, 40, a trailing comma
+// is ignored): a list with an empty element is refused before parsing, naming the flag. Every
+// argument after a list flag up to the next flag is one of its values ("--flag=a,b" too).
+void refuse_empty_list_elements(const CLI::App& app, int argc, char** argv) {
+    std::vector<std::string> flags;
+    collect_list_flags(app, flags);
+    std::string current;  // the list flag whose values follow, or empty
+    for (int i = 1; i < argc; ++i) {
+        const std::string_view arg = argv[i];
+        std::string_view value;
+        bool has_value = false;
+        if (arg == "--") break;
+        if (arg.size() > 2 && arg.substr(0, 2) == "--") {
+            const std::size_t eq = arg.find('=');
+            const std::string name(arg.substr(0, eq));
+            current = std::find(flags.begin(), flags.end(), name) != flags.end() ? name : "";
+            if (eq != std::string_view::npos && !current.empty()) {
+                value = arg.substr(eq + 1);
+                has_value = true;
+            }
+        } else if (arg.size() > 1 && arg[0] == '-' &&
+                   std::isdigit(static_cast<unsigned char>(arg[1])) == 0 && arg[1] != '.') {
+            current.clear();  // a short flag
+        } else if (!current.empty()) {
+            value = arg;
+            has_value = true;
+        }
+        if (!has_value || value.find(',') == std::string_view::npos) continue;
+        std::size_t start = 0;
+        for (;;) {
+            const std::size_t comma = value.find(',', start);
+            const std::string_view element = value.substr(
+                start, comma == std::string_view::npos ? std::string_view::npos : comma - start);
+            if (trim(element).empty())
+                throw UsageError(concat(current, ": ", roughscope::quote_input(value),
+                                        " has an empty element; give a value between every two "
+                                        "commas (e.g. 30,35,40)"));
+            if (comma == std::string_view::npos) break;
+            start = comma + 1;
+        }
+    }
+}
 
 }  // namespace
 
@@ -95,6 +149,7 @@ int run_app(CLI::App& app, int argc, char** argv) {
                                  "' (available: " + join(names, ", ") + "; see --help)");
             }
         }
+        refuse_empty_list_elements(app, argc, argv);
         try {
             app.parse(argc, argv);
         } catch (const CLI::Success& e) {  // --help, --help-all, --version

@@ -59,7 +59,7 @@ std::string text_report(const serialize::Json& doc) {
     if (doc["region"].contains("description"))
         items.emplace_back(
             "region",
-            concat(doc["region"]["description"].get<std::string>(), " (",
+            concat(printable_text(doc["region"]["description"].get<std::string>()), " (",
                    std::to_string(doc["region"]["pixels"].get<std::size_t>()), " pixels)"));
     items.emplace_back("E1/E2", value_with_error(doc, "E1_over_E2"));
     items.emplace_back("sigma/T (Gaussian)", value_with_error(doc, "sigma_over_T_gaussian"));
@@ -102,12 +102,14 @@ std::string text_report(const serialize::Json& doc) {
                                concat(format_fixed(100.0 * c["fraction"].get<double>(), 1), " %"));
         for (const auto& r : map["regions"])
             items.emplace_back(
-                concat("region ", r["name"].get<std::string>()),
+                concat("region ", printable_text(r["name"].get<std::string>())),
                 concat("sigma/T (G) ", value_with_error(r, "sigma_over_T_gaussian")));
     }
     std::ostringstream out;
     print_key_values(out, items);
-    for (const auto& w : doc["warnings"]) out << "warning: " << w.get<std::string>() << '\n';
+    // Names and paths from the capture file: control characters escaped (core/text.hpp).
+    for (const auto& w : doc["warnings"])
+        out << "warning: " << printable_text(w.get<std::string>()) << '\n';
     return out.str();
 }
 

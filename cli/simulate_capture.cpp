@@ -73,9 +73,13 @@ void run_capture(CaptureCommand& c) {
         for (std::size_t i = 0; i < record.labels.size(); ++i)
             record.labels[i] = static_cast<std::int32_t>((i % c.scene.width) * n / c.scene.width);
     }
+    if (c.out_dir.empty())
+        throw UsageError(
+            "--out: an empty path; give the directory to write capture.<ext> and "
+            "capture.json into (created if missing)");
     const fs::path dir(c.out_dir);
     if (fs::exists(dir) && !fs::is_directory(dir))
-        throw DataError(concat("--out ", c.out_dir, " exists and is not a directory"));
+        throw DataError(concat("--out ", quote_input(c.out_dir), " exists and is not a directory"));
     const simulation::Capture capture = simulation::render_capture(
         record.scene, record.truths, record.labels, record.camera,
         simulation::capture_options_for_file(c.format, !record.labels.empty()));
@@ -83,9 +87,10 @@ void run_capture(CaptureCommand& c) {
     fs::create_directories(dir);
     const serialize::CaptureFiles files =
         serialize::write_capture_files(capture, record, c.format, dir);
-    std::cout << "wrote " << files.image.string() << " and " << files.sidecar.string() << " ("
-              << capture.object_count << " object pixels, " << capture.saturated_count
-              << " saturated)\n";
+    // The paths come from the command line: control characters are escaped (core/text.hpp).
+    std::cout << "wrote " << printable_text(files.image.string()) << " and "
+              << printable_text(files.sidecar.string()) << " (" << capture.object_count
+              << " object pixels, " << capture.saturated_count << " saturated)\n";
 }
 
 }  // namespace

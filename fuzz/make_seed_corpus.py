@@ -148,6 +148,7 @@ write("capture_file", "circle_gamma.json", CAPTURE.replace('{"rect": [8, 8, 48, 
 write("capture_file", "unknown_key.json", CAPTURE.replace('"correlation"', '"colour": 1, "correlation"'))
 write("capture_file", "angle_out_of_range.json", CAPTURE.replace('"theta_i_deg": 30', '"theta_i_deg": 95'))
 write("capture_file", "truncated.json", CAPTURE[:150])
+write("capture_file", "exposures_equal.json", CAPTURE.replace('"correlation"', '"exposures_equal": true, "correlation"').replace('"exposure_s": 0.01', '"exposure_s": 0.02'))
 # Curved objects and maps (docs/measure.md "Curved objects and maps").
 write("capture_file", "cylinder.json", """{
   "object": {"shape": "cylinder", "axis": {"point_px": [40, 30], "direction": [0, 1], "radius_px": 20},

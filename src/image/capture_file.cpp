@@ -1,6 +1,7 @@
 // The capture file of `roughscope measure` (measure.hpp, docs/measure.md): JSON to a
 // MeasureRequest. Every key is checked: an unknown key, a wrong type or a value out of range is a
 // DataError naming the file and the key.
+#include <array>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -10,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "roughscope/core/errors.hpp"
+#include "roughscope/core/numbers.hpp"
 #include "roughscope/core/text.hpp"
 #include "roughscope/image/measure.hpp"
 #include "roughscope/io/input_file.hpp"
@@ -21,6 +23,10 @@ namespace roughscope::image {
 namespace {
 
 using Json = nlohmann::json;
+
+// A light or view direction closer to the sample's plane than this cosine is grazing: no
+// brightness to measure (scattering/geometry.hpp's horizon).
+constexpr double kGrazingCos = 1e-12;
 
 struct Context {
     std::string file;
@@ -39,6 +45,23 @@ struct Context {
         const double v = number(j, key);
         if (!(v > 0.0)) fail(key, concat(check::format_number(v), " must be > 0"));
         return v;
+    }
+    // A number in [lo, hi] (`unit` follows the limits in the message).
+    double range(const Json& j, const std::string& key, double lo, double hi,
+                 std::string_view unit = "") const {
+        const double v = number(j, key);
+        if (!(v >= lo && v <= hi))
+            fail(key, concat(check::format_number(v), " must be in [", check::format_number(lo),
+                             ", ", check::format_number(hi), "]", unit));
+        return v;
+    }
+    // An exposure time (s): kMinExposureS … kMaxExposureS (measure.hpp).
+    double exposure(const Json& j, const std::string& key) const {
+        return range(j, key, kMinExposureS, kMaxExposureS, " s");
+    }
+    // A length (µm) the scattering functions take: kMinLengthUm … kMaxLengthUm.
+    double length(const Json& j, const std::string& key) const {
+        return range(j, key, kMinLengthUm, kMaxLengthUm, " µm");
     }
     std::string string(const Json& j, const std::string& key) const {
         if (!j.is_string()) fail(key, concat("must be a string, not ", j.dump()));
@@ -84,12 +107,15 @@ struct Context {
     }
 };
 
+// A direction: any non-zero vector, normalised (scaled by its largest component first, so that
+// neither a huge nor a tiny one overflows or underflows).
 Eigen::Vector3d unit_vector(const Context& ctx, const Json& j, const std::string& key) {
     const auto v = ctx.numbers(j, key, 3);
     Eigen::Vector3d d(v[0], v[1], v[2]);
-    const double n = d.norm();
-    if (!(n > 0.0)) ctx.fail(key, "must be a non-zero vector");
-    return d / n;
+    const double largest = d.cwiseAbs().maxCoeff();
+    if (!(largest > 0.0)) ctx.fail(key, "must be a non-zero vector");
+    d /= largest;
+    return d / d.norm();
 }
 
 // [{"image": FILE, "exposure_s": t}, ...]: an exposure bracket (≥ 2 photographs).
@@ -105,7 +131,7 @@ std::vector<BracketShot> parse_bracket(const Context& ctx, const Json& j, const 
         if (!j[k].contains("image") || !j[k].contains("exposure_s"))
             ctx.fail(name, "needs \"image\" and \"exposure_s\"");
         shots.push_back(BracketShot{ctx.path(j[k]["image"], concat(name, ".image")),
-                                    ctx.positive(j[k]["exposure_s"], concat(name, ".exposure_s"))});
+                                    ctx.exposure(j[k]["exposure_s"], concat(name, ".exposure_s"))});
     }
     return shots;
 }
@@ -139,7 +165,11 @@ Region parse_region(const Context& ctx, const Json& j, const std::string& key,
         return PolygonRegion{points};
     }
     const std::string file = ctx.path(j["mask"], concat(key, ".mask"));
-    return mask_region_from_image(read_image(file));
+    try {
+        return mask_region_from_image(read_image(file));
+    } catch (const Error& e) {  // missing, unreadable, not an image
+        ctx.fail(concat(key, ".mask"), e.what());
+    }
 }
 
 // A whole number in [lo, hi].
@@ -293,8 +323,12 @@ MapRequest parse_maps(const Context& ctx, const Json& j) {
     MapOptions& o = maps.options;
     if (j.contains("window_px"))
         o.window_px = whole(ctx, j["window_px"], "maps.window_px", 1, 4096);
-    if (j.contains("min_used_fraction"))
-        o.min_used_fraction = ctx.positive(j["min_used_fraction"], "maps.min_used_fraction");
+    if (j.contains("min_used_fraction")) {
+        o.min_used_fraction = ctx.number(j["min_used_fraction"], "maps.min_used_fraction");
+        if (!(o.min_used_fraction > 0.0 && o.min_used_fraction <= 1.0))
+            ctx.fail("maps.min_used_fraction",
+                     concat(check::format_number(o.min_used_fraction), " must be in (0, 1]"));
+    }
     if (j.contains("max_shift_px")) {
         o.max_shift_px = ctx.number(j["max_shift_px"], "maps.max_shift_px");
         if (o.max_shift_px < 0.0) ctx.fail("maps.max_shift_px", "must be ≥ 0");
@@ -312,6 +346,13 @@ MapRequest parse_maps(const Context& ctx, const Json& j) {
     if (j.contains("very_rough_min_sigma_over_T"))
         o.very_rough_min_sigma_over_T =
             ctx.positive(j["very_rough_min_sigma_over_T"], "maps.very_rough_min_sigma_over_T");
+    if (!(o.very_rough_min_sigma_over_T >= o.slightly_rough_max_sigma_over_T))
+        ctx.fail(j.contains("very_rough_min_sigma_over_T") ? "maps.very_rough_min_sigma_over_T"
+                                                           : "maps.slightly_rough_max_sigma_over_T",
+                 concat("very_rough_min_sigma_over_T = ",
+                        check::format_number(o.very_rough_min_sigma_over_T),
+                        " must be at least slightly_rough_max_sigma_over_T = ",
+                        check::format_number(o.slightly_rough_max_sigma_over_T)));
     if (j.contains("regions")) {
         const Json& r = j["regions"];
         if (!r.is_array())
@@ -330,15 +371,21 @@ MapRequest parse_maps(const Context& ctx, const Json& j) {
 
 // The capture's geometry: theta_i_deg, theta_s_deg, phi_s_deg (paper frame) or light and view
 // vectors (the sample's normal +z; for a curved object the camera frame, view +z by default, and
-// neither given: L = V = +z, the retro-reflection of §5.2).
-void parse_capture_geometry(const Context& ctx, const Json& c, const std::string& key, bool curved,
-                            CaptureSpec& spec) {
+// neither given: L = V = +z, the retro-reflection of §5.2). Returns (θi, θs, φs) in degrees as
+// typed (from vectors: as computed), for messages that echo them.
+std::array<double, 3> parse_capture_geometry(const Context& ctx, const Json& c,
+                                             const std::string& key, bool curved,
+                                             CaptureSpec& spec) {
     const bool angles =
         c.contains("theta_i_deg") || c.contains("theta_s_deg") || c.contains("phi_s_deg");
     const bool vectors = c.contains("light") || c.contains("view");
     if (angles && vectors)
         ctx.fail(key,
                  "give either theta_i_deg, theta_s_deg, phi_s_deg or light and view, not both");
+    auto degrees = [](const Geometry& g) {
+        return std::array<double, 3>{rad_to_deg(g.theta_i_rad), rad_to_deg(g.theta_s_rad),
+                                     rad_to_deg(g.phi_s_rad)};
+    };
     if (curved && !angles) {
         spec.light = c.contains("light") ? unit_vector(ctx, c["light"], concat(key, ".light"))
                                          : Eigen::Vector3d::UnitZ();
@@ -346,19 +393,24 @@ void parse_capture_geometry(const Context& ctx, const Json& c, const std::string
                                        : Eigen::Vector3d::UnitZ();
         for (const auto& [name, v] :
              {std::pair{"light", *spec.light}, std::pair{"view", *spec.view}})
-            if (!(v.z() > 0.0))
+            if (!(v.z() > kGrazingCos))
                 ctx.fail(concat(key, ".", name),
                          "must point toward the camera side (z > 0; camera frame: x image right, "
                          "y image up, z toward the camera)");
         if (const auto g = geometry_from_vectors(Eigen::Vector3d::UnitZ(), *spec.light, *spec.view))
             spec.geometry = *g;
-        return;
+        return degrees(spec.geometry);
     }
     if (vectors) {
         if (!c.contains("light") || !c.contains("view"))
             ctx.fail(key, "light and view must both be given");
         const Eigen::Vector3d L = unit_vector(ctx, c["light"], concat(key, ".light"));
         const Eigen::Vector3d V = unit_vector(ctx, c["view"], concat(key, ".view"));
+        for (const auto& [name, v] : {std::pair{"light", L}, std::pair{"view", V}})
+            if (!(v.z() > kGrazingCos))
+                ctx.fail(concat(key, ".", name),
+                         "points at or below the sample's plane (z ≤ 0, or grazing); the "
+                         "normal of the sample is +z");
         const auto g = geometry_from_vectors(Eigen::Vector3d::UnitZ(), L, V);
         if (!g)
             ctx.fail(key,
@@ -367,28 +419,95 @@ void parse_capture_geometry(const Context& ctx, const Json& c, const std::string
         spec.geometry = *g;
         spec.light = L;
         spec.view = V;
-        return;
+        return degrees(*g);
     }
     if (!c.contains("theta_i_deg"))
         ctx.fail(key, "needs theta_i_deg (and theta_s_deg, phi_s_deg) or light and view");
-    Geometry g;
-    g.theta_i_rad = deg_to_rad(ctx.number(c["theta_i_deg"], concat(key, ".theta_i_deg")));
-    g.theta_s_rad = c.contains("theta_s_deg")
-                        ? deg_to_rad(ctx.number(c["theta_s_deg"], concat(key, ".theta_s_deg")))
-                        : 0.0;
-    g.phi_s_rad = c.contains("phi_s_deg")
-                      ? deg_to_rad(ctx.number(c["phi_s_deg"], concat(key, ".phi_s_deg")))
-                      : 0.0;
-    for (const auto& [name, value] :
-         {std::pair{"theta_i_deg", g.theta_i_rad}, std::pair{"theta_s_deg", g.theta_s_rad}}) {
-        if (!(value >= 0.0 && value < kPi / 2))
-            ctx.fail(concat(key, ".", name),
-                     concat(check::format_number(rad_to_deg(value)), " must be in [0, 90)"));
+    // Checked in degrees, as typed (a value converted to radians and back may print differently).
+    std::array<double, 3> deg{0.0, 0.0, 0.0};
+    const std::array<const char*, 3> names{"theta_i_deg", "theta_s_deg", "phi_s_deg"};
+    for (std::size_t a = 0; a < 3; ++a) {
+        if (!c.contains(names[a])) continue;
+        const std::string name = concat(key, ".", names[a]);
+        deg[a] = ctx.number(c[names[a]], name);
+        if (a < 2 && !(deg[a] >= 0.0 && deg[a] < 90.0))
+            ctx.fail(name, concat(check::format_number(deg[a]), " must be in [0, 90)"));
     }
+    Geometry g;
+    g.theta_i_rad = deg_to_rad(deg[0]);
+    g.theta_s_rad = deg_to_rad(deg[1]);
+    g.phi_s_rad = deg_to_rad(deg[2]);
+    checked(ctx, key, [&] { check::geometry(g); });
     spec.geometry = g;
     if (curved) {
         spec.light = light_direction(g);
         spec.view = view_direction(g);
+    }
+    return deg;
+}
+
+// A specular capture is taken in the mirror direction of its light (θs = θi, φs = 0; §4.1.1).
+void check_specular_geometry(const Context& ctx, const CaptureSpec& spec, const std::string& key,
+                             const std::array<double, 3>& deg) {
+    const Geometry& g = spec.geometry;
+    if (std::abs(g.theta_i_rad - g.theta_s_rad) <= kSpecularToleranceRad &&
+        std::abs(std::remainder(g.phi_s_rad, 2 * kPi)) <= kSpecularToleranceRad)
+        return;
+    ctx.fail(concat(key, ".role"),
+             concat("a specular capture must be taken in the specular direction (theta_s = "
+                    "theta_i, phi_s = 0); got theta_i = ",
+                    format_message(deg[0], 15), "°, theta_s = ", format_message(deg[1], 15),
+                    "°, phi_s = ", format_message(deg[2], 15), "°"));
+}
+
+// "captures": [...] (and the check of "exposures_equal" against the exposures they give).
+void parse_captures(const Context& ctx, const Json& doc, bool curved, MeasureRequest& request) {
+    if (!doc.contains("captures") || !doc["captures"].is_array() || doc["captures"].empty())
+        ctx.fail("captures", "must be a non-empty array of captures");
+    const Json& captures = doc["captures"];
+    for (std::size_t k = 0; k < captures.size(); ++k) {
+        const std::string key = concat("captures[", std::to_string(k), "]");
+        const Json& c = captures[k];
+        ctx.only(c, key,
+                 {"image", "bracket", "theta_i_deg", "theta_s_deg", "phi_s_deg", "light", "view",
+                  "exposure_s", "role", "description"});
+        CaptureSpec spec;
+        if (c.contains("image") == c.contains("bracket"))
+            ctx.fail(key,
+                     "needs \"image\" (a file) or \"bracket\" (an exposure bracket), one of them");
+        if (c.contains("bracket")) {
+            spec.bracket = parse_bracket(ctx, c["bracket"], concat(key, ".bracket"));
+            spec.image = spec.bracket.front().image;
+            if (c.contains("exposure_s"))
+                ctx.fail(concat(key, ".exposure_s"),
+                         "a bracket gives each photograph's exposure_s; a merged bracket is per "
+                         "second");
+        } else {
+            spec.image = ctx.path(c["image"], concat(key, ".image"));
+        }
+        const std::array<double, 3> deg = parse_capture_geometry(ctx, c, key, curved, spec);
+        if (c.contains("exposure_s") && !c["exposure_s"].is_null())
+            spec.exposure_s = ctx.exposure(c["exposure_s"], concat(key, ".exposure_s"));
+        if (c.contains("role"))
+            spec.role = ctx.named(c["role"], concat(key, ".role"), parse_capture_role);
+        if (spec.role == CaptureRole::Specular && !curved)
+            check_specular_geometry(ctx, spec, key, deg);
+        request.captures.push_back(std::move(spec));
+    }
+    if (!request.exposures_equal) return;
+    // "exposures_equal": true says the exposures are the same: exposure_s values that differ
+    // contradict it.
+    const CaptureSpec* timed = nullptr;
+    for (std::size_t k = 0; k < request.captures.size(); ++k) {
+        const CaptureSpec& spec = request.captures[k];
+        if (!spec.exposure_s || !spec.bracket.empty()) continue;
+        if (timed != nullptr && *timed->exposure_s != *spec.exposure_s)
+            ctx.fail("exposures_equal",
+                     concat("true, but captures[", std::to_string(k), "].exposure_s ",
+                            check::format_number(*spec.exposure_s), " s differs from ",
+                            check::format_number(*timed->exposure_s),
+                            " s; give each capture's exposure_s and leave exposures_equal out"));
+        if (timed == nullptr) timed = &spec;
     }
 }
 
@@ -443,21 +562,23 @@ MeasureRequest parse_checked(std::string_view text, const std::string& path) {
               "white_balance",
               "object",
               "maps",
+              "exposures_equal",
               "description"});
     MeasureRequest request;
     request.source = path;
     if (doc.contains("format") && ctx.string(doc["format"], "format") != "roughscope-measure")
         ctx.fail("format", "must be \"roughscope-measure\" when given");
     if (doc.contains("wavelength_um"))
-        request.wavelength_um = ctx.positive(doc["wavelength_um"], "wavelength_um");
+        request.wavelength_um = ctx.length(doc["wavelength_um"], "wavelength_um");
     if (doc.contains("channel_wavelengths_um")) {
-        const auto w = ctx.numbers(doc["channel_wavelengths_um"], "channel_wavelengths_um", 3);
-        for (std::size_t k = 0; k < 3; ++k) {
-            if (!(w[k] > 0.0))
-                ctx.fail(concat("channel_wavelengths_um[", std::to_string(k), "]"), "must be > 0");
-            request.channel_wavelengths_um[k] = w[k];
-        }
+        const Json& w = doc["channel_wavelengths_um"];
+        ctx.numbers(w, "channel_wavelengths_um", 3);  // the shape
+        for (std::size_t k = 0; k < 3; ++k)
+            request.channel_wavelengths_um[k] =
+                ctx.length(w[k], concat("channel_wavelengths_um[", std::to_string(k), "]"));
     }
+    if (doc.contains("exposures_equal"))
+        request.exposures_equal = boolean(ctx, doc["exposures_equal"], "exposures_equal");
     if (doc.contains("response")) {
         const Json& r = doc["response"];
         if (r.is_object() && r.contains("bracket")) {
@@ -504,11 +625,10 @@ MeasureRequest parse_checked(std::string_view text, const std::string& path) {
     if (doc.contains("radiometry"))
         request.radiometry = ctx.named(doc["radiometry"], "radiometry", parse_radiometry);
     if (doc.contains("sigma_um") && !doc["sigma_um"].is_null())
-        request.sigma_um = ctx.positive(doc["sigma_um"], "sigma_um");
-    if (doc.contains("sigma_um_stderr")) {
-        request.sigma_um_stderr = ctx.number(doc["sigma_um_stderr"], "sigma_um_stderr");
-        if (request.sigma_um_stderr < 0.0) ctx.fail("sigma_um_stderr", "must be ≥ 0");
-    }
+        request.sigma_um = ctx.length(doc["sigma_um"], "sigma_um");
+    if (doc.contains("sigma_um_stderr"))
+        request.sigma_um_stderr =
+            ctx.range(doc["sigma_um_stderr"], "sigma_um_stderr", 0.0, kMaxLengthUm, " µm");
     if (doc.contains("R0")) request.R0 = ctx.positive(doc["R0"], "R0");
     if (doc.contains("highlight")) {
         const Json& h = doc["highlight"];
@@ -558,36 +678,7 @@ MeasureRequest parse_checked(std::string_view text, const std::string& path) {
         ctx.fail("roi",
                  "missing: the region to measure is required (for a flat sample without "
                  "\"maps\")");
-    if (!doc.contains("captures") || !doc["captures"].is_array() || doc["captures"].empty())
-        ctx.fail("captures", "must be a non-empty array of captures");
-    const Json& captures = doc["captures"];
-    for (std::size_t k = 0; k < captures.size(); ++k) {
-        const std::string key = concat("captures[", std::to_string(k), "]");
-        const Json& c = captures[k];
-        ctx.only(c, key,
-                 {"image", "bracket", "theta_i_deg", "theta_s_deg", "phi_s_deg", "light", "view",
-                  "exposure_s", "role", "description"});
-        CaptureSpec spec;
-        if (c.contains("image") == c.contains("bracket"))
-            ctx.fail(key,
-                     "needs \"image\" (a file) or \"bracket\" (an exposure bracket), one of them");
-        if (c.contains("bracket")) {
-            spec.bracket = parse_bracket(ctx, c["bracket"], concat(key, ".bracket"));
-            spec.image = spec.bracket.front().image;
-            if (c.contains("exposure_s"))
-                ctx.fail(concat(key, ".exposure_s"),
-                         "a bracket gives each photograph's exposure_s; a merged bracket is per "
-                         "second");
-        } else {
-            spec.image = ctx.path(c["image"], concat(key, ".image"));
-        }
-        parse_capture_geometry(ctx, c, key, curved, spec);
-        if (c.contains("exposure_s") && !c["exposure_s"].is_null())
-            spec.exposure_s = ctx.positive(c["exposure_s"], concat(key, ".exposure_s"));
-        if (c.contains("role"))
-            spec.role = ctx.named(c["role"], concat(key, ".role"), parse_capture_role);
-        request.captures.push_back(std::move(spec));
-    }
+    parse_captures(ctx, doc, curved, request);
     return request;
 }
 

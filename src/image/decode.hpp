@@ -135,11 +135,20 @@ Evidence icc_evidence(Bytes profile, std::string_view where);
 
 LinearImage decode_png(Bytes bytes, const std::string& name, const ReadOptions& options);
 LinearImage decode_jpeg(Bytes bytes, const std::string& name, const ReadOptions& options);
+// What the TIFF directories of a camera RAW say of its exposure (EXIF 2.3 tags ExposureTime
+// 33434 and FNumber 33437, in IFD0 or the EXIF IFD): a tag present with the value 0 says "not
+// recorded" (Magic Lantern's DNGs write 0/1000000 s). LibRaw then falls back on the APEX tags,
+// whose 0 reads as 1 s and f/1: the reader takes such a value as unknown instead.
+struct RawTiffFacts {
+    bool exposure_time_zero = false;  // an ExposureTime of 0 and none other than 0
+    bool f_number_zero = false;       // an FNumber of 0 and none other than 0
+};
+
 // DataError unless the TIFF directories reachable from the header lie inside the file with
 // entries of known types (LibRaw's TIFF parser trusts them; decode_tiff.cpp). any_version: also
 // when the header's version is not TIFF's 42 (ORF, RW2 and any file starting with II or MM,
-// which LibRaw parses as TIFF directories too).
-void check_raw_structure(Bytes bytes, const std::string& name, bool any_version);
+// which LibRaw parses as TIFF directories too). Returns the exposure facts above.
+RawTiffFacts check_raw_structure(Bytes bytes, const std::string& name, bool any_version);
 
 // nullopt: the file is a TIFF-structured camera RAW (read.hpp), for decode_raw.
 std::optional<LinearImage> decode_tiff(Bytes bytes, const std::string& name,

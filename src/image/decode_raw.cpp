@@ -17,6 +17,7 @@
 #include <limits>
 #include <memory>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <libraw/libraw.h>
@@ -195,9 +196,31 @@ LinearImage decode_raw(Bytes bytes, const std::string& name, const ReadOptions& 
     image.info.source = name;
     image.info.format = "raw";
     image.info.raw_format = raw_format_name(*raw);
-    const Evidence evidence{Response::Linear, 0.0, "camera RAW (LibRaw)"};
-    if (raw->imgdata.other.shutter > 0.0F) image.info.exposure_s = raw->imgdata.other.shutter;
-    if (raw->imgdata.other.aperture > 0.0F) image.info.f_number = raw->imgdata.other.aperture;
+    // Lossy DNG (DNG 1.4 compression 34892: JPEG-compressed 8-bit data of an already demosaiced,
+    // processed image, LibRaw's lossy_dng_load_raw) holds no sensor counts.
+    const bool lossy =
+        std::string_view(raw->unpack_function_name()).find("lossy_dng") != std::string_view::npos;
+    const Evidence evidence{Response::Linear, 0.0,
+                            lossy ? "lossy DNG (LibRaw): processed values" : "camera RAW (LibRaw)"};
+    if (lossy)
+        image.info.warnings.push_back(concat(
+            "lossy DNG (JPEG-compressed ", std::to_string(color.raw_bps),
+            "-bit \"Linear Raw\" data): the values are processed (demosaiced and converted by "
+            "the software that wrote the file, quantised and lossily compressed), not linear "
+            "sensor counts; a roughness measured from them is not reliable: use the camera's own "
+            "RAW file"));
+    // An exposure time or f-number the file records as 0 is unknown, whatever LibRaw derives.
+    RawTiffFacts facts;
+    // (TIFF-structured files only: those starting II or MM but Canon's CRW, as in read.cpp.)
+    const bool crw =
+        bytes.size() >= 14 &&
+        std::string_view(reinterpret_cast<const char*>(bytes.data() + 6), 8) == "HEAPCCDR";
+    if (bytes.size() >= 8 && (bytes[0] == 'I' || bytes[0] == 'M') && bytes[1] == bytes[0] && !crw)
+        facts = check_raw_structure(bytes, name, true);
+    if (raw->imgdata.other.shutter > 0.0F && !facts.exposure_time_zero)
+        image.info.exposure_s = raw->imgdata.other.shutter;
+    if (raw->imgdata.other.aperture > 0.0F && !facts.f_number_zero)
+        image.info.f_number = raw->imgdata.other.aperture;
     if (raw->imgdata.other.iso_speed > 0.0F) image.info.iso = raw->imgdata.other.iso_speed;
     if (sizes.flip != 0)
         image.info.warnings.push_back(concat("RAW orientation (LibRaw flip ",

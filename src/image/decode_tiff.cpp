@@ -209,7 +209,7 @@ void put_row(Linearizer& lin, int bits, bool is_float, const std::uint8_t* row, 
 // inside the file, has at most 1000 entries of a known type (1 to 13) whose values lie inside the
 // file. Classic TIFF only; with any_version, whatever the two bytes after the byte order say
 // (LibRaw parses every file that starts with II or MM as TIFF directories from offset 4).
-void check_raw_structure(Bytes bytes, const std::string& name, bool any_version) {
+RawTiffFacts check_raw_structure(Bytes bytes, const std::string& name, bool any_version) {
     auto fail = [&](const std::string& what) {
         throw DataError(concat(name, ": camera RAW with a corrupt TIFF structure (", what, ")"));
     };
@@ -229,6 +229,9 @@ void check_raw_structure(Bytes bytes, const std::string& name, bool any_version)
     static constexpr std::uint32_t kTypeBytes[14] = {0, 1, 1, 2, 4, 8, 1, 1, 2, 4, 8, 4, 8, 4};
     std::vector<std::uint32_t> pending = {u32(4)};
     std::vector<std::uint32_t> seen;
+    // Per tag (ExposureTime, FNumber): seen with the value 0, seen with another value.
+    bool zero[2] = {false, false};
+    bool nonzero[2] = {false, false};
     while (!pending.empty()) {
         const std::uint32_t at = pending.back();
         pending.pop_back();
@@ -252,6 +255,10 @@ void check_raw_structure(Bytes bytes, const std::string& name, bool any_version)
             const std::uint64_t value_at = size <= 4 ? entry + 8 : u32(entry + 8);
             if (value_at + size > bytes.size())
                 fail(concat("tag ", std::to_string(tag), " values outside the file"));
+            if ((tag == 33434 || tag == 33437) && type == 5 && count >= 1) {  // RATIONAL
+                const std::size_t which = tag == 33434 ? 0 : 1;
+                (u32(static_cast<std::size_t>(value_at)) == 0 ? zero : nonzero)[which] = true;
+            }
             const bool is_ifd = tag == 330 || tag == 34665 || tag == 34853;  // SubIFDs, EXIF, GPS
             if (is_ifd && (type == 4 || type == 13))
                 for (std::uint32_t i = 0; i < std::min<std::uint32_t>(count, 64); ++i)
@@ -259,6 +266,10 @@ void check_raw_structure(Bytes bytes, const std::string& name, bool any_version)
         }
         pending.push_back(u32(at + 2 + 12 * std::size_t{entries}));  // the next IFD
     }
+    RawTiffFacts facts;
+    facts.exposure_time_zero = zero[0] && !nonzero[0];
+    facts.f_number_zero = zero[1] && !nonzero[1];
+    return facts;
 }
 
 std::optional<LinearImage> decode_tiff(Bytes bytes, const std::string& name,

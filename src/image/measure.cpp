@@ -12,6 +12,7 @@
 #include <thread>
 #include <utility>
 
+#include "measure_inputs.hpp"
 #include "measure_notes.hpp"
 #include "roughscope/core/errors.hpp"
 #include "roughscope/core/names.hpp"
@@ -49,6 +50,8 @@ double relative_stderr(const ChannelStatistics& s) {
     return std::max(s.stderr_pixel, s.stderr_tiles) / s.mean;
 }
 
+void check_combination(const MeasureRequest& request);
+
 void check_request(const MeasureRequest& request) {
     const std::string src = where(request);
     if (request.captures.empty())
@@ -78,8 +81,25 @@ void check_request(const MeasureRequest& request) {
         check::polar_angle(concat(name, ": theta_i"), spec.geometry.theta_i_rad);
         check::polar_angle(concat(name, ": theta_s"), spec.geometry.theta_s_rad);
         check::azimuth(concat(name, ": phi_s"), spec.geometry.phi_s_rad);
-        if (spec.exposure_s) check::positive(concat(name, ": exposure_s"), *spec.exposure_s, " s");
+        if (spec.exposure_s &&
+            !(*spec.exposure_s >= kMinExposureS && *spec.exposure_s <= kMaxExposureS))
+            throw InvalidArgument(concat(name,
+                                         ": exposure_s = ", check::format_number(*spec.exposure_s),
+                                         " s must be in [", check::format_number(kMinExposureS),
+                                         ", ", check::format_number(kMaxExposureS), "] s"));
     }
+    check_combination(request);
+}
+
+// What the captures, the object and the maps ask for together. A capture file's combination
+// that cannot be measured is its error (DataError naming the file and the key); a request built
+// in code gets InvalidArgument.
+void check_combination(const MeasureRequest& request) {
+    const std::string src = where(request);
+    auto refuse = [&](std::string_view key, const std::string& reason) {
+        if (request.source.empty()) throw InvalidArgument(concat(src, ": ", reason));
+        throw DataError(concat(src, ": ", key, ": ", reason));
+    };
     const auto diffuse =
         std::count_if(request.captures.begin(), request.captures.end(),
                       [](const CaptureSpec& s) { return s.role == CaptureRole::Diffuse; });
@@ -87,77 +107,113 @@ void check_request(const MeasureRequest& request) {
     const ObjectShape shape = request.object.shape;
     if (is_profile(shape)) {
         if (request.captures.size() != 1 || specular != 0)
-            throw InvalidArgument(concat(src, ": a ", to_string(shape),
-                                         " is measured from one diffuse photograph (§5.2); got ",
-                                         std::to_string(request.captures.size()), " captures (",
-                                         std::to_string(specular), " specular)"));
+            refuse("captures", concat("a ", to_string(shape),
+                                      " is measured from one diffuse photograph (§5.2); got ",
+                                      std::to_string(request.captures.size()), " captures (",
+                                      std::to_string(specular), " specular)"));
         if (request.maps)
-            throw InvalidArgument(concat(src,
-                                         ": maps are made of a flat sample or an object with "
-                                         "a normal map (object.shape plane or normal_map), "
-                                         "not of a ",
-                                         to_string(shape)));
+            refuse("maps", concat("maps are made of a flat sample or an object with a normal map "
+                                  "(object.shape plane or normal_map), not of a ",
+                                  to_string(shape)));
         return;
     }
     if (request.maps && diffuse < 2)
-        throw InvalidArgument(concat(src,
-                                     ": a roughness map needs two diffuse captures (lit from "
-                                     "two directions); got ",
-                                     std::to_string(diffuse)));
+        refuse("maps", concat("a roughness map needs two diffuse captures (lit from two "
+                              "directions); got ",
+                              std::to_string(diffuse)));
     if (shape == ObjectShape::NormalMap && !request.maps)
-        throw InvalidArgument(concat(src,
-                                     ": object.shape normal_map is measured as a map: give "
-                                     "\"maps\""));
-    if (!request.roi && !request.maps)
-        throw InvalidArgument(concat(src, ": no roi: give the region to measure"));
+        refuse("object.shape", "normal_map is measured as a map: give \"maps\"");
+    if (!request.roi && !request.maps) refuse("roi", "missing: give the region to measure");
     if (diffuse == 1 && specular == 0)
-        throw InvalidArgument(concat(src,
-                                     ": one diffuse capture gives no estimate; give a second "
-                                     "diffuse capture at another light or view direction, "
-                                     "or a specular capture"));
+        refuse("captures",
+               "one diffuse capture gives no estimate; give a second diffuse capture at another "
+               "light or view direction, or a specular capture");
 }
 
-// The exposure scale s_k of every capture (measure.hpp) and where its time came from.
-void assign_exposures(std::vector<CaptureMeasurement>& captures, std::vector<std::string>& warnings,
+// The exposure time of a capture: the capture file's, else the metadata's (0: unknown).
+double exposure_time(const CaptureMeasurement& c, std::string& source) {
+    if (c.spec.exposure_s) {
+        source = "capture file";
+        return *c.spec.exposure_s;
+    }
+    if (c.info.exposure_s && *c.info.exposure_s > 0.0) {
+        source = "metadata";
+        return *c.info.exposure_s;
+    }
+    return 0.0;
+}
+
+// "exposures_equal": every capture's time scale is 1; a time that differs from another one
+// contradicts it (a DataError naming both).
+void assign_equal_exposures(std::vector<CaptureMeasurement>& captures, const std::string& src) {
+    const CaptureMeasurement* timed = nullptr;
+    double first_time = 0.0;
+    for (auto& c : captures) {
+        std::string source;
+        const double t = c.spec.bracket.empty() ? exposure_time(c, source) : 0.0;
+        if (t > 0.0 && timed == nullptr) {
+            timed = &c;
+            first_time = t;
+        } else if (t > 0.0 && std::abs(t - first_time) > 1e-6 * first_time) {
+            throw DataError(concat(src, ": exposures_equal: true, but ", c.spec.image, " has ",
+                                   check::format_number(t), " s (", source, ") and ",
+                                   timed->spec.image, " ", check::format_number(first_time),
+                                   " s; give each capture's exposure_s and leave "
+                                   "exposures_equal out"));
+        }
+        c.exposure_scale = 1.0;
+        c.exposure_source = "equal (exposures_equal)";
+    }
+}
+
+// The exposure scale s_k of every capture (measure.hpp) and where its time came from. Captures
+// compared with each other (two diffuse ones or more) need their times: from the capture file or
+// the metadata, or "exposures_equal"; without any, a ratio of brightness would be off by the
+// ratio of the unknown exposures, so the request is refused.
+void assign_exposures(std::vector<CaptureMeasurement>& captures, bool exposures_equal,
                       const std::string& src) {
     std::size_t known = 0;
     for (auto& c : captures) {
-        if (c.spec.exposure_s) {
-            c.exposure_scale = *c.spec.exposure_s;
-            c.exposure_source = "capture file";
-            ++known;
-        } else if (c.info.exposure_s && *c.info.exposure_s > 0.0) {
-            c.exposure_scale = *c.info.exposure_s;
-            c.exposure_source = "metadata";
+        const double t = exposure_time(c, c.exposure_source);
+        if (t > 0.0) {
+            c.exposure_scale = t;
             ++known;
         }
     }
-    if (known == 0) {
+    const auto compared = std::count_if(
+        captures.begin(), captures.end(),
+        [](const CaptureMeasurement& c) { return c.spec.role == CaptureRole::Diffuse; });
+    if (exposures_equal) {
+        assign_equal_exposures(captures, src);
+    } else if (known == 0) {
+        if (compared >= 2)
+            throw DataError(concat(src,
+                                   ": exposures_equal: no capture gives an exposure time "
+                                   "(exposure_s in the capture file, or EXIF/RAW metadata), so "
+                                   "their brightness cannot be compared; give each capture's "
+                                   "exposure_s, or \"exposures_equal\": true when every "
+                                   "photograph was taken with the same exposure"));
         for (auto& c : captures) {
             c.exposure_scale = 1.0;
-            c.exposure_source = "assumed equal";
+            c.exposure_source = "not needed (one capture compared)";
         }
-        if (captures.size() > 1)
-            warnings.push_back(concat(src,
-                                      ": no capture gives an exposure time (exposure_s or "
-                                      "EXIF/RAW metadata): all are taken as equal"));
         return;
     }
-    if (known < captures.size()) {
+    if (!exposures_equal && known < captures.size()) {
         // Only the diffuse captures are compared with each other: a specular capture's σ comes
         // from a ratio within the one image (Eq. 13) and needs no exposure time.
-        for (std::size_t k = 0; k < captures.size(); ++k)
-            if (captures[k].exposure_source.empty() &&
-                captures[k].spec.role == CaptureRole::Specular) {
-                captures[k].exposure_scale = 1.0;
-                captures[k].exposure_source = "not needed (specular)";
+        for (auto& c : captures)
+            if (c.exposure_source.empty() && c.spec.role == CaptureRole::Specular) {
+                c.exposure_scale = 1.0;
+                c.exposure_source = "not needed (specular)";
             }
         for (std::size_t k = 0; k < captures.size(); ++k)
             if (captures[k].exposure_source.empty())
-                throw DataError(concat(src, ": captures[", std::to_string(k), "] (",
-                                       captures[k].spec.image,
-                                       ") has no exposure time while others have one; give "
-                                       "exposure_s for it"));
+                throw DataError(concat(src, ": captures[", std::to_string(k),
+                                       "].exposure_s: ", captures[k].spec.image,
+                                       " has no exposure time (none given, none in its "
+                                       "metadata) while others have one; give exposure_s for "
+                                       "it"));
     }
     // ISO and f-number: used when every capture's metadata gives them (s ∝ t · ISO / N²).
     const bool all_iso = std::all_of(captures.begin(), captures.end(),
@@ -174,80 +230,12 @@ void assign_exposures(std::vector<CaptureMeasurement>& captures, std::vector<std
     }
 }
 
-// 8-bit files on the code scale (value · 255 = the stored code), for response curves.
-ReadOptions code_scale() {
-    ReadOptions options;
-    options.response = Response::Linear;
-    options.black_level_dn = std::vector<double>{0.0};
-    return options;
-}
-
-// The images of a bracket on the code scale, and their exposure times.
-std::pair<std::vector<LinearImage>, std::vector<double>> read_bracket(
-    const std::vector<BracketShot>& shots) {
-    std::vector<LinearImage> images;
-    std::vector<double> times;
-    for (const BracketShot& shot : shots) {
-        images.push_back(read_image(shot.image, code_scale()));
-        times.push_back(shot.exposure_s);
-    }
-    return {std::move(images), std::move(times)};
-}
-
-// How the files become linear: the declared response (read_image), or a curve recovered from
-// the request's exposure bracket.
-class Loader {
-  public:
-    explicit Loader(const MeasureRequest& request) : request_(request) {
-        if (!request.response_bracket.empty()) {
-            const auto [images, times] = read_bracket(request.response_bracket);
-            curve_ = recover_response_debevec(images, times);
-        }
-    }
-    LinearImage image(const std::string& path) const {
-        if (!curve_) return read_image(path, request_.read);
-        LinearImage image = read_image(path, code_scale());
-        apply_response_curve(image, *curve_);
-        return image;
-    }
-    LinearImage capture(const CaptureSpec& spec) const {
-        if (spec.bracket.empty()) return image(spec.image);
-        const auto [images, times] = read_bracket(spec.bracket);
-        const ResponseCurve curve =
-            curve_ ? *curve_
-                   : response_curve_of(request_.read.response.value_or(Response::Srgb),
-                                       request_.read.gamma, images.front().channels);
-        return merge_hdr(images, times, curve);
-    }
-
-  private:
-    const MeasureRequest& request_;
-    std::optional<ResponseCurve> curve_;
-};
-
-// Width and height only (a normal map has 3 channels whatever the captures have).
-void check_same_size_pixels(const LinearImage& image, const LinearImage& first,
-                            const std::string& src) {
-    if (image.width != first.width || image.height != first.height)
-        throw DataError(concat(src, ": ", image.info.source, " is ", std::to_string(image.width),
-                               " x ", std::to_string(image.height), " but ", first.info.source,
-                               " is ", std::to_string(first.width), " x ",
-                               std::to_string(first.height),
-                               ": the normal map must have the "
-                               "captures' size"));
-}
-
-void check_same_size(const LinearImage& image, const LinearImage& first, const std::string& src) {
-    if (image.width != first.width || image.height != first.height ||
-        image.channels != first.channels)
-        throw DataError(concat(src, ": ", image.info.source, " is ", std::to_string(image.width),
-                               " x ", std::to_string(image.height), " x ",
-                               std::to_string(image.channels), " but ", first.info.source, " is ",
-                               std::to_string(first.width), " x ", std::to_string(first.height),
-                               " x ", std::to_string(first.channels),
-                               ": every capture (and the dark frame and flat field) must have the "
-                               "same size and channels"));
-}
+using detail::check_same_recording;
+using detail::check_same_size;
+using detail::check_same_size_pixels;
+using detail::code_scale;
+using detail::keyed;
+using detail::Loader;
 
 // σ per channel from one specular capture (Eq. 13, with each channel's λ) and from the RGB
 // average (λ of the request); their agreement as χ² about the weighted mean.
@@ -607,7 +595,7 @@ class CaptureRun {
         capture.spec = spec;
         // A merged bracket is per second of exposure.
         if (!spec.bracket.empty()) capture.spec.exposure_s = 1.0;
-        LinearImage image = loader_.capture(spec);
+        LinearImage image = loader_.capture(spec, k);
         if (k == 0) {
             FirstCapture first;
             first.header.width = image.width;
@@ -615,7 +603,9 @@ class CaptureRun {
             first.header.channels = image.channels;
             first.header.info.source = image.info.source;
             if (request_.roi) {
-                first.spans = region_spans(*request_.roi, image.width, image.height);
+                first.spans = keyed(request_, "roi", [&] {
+                    return region_spans(*request_.roi, image.width, image.height);
+                });
                 if (needs_mask()) first.mask = rasterize(first.spans);
             }
             first_.set_value(std::move(first));
@@ -623,31 +613,45 @@ class CaptureRun {
         }
         // Capture 0's failure ends the others here (its error is the one thrown).
         const FirstCapture& first = first_ready_.get();
-        check_same_size(image, first.header, src);
-        if (dark_) {
-            check_same_size(*dark_, first.header, src);
-            subtract_dark_frame(image, *dark_);
-        }
-        if (flat_) {
-            check_same_size(*flat_, first.header, src);
-            divide_flat_field(image, *flat_);
-        }
+        auto image_key = [](const CaptureSpec& c, std::size_t index) {
+            return concat("captures[", std::to_string(index), "]",
+                          c.bracket.empty() ? ".image" : ".bracket");
+        };
+        const std::string first_key = image_key(request_.captures.front(), 0);
+        check_same_size(image, first.header, src, image_key(spec, k), first_key);
         for (const auto& w : image.info.warnings)
             out.warnings.push_back(concat(spec.image, ": ", w));
+        detail::assumption_warnings(request_, spec, image.info, out.warnings);
+        // The dark frame, then the flat field: each of the captures' size and recording.
+        auto correct = [&](const LinearImage& frame, const std::string& frame_key, bool dark) {
+            check_same_size(frame, first.header, src, frame_key, first_key);
+            if (spec.bracket.empty()) check_same_recording(frame, image, src, frame_key);
+            keyed(request_, frame_key, [&] {
+                if (dark)
+                    subtract_dark_frame(image, frame);
+                else
+                    divide_flat_field(image, frame);
+            });
+        };
+        if (dark_) correct(*dark_, "dark_frame", true);
+        if (flat_) correct(*flat_, "flat_field", false);
         const std::vector<std::uint8_t>* roi_mask = request_.roi ? &first.mask : nullptr;
         const ObjectShape shape = request_.object.shape;
         if (shape == ObjectShape::Cylinder) {
             CylinderOptions options = request_.object.cylinder;
             options.light = spec.light.value_or(Eigen::Vector3d::UnitZ());
             options.view = spec.view.value_or(Eigen::Vector3d::UnitZ());
-            out.cylinder = measure_cylinder_profile(image, roi_mask, options);
+            out.cylinder = keyed(request_, "object", [&] {
+                return measure_cylinder_profile(image, roi_mask, options);
+            });
             for (const auto& w : out.cylinder->warnings)
                 out.warnings.push_back(concat(spec.image, ": ", w));
         } else if (shape == ObjectShape::Sphere) {
             SphereOptions options = request_.object.sphere;
             options.light = spec.light.value_or(Eigen::Vector3d::UnitZ());
             options.view = spec.view.value_or(Eigen::Vector3d::UnitZ());
-            out.sphere = measure_sphere(image, roi_mask, options);
+            out.sphere =
+                keyed(request_, "object", [&] { return measure_sphere(image, roi_mask, options); });
             for (const auto& w : out.sphere->warnings)
                 out.warnings.push_back(concat(spec.image, ": ", w));
         } else if (spec.role == CaptureRole::Specular) {
@@ -655,12 +659,16 @@ class CaptureRun {
                 throw InvalidArgument(concat(src, ": ", spec.image,
                                              ": a specular capture needs the roi that holds its "
                                              "highlight"));
-            capture.highlight = measure_highlight(image, first.mask, request_.highlight);
+            capture.highlight = keyed(request_, "highlight", [&] {
+                return measure_highlight(image, first.mask, request_.highlight);
+            });
             capture.region = capture.highlight->core;
             for (const auto& w : capture.highlight->warnings)
                 out.warnings.push_back(concat(spec.image, ": ", w));
         } else if (request_.roi) {
-            capture.region = region_statistics(image, first.spans, request_.statistics);
+            capture.region = keyed(request_, "roi", [&] {
+                return region_statistics(image, first.spans, request_.statistics);
+            });
             for (const auto& w : capture.region.warnings)
                 out.warnings.push_back(concat(spec.image, ": ", w));
         }
@@ -691,8 +699,8 @@ MeasureResult measure(const MeasureRequest& request) {
 
     const Loader loader(request);
     std::optional<LinearImage> dark, flat;
-    if (request.dark_frame) dark = loader.image(*request.dark_frame);
-    if (request.flat_field) flat = loader.image(*request.flat_field);
+    if (request.dark_frame) dark = loader.image(*request.dark_frame, "dark_frame");
+    if (request.flat_field) flat = loader.image(*request.flat_field, "flat_field");
 
     CaptureRun run(request, loader, dark, flat);
     run.run(request.threads == 0
@@ -715,7 +723,7 @@ MeasureResult measure(const MeasureRequest& request) {
         }
         result.captures.push_back(std::move(o.capture));
     }
-    assign_exposures(result.captures, result.warnings, src);
+    assign_exposures(result.captures, request.exposures_equal, src);
     if (is_profile(shape)) {
         for (CaptureMeasurement& c : result.captures) c.brightness_relative_stderr = 0.0;
         if (detail::has_exponential_sigma_over_T(result))
@@ -743,15 +751,17 @@ MeasureResult measure(const MeasureRequest& request) {
     for (const CaptureMeasurement& c : result.captures) {
         if (c.spec.role != CaptureRole::Specular) continue;
         const Geometry& g = c.spec.geometry;
-        if (std::abs(g.theta_i_rad - g.theta_s_rad) > 1e-9 ||
-            std::abs(std::remainder(g.phi_s_rad, 2 * kPi)) > 1e-9)
+        // (The capture file's parser refuses this first, echoing the angles as typed.) Degrees
+        // to 15 digits: 30° through radians prints as 30, not 29.999999999999996.
+        if (std::abs(g.theta_i_rad - g.theta_s_rad) > kSpecularToleranceRad ||
+            std::abs(std::remainder(g.phi_s_rad, 2 * kPi)) > kSpecularToleranceRad)
             throw InvalidArgument(
                 concat(src, ": ", c.spec.image,
                        ": a specular capture must be taken in the specular "
                        "direction (theta_s = theta_i, phi_s = 0); got theta_i = ",
-                       check::format_number(rad_to_deg(g.theta_i_rad)),
-                       "°, theta_s = ", check::format_number(rad_to_deg(g.theta_s_rad)),
-                       "°, phi_s = ", check::format_number(rad_to_deg(g.phi_s_rad)), "°"));
+                       format_message(rad_to_deg(g.theta_i_rad), 15),
+                       "°, theta_s = ", format_message(rad_to_deg(g.theta_s_rad), 15),
+                       "°, phi_s = ", format_message(rad_to_deg(g.phi_s_rad), 15), "°"));
         estimate_specular(c, request, result);
         // A highlight whose core or surround has no measurable noise gives σ with a standard
         // error of 0: unknown (measure.hpp).
@@ -793,14 +803,18 @@ MeasureResult measure(const MeasureRequest& request) {
         std::vector<float> normals;
         if (shape == ObjectShape::NormalMap) {
             // Read as stored (linear, no black level): the values encode directions, not light.
-            const LinearImage normal_image = read_image(request.object.normal_map, code_scale());
-            check_same_size_pixels(normal_image, *first, src);
+            const LinearImage normal_image = keyed(request, "object.file", [&] {
+                return read_image(request.object.normal_map, code_scale());
+            });
+            check_same_size_pixels(normal_image, *first, src, "object.file");
             normals = decode_normal_map(normal_image, src);
             options.normal_map = normals;
         }
         std::vector<std::int32_t> labels;
         if (!request.maps->regions.empty()) {
-            labels = region_labels(*request.maps, first->width, first->height);
+            labels = keyed(request, "maps.regions", [&] {
+                return region_labels(*request.maps, first->width, first->height);
+            });
             options.region_labels = labels;
             for (const auto& r : request.maps->regions) options.region_names.push_back(r.first);
         }
@@ -827,7 +841,7 @@ MeasureResult measure(const MeasureRequest& request) {
             result.warnings.push_back(concat(src,
                                              ": the map divides the first two diffuse captures; "
                                              "the others enter the region measurement only"));
-        result.map = roughness_map(captures, options);
+        result.map = keyed(request, "maps", [&] { return roughness_map(captures, options); });
         for (const auto& w : result.map->warnings) result.warnings.push_back(concat("map: ", w));
     }
     if (detail::has_exponential_sigma_over_T(result))

@@ -10,6 +10,7 @@
 
 #include "roughscope/core/errors.hpp"
 #include "roughscope/core/numbers.hpp"
+#include "roughscope/core/text.hpp"
 #include "roughscope/scattering/factors.hpp"
 #include "roughscope/scattering/validity.hpp"
 #include "roughscope/serialize/model.hpp"
@@ -127,7 +128,8 @@ Json to_json(const StatisticsInput& input, const surface::SurfaceStatistics& s, 
 std::string to_text(const StatisticsInput& input, const surface::SurfaceStatistics& s) {
     const Json j = to_json(input, s, false);
     std::ostringstream out;
-    std::string source = input.file.empty() ? std::string("heights") : input.file;
+    // The file name as typed, its control characters escaped (core/text.hpp).
+    std::string source = input.file.empty() ? std::string("heights") : printable_text(input.file);
     if (!input.format.empty()) source.append(" (").append(input.format).append(")");
     out << source << ": " << input.nx << " x " << input.ny
         << " points, dx = " << text_of(j["dx_um"]) << " um, dy = " << text_of(j["dy_um"])

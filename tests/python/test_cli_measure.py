@@ -152,11 +152,11 @@ def test_an_angle_out_of_range_is_named(linear_sample, tmp_path):
     assert "theta_i_deg" in line and "[0, 90)" in line
 
 
-def test_a_region_outside_the_image_is_invalid(linear_sample, tmp_path):
+def test_a_region_outside_the_image_is_a_bad_value_of_the_capture_file(linear_sample, tmp_path):
     _, capture_file = linear_sample
     path = edited(capture_file, tmp_path, lambda d: d.update(roi={"rect": [100, 100, 500, 500]}))
-    line = fails(EXIT_USAGE, path)
-    assert "outside" in line
+    line = fails(EXIT_DATA, path)
+    assert f"{path}: roi: " in line and "outside" in line
 
 
 def test_captures_of_different_sizes_are_a_data_error(linear_sample, tmp_path):

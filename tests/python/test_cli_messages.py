@@ -2,6 +2,7 @@
 character, never a value echoed whole, never a number rounded onto the limit it breaks, and
 nothing from the solver's own logging on stderr (core/text.hpp, core/numbers.hpp, fit/engine)."""
 
+import json
 import subprocess
 
 import pytest
@@ -104,3 +105,58 @@ def test_what_the_solver_logged_is_in_the_fit_message(tmp_path):
     proc = run("estimate", "fit", "--measurements", f, "--correlation", "gaussian")
     assert proc.stderr == b"", proc.stderr.decode()
     assert b"solver log: Terminating: Residual and Jacobian evaluation failed." in proc.stdout
+
+
+def test_an_empty_output_directory_names_the_flag():
+    proc = run("simulate", "capture", "--out", "")
+    assert proc.returncode == 2
+    line = one_error_line(proc)
+    assert "--out" in line and "filesystem error" not in line, line
+
+
+SCATTER = ["simulate", "scatter", "--sigma-um", "0.05", "--T-um", "1", "--realisations", "3"]
+
+
+@pytest.mark.parametrize("flag,args", [
+    ("--theta-i", [*SCATTER, "--theta-i", "30,,40", "--theta-s", "0", "--phi-s", "0"]),
+    ("--theta-s", [*SCATTER, "--theta-i", "30", "--theta-s=0,", "--phi-s", "0"]),
+    ("--phi-s", ["surface", "predict", "--sigma-um", "0.5", "--T-um", "5", "--theta-i", "30",
+                 "--theta-s", "0", "--phi-s", ",0"]),
+    ("--sigma-over-T", ["simulate", "capture", "--sigma-over-T", "0.2,,0.4", "--out", "never"]),
+    ("--pair", ["curet", "--sample", "25", "--pair", "81, ,112"]),
+])
+def test_an_empty_list_element_is_refused(flag, args, tmp_path):
+    # CLI11 alone drops it: "30,,40" read as 30, 40.
+    proc = run(*args, cwd=tmp_path)
+    assert proc.returncode == 2, proc.stderr
+    line = one_error_line(proc)
+    assert f"{flag}: " in line and "empty element" in line, line
+    assert not (tmp_path / "never").exists()
+
+
+def test_control_characters_of_a_file_name_are_escaped_in_text_output(tmp_path):
+    # A 16-bit pair without black_level_dn: the result's warnings name each photograph.
+    names = []
+    for k, theta in enumerate((30.0, 45.0)):
+        name = f"cap\x1b[31m{k}\x07"
+        core.write_capture(str(tmp_path), "png", stem=name, width=16, height=16, bits=16,
+                           theta_i_deg=theta, sigma_over_T=0.3)
+        names.append({"image": name + ".png", "theta_i_deg": theta, "exposure_s": 1})
+    path = tmp_path / "capture-file.json"
+    path.write_text(json.dumps({"roi": {"rect": [2, 2, 12, 12]}, "captures": names}))
+    proc = run("measure", path)
+    assert proc.returncode == 0, proc.stderr
+    out = proc.stdout.decode("utf-8")
+    assert "\\x1b[31m0\\x07" in out and "\x1b" not in out and "\x07" not in out, out
+    # The JSON keeps the names as they are (escaped by JSON itself).
+    doc = json.loads(run("measure", path, "--json").stdout)
+    assert doc["captures"][0]["image"].endswith("cap\x1b[31m0\x07.png")
+    proc = run("simulate", "capture", "--width", "8", "--height", "8", "--out",
+               tmp_path / "out\x1b]0;x\x07")
+    assert proc.returncode == 0 and b"\x1b" not in proc.stdout, proc.stdout
+    assert b"out\\x1b]0;x\\x07" in proc.stdout
+    heights = tmp_path / "h\x1b[31m.x3p"
+    assert run("surface", "generate", "--sigma-um", "1", "--T-um", "5", "--nx", "32", "--out",
+               heights).returncode == 0
+    out = run("surface", "stats", heights).stdout
+    assert b"\x1b" not in out and b"h\\x1b[31m.x3p (x3p): " in out, out

@@ -50,8 +50,8 @@ for _k, _theta in enumerate((30.0, 45.0)):
 CAPTURE_FILE = _HEIGHT_DIR + "/capture-file.json"
 with open(CAPTURE_FILE, "w", encoding="utf-8") as _f:
     _f.write('{"response": "linear", "black_level_dn": 64, "roi": {"rect": [4, 4, 16, 16]}, '
-             '"captures": [{"image": "cap0.png", "theta_i_deg": 30}, '
-             '{"image": "cap1.png", "theta_i_deg": 45}]}')
+             '"captures": [{"image": "cap0.png", "theta_i_deg": 30, "exposure_s": 1}, '
+             '{"image": "cap1.png", "theta_i_deg": 45, "exposure_s": 1}]}')
 IMAGE_VALUES = np.random.default_rng(2).uniform(0.2, 0.3, size=(3, 12, 12))
 IMAGE_MASK = np.ones((12, 12), dtype=bool)
 LOBES = Lobes([{"Cx": -1.0, "Cy": -1.0, "Cz": 1.0, "n": 10.0, "albedo": 0.5}])

@@ -38,6 +38,13 @@ enum class CaptureRole { Diffuse, Specular };
 std::string_view to_string(CaptureRole role);  // "diffuse", "specular"
 CaptureRole parse_capture_role(std::string_view name);
 
+// Exposure times accepted (s): from a nanosecond gate to about eleven days.
+inline constexpr double kMinExposureS = 1e-9;
+inline constexpr double kMaxExposureS = 1e6;
+
+// A specular capture's θs may differ from θi, and φs from 0, by at most this (rad).
+inline constexpr double kSpecularToleranceRad = 1e-9;
+
 // Default wavelengths of the R, G, B channels (µm): the centres of typical camera colour filters.
 // The RGB average (and a grey image) uses MeasureRequest::wavelength_um (the paper's 0.555 µm).
 inline constexpr std::array<double, 3> kDefaultChannelWavelengthsUm{0.600, 0.530, 0.460};
@@ -60,8 +67,9 @@ struct CaptureSpec {
     // (x image right, y image up, z toward the camera); absent, both are +z (L = V, §5.2).
     std::optional<Eigen::Vector3d> light;
     std::optional<Eigen::Vector3d> view;
-    // Exposure time (s); when absent, the file's metadata (EXIF, RAW); when no capture has one,
-    // all are taken as equal (a warning says so).
+    // Exposure time (s), in [kMinExposureS, kMaxExposureS]; when absent, the file's metadata
+    // (EXIF, RAW). When no capture has one, measure() refuses to compare the captures unless
+    // MeasureRequest::exposures_equal says they are the same.
     std::optional<double> exposure_s;
     CaptureRole role = CaptureRole::Diffuse;
 };
@@ -106,6 +114,9 @@ struct MeasureRequest {
     ObjectSpec object;
     std::optional<MapRequest> maps;
     std::vector<CaptureSpec> captures;
+    // The exposures of the captures are the same (the capture file's "exposures_equal"): what
+    // lets captures without an exposure time (none given, none in the metadata) be compared.
+    bool exposures_equal = false;
     Correlation correlation = Correlation::Gaussian;  // for T given σ
     // The diffuse term's regime for T given σ: SlightlyRough is the paper's Eq. 15 (§4.1.2,
     // Table 1); Series the exact sum at any g; Auto as scattering/beckmann.hpp; VeryRough Eq. 4/5.
@@ -134,9 +145,9 @@ struct MeasureRequest {
 struct CaptureMeasurement {
     CaptureSpec spec;
     ImageInfo info;
-    double exposure_scale = 1.0;                    // s_k
-    std::string exposure_source;                    // "capture file", "metadata", "assumed equal"
-    RegionStatistics region;                        // diffuse: the region; specular: the core
+    double exposure_scale = 1.0;  // s_k
+    std::string exposure_source;  // "capture file", "metadata", "equal (exposures_equal)"
+    RegionStatistics region;      // diffuse: the region; specular: the core
     std::optional<HighlightMeasurement> highlight;  // specular captures only
     double brightness = 0.0;                        // Ẽ_k = region.average.mean / s_k (diffuse)
     double brightness_relative_stderr = 0.0;
@@ -177,9 +188,12 @@ struct MeasureResult {
 };
 
 // Reads every capture, measures the region and estimates what the captures allow. Throws
-// DataError (a file: missing, unreadable, sizes that differ) or InvalidArgument (angles, region
-// outside the image, a mostly saturated region, no diffuse pair and no specular capture),
-// NoSolution (a ratio no model produces), each naming the capture file and the input.
+// DataError (a file: missing, unreadable, sizes that differ; a dark frame or flat field recorded
+// unlike the captures; captures to compare without exposure times and without exposures_equal)
+// or InvalidArgument (angles, region outside the image, a mostly saturated region, no diffuse
+// pair and no specular capture), NoSolution (a ratio no model produces). With a capture file
+// (`source` not empty) every error caused by one of its values is a DataError
+// "<file>: <key>: <reason>"; without one, the InvalidArgument names the input.
 MeasureResult measure(const MeasureRequest& request);
 
 // The capture file (JSON, docs/measure.md): keys wavelength_um, channel_wavelengths_um,
@@ -189,8 +203,9 @@ MeasureResult measure(const MeasureRequest& request);
 // {"mask": FILE}), correlation, sigma_um, sigma_um_stderr, R0, factor, radiometry, highlight
 // {core_radius_px, annulus_inner_px, annulus_outer_px, smoothing_sigma_px, centre_px}, and
 // captures: [{image | bracket: [{image, exposure_s}, ...], theta_i_deg, theta_s_deg, phi_s_deg |
-// light, view (unit vectors, normal +Z), exposure_s, role}]. Paths are relative to the capture
-// file. DataError naming the file and the key for anything malformed or unknown.
+// light, view (directions, normal +Z), exposure_s, role}], exposures_equal. Paths are relative
+// to the capture file. DataError naming the file and the key for anything malformed, unknown or
+// out of range (measure() names the key of a value it cannot use in the same way).
 MeasureRequest read_capture_file(const std::string& path);
 MeasureRequest parse_capture_file(std::string_view text, const std::string& path);
 

@@ -287,13 +287,14 @@ ByteVector raw_bytes(const std::vector<T>& values) {
 // A Bayer DNG (DNG 1.4): one IFD, CFA photometric, 16-bit sites, RGGB pattern, the given black
 // levels (BlackLevelRepeatDim `repeat`, by default 1 x 1 for one value, 2 x 2 for four) and white
 // level,
-// AsShotNeutral, identity ColorMatrix1, and an EXIF IFD with ExposureTime 1/250 s, FNumber 8,
-// ISO 400.
+// AsShotNeutral, identity ColorMatrix1, and an EXIF IFD `exif` (by default ExposureTime 1/250 s,
+// FNumber 8, ISO 400).
 inline ByteVector bayer_dng(
     std::uint32_t width, std::uint32_t height, const std::vector<std::uint16_t>& sites,
     const std::vector<std::uint32_t>& black, std::uint32_t white,
     std::vector<std::pair<std::uint32_t, std::uint32_t>> neutral = {{1, 1}, {1, 1}, {1, 1}},
-    std::pair<std::uint32_t, std::uint32_t> repeat = {0, 0}) {
+    std::pair<std::uint32_t, std::uint32_t> repeat = {0, 0},
+    const std::vector<TiffEntry>& exif = exif_exposure(250, 80, 400)) {
     if (repeat.first == 0) repeat = black.size() == 4 ? std::pair{2U, 2U} : std::pair{1U, 1U};
     std::vector<TiffEntry> ifd0 = {
         longs(254, {0}),
@@ -322,7 +323,7 @@ inline ByteVector bayer_dng(
         rationals(50728, neutral),
         shorts(50778, {21}),
     };
-    return tiff_file(ifd0, raw_bytes(sites), exif_exposure(250, 80, 400));
+    return tiff_file(ifd0, raw_bytes(sites), exif);
 }
 
 }  // namespace roughscope::testing

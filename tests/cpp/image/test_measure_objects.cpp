@@ -224,19 +224,31 @@ TEST(MeasureObjects, CylinderThroughMeasureIsTheProfileOfTheCapture) {
     fs::remove_all(dir);
 }
 
+// A combination the capture file asks for that cannot be measured is that file's error
+// (DataError naming the key); the same request built in code is an InvalidArgument.
 TEST(MeasureObjects, ProfilesAndMapsRefuseTheWrongCaptures) {
     const std::string two = R"("captures": [{"image": "a.tiff"}, {"image": "b.tiff"}])";
-    EXPECT_THROW(measure(parse(concat(R"({"object": {"shape": "cylinder"}, )", two, "}"))),
-                 InvalidArgument);
-    EXPECT_THROW(measure(parse(R"({"object": {"shape": "sphere"}, "maps": {},
-      "captures": [{"image": "a.tiff"}]})")),
-                 InvalidArgument);
-    EXPECT_THROW(measure(parse(R"({"maps": {}, "captures": [{"image": "a.tiff",
-      "theta_i_deg": 30}]})")),
-                 InvalidArgument);
-    EXPECT_THROW(measure(parse(R"({"object": {"shape": "normal_map", "file": "n.tiff"},
-      "roi": {"rect": [0, 0, 4, 4]}, "captures": [{"image": "a.tiff"}, {"image": "b.tiff"}]})")),
-                 InvalidArgument);  // a normal map without "maps"
+    const std::vector<std::pair<std::string, std::string>> cases = {
+        {concat(R"({"object": {"shape": "cylinder"}, )", two, "}"), "c.json: captures: "},
+        {R"({"object": {"shape": "sphere"}, "maps": {}, "captures": [{"image": "a.tiff"}]})",
+         "c.json: maps: "},
+        {R"({"maps": {}, "captures": [{"image": "a.tiff", "theta_i_deg": 30}]})", "c.json: maps: "},
+        // a normal map without "maps"
+        {R"({"object": {"shape": "normal_map", "file": "n.tiff"},
+      "roi": {"rect": [0, 0, 4, 4]}, "captures": [{"image": "a.tiff"}, {"image": "b.tiff"}]})",
+         "c.json: object.shape: "},
+    };
+    for (const auto& [text, key] : cases) {
+        try {
+            measure(parse(text));
+            ADD_FAILURE() << "no error: " << text;
+        } catch (const DataError& e) {
+            EXPECT_EQ(std::string(e.what()).rfind(key, 0), 0U) << e.what();
+        }
+        MeasureRequest in_code = parse(text);
+        in_code.source.clear();
+        EXPECT_THROW(measure(in_code), InvalidArgument) << text;
+    }
 }
 
 // A sphere photographed twice (light at 30° and 45° in the camera frame, camera on +z) with its
