@@ -300,6 +300,7 @@ DEMO_EXPOSURE_FACTORS = (1.0, 0.5)
 DEMO_SIZE = 160
 DEMO_ELECTRONS = 20000.0
 DEMO_FULL_WELL = 60000.0
+DEMO_BASE_EXPOSURE_S = 0.02  # the first capture of each pair: 1/50 s
 DEMO_WAVELENGTH_UM = 0.555
 DEMO_HIGHLIGHT_RADIUS_PX = 12
 
@@ -315,9 +316,9 @@ def _demo_gain(sample):
     return 1.05 * (white - _demo_black_level(sample)) / DEMO_FULL_WELL
 
 
-def _camera(sample):
+def _camera(sample, electrons_per_unit_s=DEMO_ELECTRONS):
     return dict(bits=sample["bits"], response=sample["response"],
-                electrons_per_unit_s=DEMO_ELECTRONS, full_well_e=DEMO_FULL_WELL,
+                electrons_per_unit_s=electrons_per_unit_s, full_well_e=DEMO_FULL_WELL,
                 black_level=_demo_black_level(sample), gain=_demo_gain(sample),
                 keep_geometry=False)
 
@@ -364,13 +365,22 @@ def _write_specular(sample, folder, ext):
             "phi_s_deg": 0.0, "role": "specular"}
 
 
+def demo_lamp(sample, brightness=None):
+    """Electrons per unit brightness and second of the sample's diffuse captures: the lamp that
+    puts the first capture's mean at 40 % of the full well in DEMO_BASE_EXPOSURE_S (a dim,
+    slightly rough sample gets a brighter lamp, not an exposure of years)."""
+    if brightness is None:
+        brightness = [_mean_brightness(sample, t) for t in DEMO_THETA_I_DEG]
+    return 0.4 * DEMO_FULL_WELL / (DEMO_BASE_EXPOSURE_S * max(brightness))
+
+
 def write_demo_sample(sample, folder):
     """Write the captures and the capture file of one demo sample; return its path."""
     folder = pathlib.Path(folder)
     ext = "dng" if sample["fmt"] == "dng" else ("tiff" if sample["fmt"] == "tiff" else "png")
     brightness = [_mean_brightness(sample, t) for t in DEMO_THETA_I_DEG]
-    # Exposure of the first capture: its mean at 40 % of the full well.
-    base_exposure = 0.4 * DEMO_FULL_WELL / (DEMO_ELECTRONS * max(brightness))
+    base_exposure = DEMO_BASE_EXPOSURE_S
+    lamp = demo_lamp(sample, brightness)
     captures = []
     if "specular_theta_deg" in sample:
         captures.append(_write_specular(sample, folder, ext))
@@ -380,7 +390,8 @@ def write_demo_sample(sample, folder):
         exposure = base_exposure * factor
         _core.write_capture(str(sub), sample["fmt"], scene="plane", width=DEMO_SIZE,
                             height=DEMO_SIZE, theta_i_deg=theta, exposure_s=exposure,
-                            seed=sample["seed"] * 10 + k, **_surface(sample), **_camera(sample))
+                            seed=sample["seed"] * 10 + k, **_surface(sample),
+                            **_camera(sample, electrons_per_unit_s=lamp))
         captures.append({"image": f"capture{k + 1}/capture.{ext}", "theta_i_deg": theta,
                          "theta_s_deg": 0.0, "phi_s_deg": 0.0, "exposure_s": exposure,
                          "role": "diffuse"})

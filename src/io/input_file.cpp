@@ -32,10 +32,11 @@ std::string_view special_kind(const std::filesystem::file_status& status) {
 
 }  // namespace
 
-void check_input_file(const std::filesystem::path& path, std::string_view name) {
+void check_input_file(const std::filesystem::path& path, std::string_view name, bool allow_fifo) {
     std::error_code ec;
     const std::filesystem::file_status status = std::filesystem::status(path, ec);
     if (ec) return;  // no such file, or not reachable: the caller's open reports it
+    if (allow_fifo && status.type() == std::filesystem::file_type::fifo) return;
     const std::string_view kind = special_kind(status);
     if (kind.empty()) return;
     throw DataError(concat(name, ": is a ", kind,

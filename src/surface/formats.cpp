@@ -9,6 +9,7 @@
 #include <iterator>
 #include <string>
 #include <system_error>
+#include <vector>
 
 #include "roughscope/core/errors.hpp"
 #include "roughscope/core/memory.hpp"
@@ -87,7 +88,8 @@ std::string read_whole_file(const std::filesystem::path& path) {
     if (std::filesystem::is_directory(status)) {
         throw DataError("cannot read " + quote_input(path.string()) + ": it is a directory");
     }
-    io::check_input_file(path, "cannot read " + quote_input(path.string()));
+    // A FIFO is read (docs/height-files.md, "Pipes"), up to the memory budget; a device is not.
+    io::check_input_file(path, "cannot read " + quote_input(path.string()), true);
     std::ifstream in(path, std::ios::binary);
     if (!in) {
         std::string message = "cannot read " + quote_input(path.string());
@@ -108,7 +110,19 @@ std::string read_whole_file(const std::filesystem::path& path) {
         if (in.bad()) throw DataError("cannot read " + quote_input(path.string()) + ": read error");
         in.clear(in.rdstate() & ~std::ios::failbit & ~std::ios::eofbit);
     }
-    bytes.append(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+    // The rest (a pipe: all of it) in chunks, never more than the memory budget.
+    const MemoryBudget budget = memory_budget();
+    std::vector<char> chunk(std::size_t{1} << 20);
+    while (in) {
+        in.read(chunk.data(), static_cast<std::streamsize>(chunk.size()));
+        const auto got = static_cast<std::size_t>(in.gcount());
+        if (static_cast<double>(bytes.size() + got) > budget.bytes)
+            throw DataError(concat("cannot read ", quote_input(path.string()),
+                                   ": it delivers more than the memory limit of ",
+                                   format_gigabytes(budget.bytes), " (", budget.source,
+                                   "; ROUGHSCOPE_MEMORY_LIMIT_GB sets it)"));
+        bytes.append(chunk.data(), got);
+    }
     if (in.bad()) throw DataError("cannot read " + quote_input(path.string()) + ": read error");
     return bytes;
 }

@@ -216,7 +216,8 @@ def test_three_captures_are_fitted(linear_sample, tmp_path):
     (folder / "capture3").mkdir(exist_ok=True)
     _core.write_capture(str(folder / "capture3"), "tiff", scene="plane", width=rm.DEMO_SIZE,
                         height=rm.DEMO_SIZE, theta_i_deg=60.0, exposure_s=first["exposure_s"],
-                        seed=99, **rm._surface(spec), **rm._camera(spec))
+                        seed=99, **rm._surface(spec),
+                        **rm._camera(spec, electrons_per_unit_s=rm.demo_lamp(spec)))
     path = edited(capture_file, tmp_path, lambda d: d["captures"].append(
         {"image": "capture3/capture.tiff", "theta_i_deg": 60.0,
          "exposure_s": first["exposure_s"]}))

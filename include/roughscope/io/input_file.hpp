@@ -15,7 +15,10 @@ namespace roughscope::io {
 // followed) and is a character or block device, a FIFO, a socket or of another special kind.
 // A missing path and a directory are left to the caller's own message (each reader says what it
 // expected). `name` is how the caller names the file in its messages.
-void check_input_file(const std::filesystem::path& path, std::string_view name);
+// With `allow_fifo`, a FIFO passes (a reader that takes a pipe reads it up to a stated cap,
+// e.g. height files up to the memory budget); devices and sockets are still refused.
+void check_input_file(const std::filesystem::path& path, std::string_view name,
+                      bool allow_fifo = false);
 
 // Throws DataError "<name>: <size> bytes, larger than the limit of <limit> for <what>" when the
 // regular file `path` is larger than `max_bytes`, checked before it is read.
