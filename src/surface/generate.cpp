@@ -313,7 +313,8 @@ HeightMap titled(HeightMap map, const GenerationOptions& o) {
 double generation_memory_bytes(const GenerationOptions& o) {
     // The in-place FFT buffer that becomes the map (ny rows of 2·(nx/2 + 1) doubles) and the
     // filter's half spectrum (gain_rows(ny) rows of nx/2 + 1).
-    const double cols = static_cast<double>(o.nx / 2 + 1);
+    const auto half_spectrum_cols = o.nx / 2 + 1;  // r2c: nx/2 + 1 complex columns
+    const double cols = static_cast<double>(half_spectrum_cols);
     return 8.0 * cols * (2.0 * static_cast<double>(o.ny) + static_cast<double>(gain_rows(o.ny)));
 }
 
