@@ -20,6 +20,9 @@ ROUGHSCOPE_WERROR ?= OFF
 # build on a fresh machine already goes through it (a lookup when make reads this file would
 # find nothing there, and the next configure would then rebuild everything).
 export CCACHE_BASEDIR ?= $(CURDIR)
+# The sanitizer and fuzz builds have debug info (-g), for which ccache by default also hashes the
+# working directory: without this, another clone (CI's) would rebuild them cold.
+export CCACHE_NOHASHDIR ?= 1
 LAUNCHER_FLAGS = $$(command -v ccache >/dev/null 2>&1 && echo -DCMAKE_CXX_COMPILER_LAUNCHER=$$(command -v ccache))
 
 CONFIGURE_FLAGS = -G Ninja $(LAUNCHER_FLAGS) \
