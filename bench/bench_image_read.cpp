@@ -31,7 +31,7 @@
 #include <unistd.h>
 
 #include "bench_timing.hpp"
-#include "roughscope/image/read.hpp"
+#include "roughscope/photo/read.hpp"
 
 namespace {
 

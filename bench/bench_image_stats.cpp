@@ -23,8 +23,8 @@
 #include <benchmark/benchmark.h>
 
 #include "bench_timing.hpp"
-#include "roughscope/image/region.hpp"
-#include "roughscope/image/statistics.hpp"
+#include "roughscope/region/region.hpp"
+#include "roughscope/region/statistics.hpp"
 
 namespace {
 

@@ -33,10 +33,10 @@
 #include <unistd.h>
 
 #include "bench_timing.hpp"
-#include "roughscope/image/maps.hpp"
-#include "roughscope/image/read.hpp"
-#include "roughscope/image/registration.hpp"
 #include "roughscope/io/output_file.hpp"
+#include "roughscope/maps/maps.hpp"
+#include "roughscope/maps/registration.hpp"
+#include "roughscope/photo/read.hpp"
 #include "roughscope/simulation/capture.hpp"
 
 namespace {

@@ -21,8 +21,8 @@
 #include <unistd.h>
 
 #include "bench_timing.hpp"
-#include "roughscope/image/measure.hpp"
 #include "roughscope/io/output_file.hpp"
+#include "roughscope/measure/measure.hpp"
 #include "roughscope/simulation/capture.hpp"
 
 namespace {

@@ -31,9 +31,9 @@
 #include <unistd.h>
 
 #include "bench_timing.hpp"
-#include "roughscope/image/cylinder.hpp"
-#include "roughscope/image/read.hpp"
-#include "roughscope/image/sphere.hpp"
+#include "roughscope/objects/cylinder.hpp"
+#include "roughscope/objects/sphere.hpp"
+#include "roughscope/photo/read.hpp"
 
 namespace {
 

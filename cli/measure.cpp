@@ -4,7 +4,7 @@
 // (Eq. 15), with standard errors. The JSON document is serialize/measure.hpp's (the same as the
 // Python module's dict); --report DIR writes the HTML report through the Python package
 // (roughscope.report_measure). Keys and the capture file: docs/measure.md.
-#include "roughscope/image/measure.hpp"
+#include "roughscope/measure/measure.hpp"
 
 #include <filesystem>
 #include <iostream>
@@ -20,8 +20,8 @@
 #include "common.hpp"
 #include "python_runner.hpp"
 #include "roughscope/core/text.hpp"
-#include "roughscope/image/map_files.hpp"
 #include "roughscope/io/output_file.hpp"
+#include "roughscope/maps/map_files.hpp"
 #include "roughscope/serialize/json.hpp"
 #include "roughscope/serialize/measure.hpp"
 

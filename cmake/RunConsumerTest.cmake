@@ -87,8 +87,32 @@ endif()
 
 run("build" "${CMAKE_COMMAND}" --build "${build}" ${config_args})
 
+# --- 3b. the photograph topic alone links neither Ceres nor the fit/brdf/objects topics --------
+# The link command of roughscope_consumer_photo, from the generator's files (Ninja: build.ninja's
+# LINK_LIBRARIES of its link step; Makefiles: the target's link.txt).
+set(photo_link "")
+if(EXISTS "${build}/build.ninja")
+  file(READ "${build}/build.ninja" ninja)
+  string(FIND "${ninja}" "build roughscope_consumer_photo:" start)
+  if(NOT start EQUAL -1)
+    string(SUBSTRING "${ninja}" ${start} -1 ninja)
+    string(REGEX MATCH "LINK_LIBRARIES = [^\n]*" photo_link "${ninja}")
+  endif()
+elseif(EXISTS "${build}/CMakeFiles/roughscope_consumer_photo.dir/link.txt")
+  file(READ "${build}/CMakeFiles/roughscope_consumer_photo.dir/link.txt" photo_link)
+endif()
+if(NOT photo_link MATCHES "roughscope_photo")
+  message(FATAL_ERROR "consumer test: the link command of roughscope_consumer_photo was not found")
+endif()
+foreach(forbidden "ceres" "roughscope_fit" "roughscope_brdf" "roughscope_objects" "roughscope_measure")
+  string(FIND "${photo_link}" "${forbidden}" pos)
+  if(NOT pos EQUAL -1)
+    message(FATAL_ERROR "consumer test: roughscope::photo alone links ${forbidden}:\n${photo_link}")
+  endif()
+endforeach()
+
 # --- 4. run them: the umbrella target and one topic alone ---------------------
-foreach(name roughscope_consumer roughscope_consumer_scattering)
+foreach(name roughscope_consumer roughscope_consumer_scattering roughscope_consumer_photo)
   set(exe "")
   foreach(candidate
       "${build}/${name}"

@@ -3,7 +3,7 @@
 // the answer to anything malformed. Images named in the input are not read (only a `mask`
 // region's file is, which the corpus never names).
 #include "fuzz_target.hpp"
-#include "roughscope/image/measure.hpp"
+#include "roughscope/measure/measure.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
     roughscope::fuzz::expect_only_roughscope_errors([&] {

@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "fuzz_target.hpp"
-#include "roughscope/image/read.hpp"
+#include "roughscope/photo/read.hpp"
 
 namespace {
 

@@ -15,11 +15,11 @@
 #include "bindings.hpp"
 #include "roughscope/core/errors.hpp"
 #include "roughscope/core/text.hpp"
-#include "roughscope/image/image.hpp"
-#include "roughscope/image/measure.hpp"
-#include "roughscope/image/read.hpp"
-#include "roughscope/image/region.hpp"
-#include "roughscope/image/statistics.hpp"
+#include "roughscope/measure/measure.hpp"
+#include "roughscope/photo/image.hpp"
+#include "roughscope/photo/read.hpp"
+#include "roughscope/region/region.hpp"
+#include "roughscope/region/statistics.hpp"
 #include "roughscope/serialize/measure.hpp"
 
 namespace py = pybind11;

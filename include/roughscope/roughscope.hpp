@@ -1,17 +1,22 @@
 // Umbrella header: the whole public API of the roughscope library, every public header of every
-// topic (docs/architecture.md). Link roughscope::roughscope. The version macros are in the
-// generated <roughscope/version.hpp>.
+// topic (docs/architecture.md; tests/python/test_architecture.py checks that none is missing).
+// Link roughscope::roughscope. The version macros are in the generated <roughscope/version.hpp>.
 #pragma once
 
-// core: errors and argument checks, the enum-name scheme, number parsing and formatting
+// core: errors and argument checks, the enum-name scheme, numbers, memory limit, parallel loops,
+// response curves
 #include "roughscope/core/errors.hpp"
+#include "roughscope/core/memory.hpp"
 #include "roughscope/core/names.hpp"
 #include "roughscope/core/numbers.hpp"
+#include "roughscope/core/parallel.hpp"
+#include "roughscope/core/response.hpp"
 #include "roughscope/core/text.hpp"
 
-// io: the CSV reader, atomic output files, the reference-data locator
+// io: the CSV reader, input-file checks, atomic output files, the reference-data locator
 #include "roughscope/io/csv.hpp"
 #include "roughscope/io/data_locator.hpp"
+#include "roughscope/io/input_file.hpp"
 #include "roughscope/io/output_file.hpp"
 
 // scattering: geometry, factors, B-K (Eq. 1-5), retro forms, validity, comparison models, batch
@@ -20,6 +25,7 @@
 #include "roughscope/scattering/brightness_batch.hpp"
 #include "roughscope/scattering/factors.hpp"
 #include "roughscope/scattering/geometry.hpp"
+#include "roughscope/scattering/precomputed_terms.hpp"
 #include "roughscope/scattering/reflectance_models.hpp"
 #include "roughscope/scattering/retro.hpp"
 #include "roughscope/scattering/validity.hpp"
@@ -36,10 +42,11 @@
 #include "roughscope/brdf/curet.hpp"
 #include "roughscope/brdf/table.hpp"
 
-// surface: height maps, their files, statistics and generated surfaces
+// surface: height maps, their files, statistics, generated surfaces, predictions
 #include "roughscope/surface/formats.hpp"
 #include "roughscope/surface/generate.hpp"
 #include "roughscope/surface/height_map.hpp"
+#include "roughscope/surface/predict.hpp"
 #include "roughscope/surface/spectral.hpp"
 #include "roughscope/surface/statistics.hpp"
 
@@ -47,26 +54,37 @@
 #include "roughscope/simulation/capture.hpp"
 #include "roughscope/simulation/kirchhoff.hpp"
 
-// image: photographs on a linear scale, regions, the highlight, response curves, measurements
-#include "roughscope/image/cylinder.hpp"
-#include "roughscope/image/hdr.hpp"
-#include "roughscope/image/image.hpp"
-#include "roughscope/image/map_files.hpp"
-#include "roughscope/image/maps.hpp"
-#include "roughscope/image/measure.hpp"
-#include "roughscope/image/radiometry.hpp"
-#include "roughscope/image/read.hpp"
-#include "roughscope/image/region.hpp"
-#include "roughscope/image/registration.hpp"
-#include "roughscope/image/silhouette.hpp"
-#include "roughscope/image/specular.hpp"
-#include "roughscope/image/sphere.hpp"
-#include "roughscope/image/statistics.hpp"
+// photo: photographs on a linear scale (decoders, metadata, radiometry, HDR)
+#include "roughscope/photo/hdr.hpp"
+#include "roughscope/photo/image.hpp"
+#include "roughscope/photo/radiometry.hpp"
+#include "roughscope/photo/read.hpp"
+
+// region: regions of a photograph, their statistics, the highlight
+#include "roughscope/region/region.hpp"
+#include "roughscope/region/specular.hpp"
+#include "roughscope/region/statistics.hpp"
+
+// maps: registration, per-pixel and per-tile roughness maps, map files
+#include "roughscope/maps/map_files.hpp"
+#include "roughscope/maps/maps.hpp"
+#include "roughscope/maps/registration.hpp"
+
+// objects: curved objects of known shape (silhouette, cylinder, sphere)
+#include "roughscope/objects/cylinder.hpp"
+#include "roughscope/objects/silhouette.hpp"
+#include "roughscope/objects/sphere.hpp"
+
+// measure: the capture file and the measurement
+#include "roughscope/measure/measure.hpp"
 
 // serialize: every result type to JSON, CSV and Markdown
+#include "roughscope/serialize/capture.hpp"
 #include "roughscope/serialize/comparison.hpp"
 #include "roughscope/serialize/estimation.hpp"
 #include "roughscope/serialize/json.hpp"
 #include "roughscope/serialize/measure.hpp"
 #include "roughscope/serialize/model.hpp"
 #include "roughscope/serialize/paper_tables.hpp"
+#include "roughscope/serialize/simulation.hpp"
+#include "roughscope/serialize/surface.hpp"

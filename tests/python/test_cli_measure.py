@@ -72,7 +72,7 @@ def test_json_recovers_the_truth_with_every_headline_key(sample):
     key = f"sigma_over_T_{spec['correlation']}"
     value, err = doc[key], doc[key + "_stderr"]
     assert err > 0
-    # 4σ: a single draw (the ≥ 90 % coverage at 2σ is tests/cpp/image/test_measure.cpp's).
+    # 4σ: a single draw (the ≥ 90 % coverage at 2σ is tests/cpp/measure/test_measure.cpp's).
     assert abs(value - spec["sigma_over_T"]) <= 4 * err, (value, err)
     # σ unknown: no σ, no T.
     assert doc["sigma_um"] is None and doc["T_um"] is None

@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "roughscope/image/measure.hpp"
+#include "roughscope/measure/measure.hpp"
 #include "roughscope/serialize/json.hpp"
 
 namespace roughscope::serialize {
