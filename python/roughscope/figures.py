@@ -41,7 +41,8 @@ def _save(fig, path):
     path."""
     path = pathlib.Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    return save(fig, path)
+    save(fig, path)
+    return path
 
 
 def normalised_retro_curves(equation, m_values=M_VALUES, theta_deg=THETA_DEG):
