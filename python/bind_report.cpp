@@ -8,6 +8,7 @@
 // naming the input and its valid range for a bad value.
 #include <cmath>
 #include <string>
+#include <utility>
 
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
@@ -26,6 +27,29 @@ namespace {
 // A checked numeric argument as a float64 array (real_array: TypeError for a non-real type).
 py::array_t<double> real_doubles(const char* name, py::handle value) {
     return py::array_t<double, py::array::forcecast>::ensure(real_array(name, value));
+}
+
+// Two checked numeric arguments broadcast together with NumPy's rules (views, no copy):
+// InvalidArgument when their shapes do not broadcast, MemoryError (before allocating) when the
+// result would not fit in memory.
+std::pair<py::array_t<double>, py::array_t<double>> broadcast_pair(const char* name_a,
+                                                                   py::handle a,
+                                                                   const char* name_b,
+                                                                   py::handle b) {
+    const py::object np = py::module_::import("numpy");
+    const py::object x = real_doubles(name_a, a);
+    const py::object y = real_doubles(name_b, b);
+    py::list both;
+    try {
+        both = np.attr("broadcast_arrays")(x, y);
+    } catch (const py::error_already_set&) {
+        throw InvalidArgument(std::string(name_a) + " and " + name_b +
+                              " cannot be broadcast together");
+    }
+    const py::array first = py::array::ensure(both[0]);
+    check_allocation(static_cast<double>(first.size()), 1,
+                     "a result of shape " + py::str(first.attr("shape")).cast<std::string>());
+    return {real_doubles(name_a, both[0]), real_doubles(name_b, both[1])};
 }
 
 }  // namespace
@@ -56,7 +80,8 @@ captures and sRGB photographs use, core/response.hpp): 12.92 u for u <= 0.003130
                 check::positive("T_um", T, "um");
                 return surface::acf_model(c, lag, T);
             });
-            return model(real_doubles("lag_um", lag_um), real_doubles("T_um", T_um));
+            const auto [lag, T] = broadcast_pair("lag_um", lag_um, "T_um", T_um);
+            return model(lag, T);
         },
         py::arg("lag_um"), py::arg("T_um"), py::arg("correlation") = "gaussian",
         R"doc(The model autocorrelation function of §3.1 at lag τ (µm) for a correlation length

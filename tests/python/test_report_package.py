@@ -300,6 +300,9 @@ def test_acf_model_is_the_papers_correlation_functions():
         _core.acf_model(1.0, 0.0)
     with pytest.raises(ValueError, match="correlation"):
         _core.acf_model(1.0, 1.0, "lorentzian")
+    with pytest.raises(ValueError, match="lag_um and T_um cannot be broadcast together"):
+        _core.acf_model(np.zeros(2), np.ones(3))
+    assert _core.acf_model(np.zeros((2, 1)), np.ones(3)).shape == (2, 3)
 
 
 def test_the_acf_model_fits_what_surface_statistics_fitted():
