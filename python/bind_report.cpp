@@ -32,8 +32,7 @@ py::array_t<double> real_doubles(const char* name, py::handle value) {
 // Two checked numeric arguments broadcast together with NumPy's rules (views, no copy):
 // InvalidArgument when their shapes do not broadcast, MemoryError (before allocating) when the
 // result would not fit in memory.
-std::pair<py::array_t<double>, py::array_t<double>> broadcast_pair(const char* name_a,
-                                                                   py::handle a,
+std::pair<py::array_t<double>, py::array_t<double>> broadcast_pair(const char* name_a, py::handle a,
                                                                    const char* name_b,
                                                                    py::handle b) {
     const py::object np = py::module_::import("numpy");
