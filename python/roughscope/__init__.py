@@ -24,7 +24,7 @@ def __getattr__(name):
     # Lazy submodules: importing roughscope must not import matplotlib.
     if name in ("figures", "report", "report_estimation", "report_curet", "curet", "plot",
                 "surface_figures", "report_surface", "simulation_figures", "report_simulation",
-                "sweep"):
+                "sweep", "demo", "report_measure", "report_objects"):
         import importlib
 
         return importlib.import_module(f".{name}", __name__)

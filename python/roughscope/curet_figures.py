@@ -10,41 +10,10 @@ command-line entry point (used by ``roughscope curet --plot FILE.png``) is
 atomically (temporary file, then rename). matplotlib is imported only here.
 """
 
-import os
-import tempfile
-
 import numpy as np
 
+from ._plotting import pyplot, save
 from .curet import LABELS, MODELS, PAPER_MODELS
-
-
-def _pyplot():
-    import matplotlib
-
-    if not os.environ.get("MPLBACKEND"):
-        matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    return plt
-
-
-def _save(fig, path):
-    """Save atomically: a temporary file in the target directory, then os.replace."""
-    path = os.fspath(path)
-    directory = os.path.dirname(os.path.abspath(path))
-    suffix = os.path.splitext(path)[1] or ".png"
-    fd, tmp = tempfile.mkstemp(prefix=".tmp-", suffix=suffix, dir=directory)
-    os.close(fd)
-    try:
-        fig.savefig(tmp, dpi=fig.dpi)
-        umask = os.umask(0)
-        os.umask(umask)
-        os.chmod(tmp, 0o666 & ~umask)  # mkstemp's 0600 → the usual permissions
-        os.replace(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.remove(tmp)
-        raise
 
 
 def _title(result):
@@ -112,7 +81,7 @@ def _wrap(text, width):
 def fig10(result, path, models=PAPER_MODELS, gain=False):
     """Fig. 10 for one comparison (dict with 'series'): one panel per model. gain=True plots each
     model times its optimal gain instead of divided by its maximum."""
-    plt = _pyplot()
+    plt = pyplot()
     n = len(models)
     cols = 3 if n > 4 else n
     rows = int(np.ceil(n / cols))
@@ -130,14 +99,14 @@ def fig10(result, path, models=PAPER_MODELS, gain=False):
                  + (", times the optimal gain)" if gain else ", divided by their maxima)"),
                  fontsize=9)
     fig.tight_layout()
-    _save(fig, path)
+    save(fig, path)
     plt.close(fig)
     return path
 
 
 def fig10_paper_layout(results, path, models=PAPER_MODELS):
     """The paper's Fig. 10 layout: one row per model, one column per sample."""
-    plt = _pyplot()
+    plt = pyplot()
     rows, cols = len(models), len(results)
     fig, axes = plt.subplots(rows, cols, figsize=(3.2 * cols, 1.9 * rows), squeeze=False,
                              dpi=110, sharex=True)
@@ -149,7 +118,7 @@ def fig10_paper_layout(results, path, models=PAPER_MODELS):
     for r in range(rows):
         axes[r][0].set_ylabel("normalised", fontsize=7)
     fig.tight_layout()
-    _save(fig, path)
+    save(fig, path)
     plt.close(fig)
     return path
 
@@ -157,7 +126,7 @@ def fig10_paper_layout(results, path, models=PAPER_MODELS):
 def summary(results, path):
     """Database-wide summary: how often each model wins (by the Table-4 metric among the paper's
     methods, and by the gain-optimal SSE with the fits) and the distribution of each error."""
-    plt = _pyplot()
+    plt = pyplot()
     fig, axes = plt.subplots(2, 2, figsize=(12, 8), dpi=100)
 
     def counts(key, candidates):
@@ -197,6 +166,6 @@ def summary(results, path):
         ax.set_title(title, fontsize=9)
     fig.suptitle("CUReT: models against the measured BRDFs of every sample", fontsize=10)
     fig.tight_layout()
-    _save(fig, path)
+    save(fig, path)
     plt.close(fig)
     return path

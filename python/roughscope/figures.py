@@ -13,13 +13,12 @@ matplotlib is imported only here (and only through its object-oriented API, so t
 pyplot state and backend are untouched): ``import roughscope`` works without it.
 """
 
-import os
 import pathlib
-import tempfile
 
 import numpy as np
 
 from . import _core
+from ._plotting import save
 
 #: The σ/T values plotted (the paper mentions 0.71 and 1.8 in §3.4).
 M_VALUES = (0.2, 0.4, 0.71, 1.0, 1.8)
@@ -38,19 +37,11 @@ def _new_figure(width_in=10.0, height_in=4.2):
 
 
 def _save(fig, path):
-    """Save `fig` as PNG at `path` atomically; return the path."""
+    """Save `fig` as PNG at `path` atomically (its folder created when missing); return the
+    path."""
     path = pathlib.Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.stem}-", suffix=".png", dir=path.parent)
-    try:
-        with os.fdopen(fd, "wb") as f:
-            fig.savefig(f, format="png")
-        os.chmod(tmp, 0o644)  # mkstemp creates 0600
-        os.replace(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.remove(tmp)
-        raise
+    save(fig, path)
     return path
 
 

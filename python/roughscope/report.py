@@ -5,9 +5,9 @@ linked relatively) — with:
 
 * a header (library version, date);
 * first, the main job — :mod:`roughscope.report_measure`: synthetic photographs of samples of known
-  roughness written, measured (``roughscope measure``) and the recovered values set against the
-  truth; then :mod:`roughscope.report_objects`: a cylinder (Fig. 8), a sphere and a roughness map
-  of synthetic photographs;
+  roughness written and measured (``roughscope measure``) by :mod:`roughscope.demo`, the
+  recovered values set against the truth; then :mod:`roughscope.report_objects`: a cylinder
+  (Fig. 8), a sphere and a roughness map of synthetic photographs;
 * "Models": the paper's Figs. 3 and 4 (retro-scattering, B–K and V–H) and a table checking the
   closed forms Eq. 7–11 against the library's general forms at the retro geometry;
 * the sections of :mod:`roughscope.report_estimation`, :mod:`roughscope.report_curet`,
@@ -23,7 +23,6 @@ failure a one-line error goes to stderr and the exit status is 1.
 
 import argparse
 import datetime
-import html
 import os
 import pathlib
 import shutil
@@ -33,21 +32,7 @@ import tempfile
 import numpy as np
 
 from . import _core
-
-_CSS = """
-body { font-family: system-ui, -apple-system, "Segoe UI", sans-serif; max-width: 1100px;
-       margin: 2em auto; padding: 0 1em; color: #1d1d1f; line-height: 1.45; }
-h1 { margin-bottom: 0.1em; } h2 { border-bottom: 1px solid #ccc; padding-bottom: 0.2em;
-       margin-top: 2em; }
-.meta { color: #666; margin-top: 0; }
-figure { margin: 1.2em 0; } figure img { max-width: 100%; border: 1px solid #ddd; }
-figcaption { font-size: 0.92em; color: #444; }
-table { border-collapse: collapse; margin: 1em 0; font-size: 0.92em; }
-th, td { border: 1px solid #ccc; padding: 0.25em 0.6em; text-align: right; }
-th { background: #f3f3f3; } td.l, th.l { text-align: left; }
-.pass { color: #0a7d2c; font-weight: 600; } .fail { color: #b00020; font-weight: 600; }
-code { background: #f3f3f3; padding: 0 0.2em; }
-"""
+from ._html import escape, one_line_error, page_html
 
 # Relative agreement required of a closed form and the general form it simplifies.
 CLOSED_FORM_TOLERANCE = 1e-12
@@ -99,7 +84,7 @@ def _closed_form_table(rows):
     for eq, label, t, cv, gv, rel in rows:
         ok = rel <= CLOSED_FORM_TOLERANCE
         out.append(
-            f'<tr><td>{eq}</td><td class="l">{html.escape(label)}</td><td>{t:g}</td>'
+            f'<tr><td>{eq}</td><td class="l">{escape(label)}</td><td>{t:g}</td>'
             f'<td>{cv:.10g}</td><td>{gv:.10g}</td><td>{rel:.2e}</td>'
             f'<td class="{"pass" if ok else "fail"}">{"pass" if ok else "FAIL"}</td></tr>')
     out.append('</table>')
@@ -123,12 +108,12 @@ def models_section(outdir):
 <h2 id="models">Models</h2>
 <p>Retro-scattering (L = V: θi = θs = θ, φs = 180°) for very rough surfaces, paper §3.4. Each
 curve is divided by its value at θ = 0; σ/T = {m_list}; the dashed curve is Lambert's law.</p>
-<figure><img src="{html.escape(fig3.name)}" alt="Figure 3">
+<figure><img src="{escape(fig3.name)}" alt="Figure 3">
 <figcaption>Fig. 3 — original Beckmann–Kirchhoff model (F = F_Beck): (a) Gaussian correlation,
 Eq. 7; (b) exponential correlation, Eq. 8 (logarithmic axis). The 1/cos⁶θ factor makes the
 radiance peak at grazing angles for large σ/T, and Eq. 8 diverges as θ → 90°.</figcaption>
 </figure>
-<figure><img src="{html.escape(fig4.name)}" alt="Figure 4">
+<figure><img src="{escape(fig4.name)}" alt="Figure 4">
 <figcaption>Fig. 4 — Vernold–Harvey modified model (F² = cos θi): (a) Eq. 9; (b) Eq. 10. The
 1/cos θ behaviour stays bounded and tends to 0 at grazing angles; larger σ/T gives a higher
 normalised radiance.</figcaption>
@@ -142,43 +127,25 @@ normalised radiance.</figcaption>
 """
 
 
-def _import_section_module(name):
-    import importlib
-
-    return importlib.import_module(f"roughscope.{name}")
-
-
 def build_report(outdir):
     """Write the full report into `outdir` (an existing, empty folder); return index.html's path."""
+    from . import (demo, report_curet, report_estimation, report_measure, report_objects,
+                   report_simulation, report_surface)
+
     outdir = pathlib.Path(outdir)
     now = datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
-    sections = [_import_section_module("report_measure").section(outdir),
-                _import_section_module("report_objects").section(outdir),
+    sections = [report_measure.section(demo.measure_samples(outdir)),
+                report_objects.section(demo.measure_objects(outdir)),
                 models_section(outdir)]
-    for name in ("report_estimation", "report_curet", "report_surface", "report_simulation"):
-        fragment = _import_section_module(name).section(outdir)
+    for module in (report_estimation, report_curet, report_surface, report_simulation):
+        fragment = module.section(outdir)
         if fragment is not None:
             sections.append(str(fragment))
-    body = "\n".join(sections)
-    page = f"""<!DOCTYPE html>
-<html lang="en">
-<head>
-<meta charset="utf-8">
-<meta name="viewport" content="width=device-width, initial-scale=1">
-<title>roughscope report</title>
-<style>{_CSS}</style>
-</head>
-<body>
-<h1>roughscope report</h1>
-<p class="meta">roughscope {html.escape(_core.__version__)} · generated {now} · Ragheb &amp;
-Hancock, “The modified Beckmann–Kirchhoff scattering theory for rough surface analysis”,
-Pattern Recognition (2007)</p>
-{body}
-</body>
-</html>
-"""
+    meta = (f"roughscope {escape(_core.__version__)} · generated {now} · Ragheb &amp;\n"
+            "Hancock, “The modified Beckmann–Kirchhoff scattering theory for rough surface "
+            "analysis”,\nPattern Recognition (2007)")
     index = outdir / "index.html"
-    index.write_text(page, encoding="utf-8")
+    index.write_text(page_html("\n".join(sections), "roughscope report", meta), encoding="utf-8")
     return index
 
 
@@ -247,8 +214,6 @@ def main(argv=None):
     try:
         index = write_report(args.out)
     except Exception as exc:  # one line, no traceback: this is a command-line tool
-        from .report_measure import one_line_error
-
         print(f"roughscope.report: error: {one_line_error(exc)}", file=sys.stderr)
         return 1
     print(index)

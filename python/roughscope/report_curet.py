@@ -5,19 +5,18 @@ when present), draws Fig. 10 for samples 25, 34 and 41 and a summary of all 61 s
 CUReT directory cannot be found the section is a short note saying so.
 """
 
-import html
+import functools
 import json
 from pathlib import Path
 
 from . import _core
+from ._html import escape, number, relative_difference
 
 _PAPER_SAMPLES = (25, 34, 41)
+# The tables of this section show a missing value as an em dash.
+_num = functools.partial(number, missing="—")
 _TABLE4_KEYS = ("oren_nayar", "lafortune", "bk_gaussian", "bk_exponential", "vh_gaussian",
                 "vh_exponential")
-
-
-def _e(text):
-    return html.escape(str(text))
 
 
 def _paper_tables(data_dir):
@@ -30,16 +29,6 @@ def _paper_tables(data_dir):
         return json.load(f)
 
 
-def _num(v, spec):
-    return "—" if v is None else format(v, spec)
-
-
-def _rel(v, printed):
-    if v is None or printed in (None, 0):
-        return "—"
-    return f"{100.0 * (v - printed) / printed:+.3f} %"
-
-
 def section(outdir):
     """Return the HTML fragment (figures are written into outdir)."""
     from . import curet
@@ -50,7 +39,7 @@ def section(outdir):
         data_dir = curet.find_directory()
     except _core.DataError as e:
         return (head + "<p><em>Skipped: the CUReT directory was not found.</em> "
-                f"{_e(e)}</p>\n")
+                f"{escape(e)}</p>\n")
 
     db = curet.load(data_dir)
     paper = _paper_tables(data_dir)
@@ -77,7 +66,7 @@ def section(outdir):
 
     out = [head]
     out.append(
-        f"<p>Data: {_e(data_dir)} (abrdf.dat, table.txt; {db.brdf.shape[0]} samples × "
+        f"<p>Data: {escape(data_dir)} (abrdf.dat, table.txt; {db.brdf.shape[0]} samples × "
         f"{db.brdf.shape[1]} measurements). Brightness E = f cos θ<sub>i</sub>; geometry in the "
         "paper's frame θ<sub>s</sub> = θ<sub>v</sub>, φ<sub>s</sub> = φ<sub>v</sub> − "
         "φ<sub>i</sub> + π. "
@@ -95,7 +84,7 @@ def section(outdir):
         r, n, p = results[s], nominal[s], t3.get(s, {})
         on = r["models"]["oren_nayar"]["parameters"]
         out.append(
-            f"<tr><td>{s} {_e(r['name'] or '')}</td><td>{_num(r['E1_over_E2'], '.6f')}</td>"
+            f"<tr><td>{s} {escape(r['name'] or '')}</td><td>{_num(r['E1_over_E2'], '.6f')}</td>"
             f"<td>{_num(n['E1_over_E2'], '.6f')}</td><td>{_num(p.get('E1_over_E2'), '.6f')}</td>"
             f"<td>{_num(r['sigma_over_T_gaussian'], '.4f')}</td>"
             f"<td>{_num(p.get('sigma_over_T_G'), '.4f')}</td>"
@@ -117,7 +106,7 @@ def section(outdir):
     # Table 4 ------------------------------------------------------------------------------
     out.append("<h3>Table 4: error per model (recomputed / printed / difference)</h3>\n")
     out.append("<table>\n<tr><th>sample</th>"
-               + "".join(f"<th>{_e(curet.LABELS[k])}</th>" for k in _TABLE4_KEYS) + "</tr>\n")
+               + "".join(f"<th>{escape(curet.LABELS[k])}</th>" for k in _TABLE4_KEYS) + "</tr>\n")
     for s in _PAPER_SAMPLES:
         r = results[s]
         printed = t4.get(s, [None] * 6)
@@ -125,8 +114,8 @@ def section(outdir):
         for k, pv in zip(_TABLE4_KEYS, printed):
             v = r["sse"][k]
             cells.append(f"<td>{_num(v, '.3f')}<br><small>{_num(pv, 'g')}<br>"
-                         f"{_rel(v, pv)}</small></td>")
-        out.append(f"<tr><td>{s} {_e(r['name'] or '')}</td>{''.join(cells)}</tr>\n")
+                         f"{relative_difference(v, pv)}</small></td>")
+        out.append(f"<tr><td>{s} {escape(r['name'] or '')}</td>{''.join(cells)}</tr>\n")
     out.append("</table>\n")
     out.append(
         "<p>Error = Σ over the 205 measurements of (M/max M − d/max d)², d = f cos θ<sub>i</sub> "
@@ -172,7 +161,7 @@ def section(outdir):
                'style="max-width:100%"></p>\n')
     out.append(
         "<p>Winner by the Table-4 error among the paper's methods: "
-        + ", ".join(f"{_e(curet.LABELS[k])} {v}" for k, v in
+        + ", ".join(f"{escape(curet.LABELS[k])} {v}" for k, v in
                     sorted(wins.items(), key=lambda kv: -kv[1]))
         + f". Non-positive BRDF values: {nonpos} (kept in every error sum and fit). Two-point "
         "estimate unavailable for sample(s) "
@@ -180,7 +169,7 @@ def section(outdir):
         + " (non-positive f at measurement 81 or 112).</p>\n")
     out.append("<table>\n<tr><th>sample</th><th>E1/E2</th><th>σ/T<sub>G</sub></th>"
                "<th>σ/T<sub>E</sub></th>"
-               + "".join(f"<th>{_e(curet.LABELS[k])}</th>" for k in _TABLE4_KEYS)
+               + "".join(f"<th>{escape(curet.LABELS[k])}</th>" for k in _TABLE4_KEYS)
                + "<th>best (gain SSE, fits incl.)</th><th>notes</th></tr>\n")
     for r in everything:
         notes = []
@@ -194,7 +183,7 @@ def section(outdir):
             f"<td>{_num(r['sigma_over_T_gaussian'], '.4f')}</td>"
             f"<td>{_num(r['sigma_over_T_exponential'], '.4f')}</td>"
             + "".join(f"<td>{_num(r['sse'][k], '.3f')}</td>" for k in _TABLE4_KEYS)
-            + f"<td>{_e(curet.LABELS.get(r['winner'], '—'))}</td>"
-            f"<td>{_e('; '.join(notes))}</td></tr>\n")
+            + f"<td>{escape(curet.LABELS.get(r['winner'], '—'))}</td>"
+            f"<td>{escape('; '.join(notes))}</td></tr>\n")
     out.append("</table>\n")
     return "".join(out)

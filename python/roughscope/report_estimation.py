@@ -9,15 +9,11 @@ or "≠". A figure shows σ/T against E1/E2 for the Table 2 geometry with the va
 and Eq. 19 and the Table 2 surfaces.
 """
 
-import html
 import json
 from pathlib import Path
 
 from . import _core
-
-
-def _e(text):
-    return html.escape(str(text))
+from ._html import escape, linked_figure
 
 
 def find_paper_tables():
@@ -52,7 +48,7 @@ def _cell(entry, digits):
     printed, value, mark, _lo, _hi = entry
     cls = {"=": "ok", "≈": "near", "≠": "bad"}[mark]
     return (f"<td>{printed:.{digits}f}</td><td class='{cls}'>{value:.{digits + 1}f} "
-            f"{_e(mark)}</td>")
+            f"{escape(mark)}</td>")
 
 
 def _figure(tables, outdir):
@@ -115,7 +111,7 @@ def section(outdir):
                  "<th>σ (µm)</th><th>recomputed</th><th>E1/E2</th><th>T (µm)</th>"
                  "<th>recomputed</th><th>σ/T</th><th>recomputed</th></tr>\n")
     for row in rec["table1"]:
-        parts.append(f"<tr><td>{_e(row['surface'])}</td><td>{row['R_spec']:.3f}</td>"
+        parts.append(f"<tr><td>{escape(row['surface'])}</td><td>{row['R_spec']:.3f}</td>"
                      f"{_cell(row['sigma_um'], 3)}<td>{row['E1_over_E2']:.3f}</td>"
                      f"{_cell(row['T_um'], 3)}{_cell(row['sigma_over_T'], 3)}</tr>\n")
     parts.append("</table>\n<p>Porcelain and plastic: σ from the printed R_spec = 0.003 and "
@@ -128,7 +124,7 @@ def section(outdir):
                  "<th>recomputed</th><th>θK (°)</th><th>recomputed</th><th>ξK (%)</th>"
                  "<th>recomputed</th></tr>\n")
     for row in rec["table2"]:
-        parts.append(f"<tr><td>{_e(row['surface'])}</td><td>{row['E1_over_E2']:.3f}</td>"
+        parts.append(f"<tr><td>{escape(row['surface'])}</td><td>{row['E1_over_E2']:.3f}</td>"
                      f"{_cell(row['sigma_over_T_G'], 4)}{_cell(row['sigma_over_T_E'], 4)}"
                      f"{_cell(row['theta_K_deg'], 0)}{_cell(row['xi_K_percent'], 1)}</tr>\n")
     parts.append("</table>\n<p>E1/E2 is printed to 3 decimals, which moves σ/T by up to ~0.03: "
@@ -138,14 +134,14 @@ def section(outdir):
                  "<th>sample</th><th>E1/E2</th><th>σ/T_G</th><th>recomputed</th><th>σ/T_E</th>"
                  "<th>recomputed</th></tr>\n")
     for row in rec["table3"]:
-        parts.append(f"<tr><td>{_e(row['sample'])}</td><td>{row['E1_over_E2']:.6f}</td>"
+        parts.append(f"<tr><td>{escape(row['sample'])}</td><td>{row['E1_over_E2']:.6f}</td>"
                      f"{_cell(row['sigma_over_T_G'], 4)}{_cell(row['sigma_over_T_E'], 4)}</tr>\n")
     parts.append("</table>\n<p>The text of §5.3 gives θ1 = 45.5° for CUReT measurement 81, but "
                  "the printed slopes are reproduced to all four digits only with θ1 = 45°.</p>\n")
     outdir.mkdir(parents=True, exist_ok=True)
     name = _figure(tables, outdir)
     if name:
-        parts.append(f"<figure><img src='{_e(name)}' alt='sigma/T against E1/E2'>"
-                     "<figcaption>σ/T from the brightness ratio (Eq. 17, 19) with the printed "
-                     "Table 2 values.</figcaption></figure>\n")
+        parts.append(linked_figure(name, "sigma/T against E1/E2",
+                                   "σ/T from the brightness ratio (Eq. 17, 19) with the printed "
+                                   "Table 2 values.") + "\n")
     return "".join(parts)

@@ -13,21 +13,16 @@ Every number comes from :func:`roughscope.simulate_scatter` with fixed seeds (th
 reproducible); the realisations are kept small so that the report builds in about a minute.
 """
 
-import html
-
 import numpy as np
 
 from . import _core
+from ._html import escape, fmt, linked_figure
 
 LAMBDA_UM = 0.5
 T_UM = 1.0
 THETA_I = 30.0
 SIGMAS = [("g ≈ 0.3", 0.023), ("g ≈ 2", 0.06), ("g ≈ 10", 0.135)]
 REALISATIONS = 100
-
-
-def _e(text):
-    return html.escape(str(text))
 
 
 def _geometries():
@@ -74,15 +69,15 @@ def _validation(outdir):
     figure = ""
     try:
         simulation_figures.validation_figure(panels, outdir / name)
-        figure = (f"<figure><img src='{name}' alt='simulated against series'><figcaption>"
-                  f"Diffuse power × A/T² at θi = {THETA_I:g}° across the plane of incidence: "
-                  f"lines the exact series (Eq. 2; the exact exponential series), points the "
-                  f"Monte Carlo ({REALISATIONS} surfaces per point, ±2 standard errors). Dashed: "
-                  "the paper's Eq. 5 at g ≈ 10, which the simulation does not follow."
-                  "</figcaption></figure>")
+        figure = linked_figure(
+            name, "simulated against series",
+            f"Diffuse power × A/T² at θi = {THETA_I:g}° across the plane of incidence: lines "
+            "the exact series (Eq. 2; the exact exponential series), points the Monte Carlo "
+            f"({REALISATIONS} surfaces per point, ±2 standard errors). Dashed: the paper's Eq. 5 "
+            "at g ≈ 10, which the simulation does not follow.")
     except ImportError:
         pass
-    rows = "".join(f"<tr><td class='l'>{_e(c)}</td><td class='l'>{_e(l)}</td><td>{n}</td>"
+    rows = "".join(f"<tr><td class='l'>{escape(c)}</td><td class='l'>{escape(l)}</td><td>{n}</td>"
                    f"<td>{m:.2f}</td><td>{r:.2f}</td></tr>" for c, l, n, m, r in table)
     return figure + ("<table><tr><th class='l'>correlation</th><th class='l'>roughness</th>"
                      "<th>geometries</th><th>max |deviation| (s.e.)</th><th>RMS deviation "
@@ -108,7 +103,7 @@ def _moderately_rough():
         out.append((r, forms))
     rows = "".join(
         f"<tr><td>{r['theta_s_deg']:g}</td><td>{r['g']:.2f}</td>"
-        f"<td>{r['diffuse']:.4g} ± {r['diffuse_stderr']:.2g}</td><td>{r['series_diffuse']:.4g}</td>"
+        f"<td>{fmt(r['diffuse'], r['diffuse_stderr'])}</td><td>{r['series_diffuse']:.4g}</td>"
         f"<td>{f['slightly_rough']:.4g}</td><td>{f['very_rough']:.4g}</td>"
         f"<td>{f['very_rough_series_limit']:.4g}</td></tr>" for r, f in out)
     return ("<table><tr><th>θs</th><th>g</th><th>simulated</th><th>exact series</th>"
@@ -127,7 +122,7 @@ def _finite_patch():
                                            seed=11)["results"][0]
                 q = r["diffuse"] / r["series_diffuse"]
                 e = r["diffuse_stderr"] / r["series_diffuse"]
-                cells.append(f"<td>{q:.3f} ± {e:.3f}</td>")
+                cells.append(f"<td>{fmt(q, e, decimals=3)}</td>")
         rows.append(f"<tr><td>{L}</td>{''.join(cells)}</tr>")
     return ("<table><tr><th>L/T</th><th>Gaussian, periodic lattice</th><th>Gaussian, finite "
             "patch</th><th>exponential, periodic lattice</th><th>exponential, finite patch</th>"
@@ -194,19 +189,20 @@ def section(outdir):
     figure = ""
     try:
         simulation_figures.estimator_figure(rows, outdir / name)
-        figure = (f"<figure><img src='{name}' alt='estimated against true sigma/T'><figcaption>"
-                  "σ/T from the simulated brightness ratio at the paper's two geometry pairs "
-                  "(camera on the normal), inverted by Eq. 17 (Gaussian) and Eq. 19 "
-                  "(exponential), against the σ/T the surfaces were generated with (T = "
-                  f"{T_ESTIMATOR_UM} µm, λ = {LAMBDA_UM} µm; ±2 standard errors from the "
-                  "simulation's).</figcaption></figure>")
+        figure = linked_figure(
+            name, "estimated against true sigma/T",
+            "σ/T from the simulated brightness ratio at the paper's two geometry pairs (camera "
+            "on the normal), inverted by Eq. 17 (Gaussian) and Eq. 19 (exponential), against "
+            f"the σ/T the surfaces were generated with (T = {T_ESTIMATOR_UM} µm, λ = "
+            f"{LAMBDA_UM} µm; ±2 standard errors from the simulation's).")
     except ImportError:
         pass
     est_rows = "".join(
-        f"<tr><td class='l'>{_e(r['correlation'])}</td><td class='l'>{_e(r['pair'])}</td>"
+        f"<tr><td class='l'>{escape(r['correlation'])}</td><td class='l'>{escape(r['pair'])}</td>"
         f"<td>{r['true']:g}</td><td>{r['g1']:.3g}</td>"
-        + (f"<td>{r['estimate']:.3g} ± {r['stderr']:.2g}</td><td>{r['estimate'] / r['true'] - 1:+.0%}"
-           "</td>" if r["estimate"] is not None else "<td>no solution</td><td>–</td>")
+        + (f"<td>{fmt(r['estimate'], r['stderr'], digits=3)}</td>"
+           f"<td>{r['estimate'] / r['true'] - 1:+.0%}</td>" if r["estimate"] is not None
+           else "<td>no solution</td><td>–</td>")
         + (f"<td>{r['series_estimate']:.3g}</td>" if r["series_estimate"] is not None
            else "<td>no solution</td>")
         + "</tr>" for r in rows)

@@ -6,7 +6,7 @@ scatter --json``). Figures are written atomically; matplotlib is imported only h
 
 import numpy as np
 
-from .curet_figures import _pyplot, _save
+from ._plotting import pyplot, save
 
 
 def signed_theta_s(result):
@@ -21,7 +21,7 @@ def validation_figure(panels, out):
     dicts {label, document, theta_deg (dense θs grid, signed), series (D·A/T² on that grid),
     paper (optional: the paper's very-rough form on that grid)}. Points: D·A/T² with ±2 standard
     errors from the document's results."""
-    plt = _pyplot()
+    plt = pyplot()
     fig, axes = plt.subplots(1, len(panels), figsize=(6.2 * len(panels), 4.6), dpi=110,
                              squeeze=False)
     colours = ["#1f77b4", "#d62728", "#2ca02c", "#9467bd", "#ff7f0e"]
@@ -46,14 +46,14 @@ def validation_figure(panels, out):
         ax.grid(True, alpha=0.3)
         ax.legend(fontsize=7, loc="lower center")
     fig.tight_layout()
-    _save(fig, out)
+    save(fig, out)
     plt.close(fig)
 
 
 def estimator_figure(rows, out):
     """σ/T estimated from simulated brightness ratios against the true σ/T. ``rows``: dicts
     {correlation, pair (label), true, estimate (or None), stderr, series_estimate (or None)}."""
-    plt = _pyplot()
+    plt = pyplot()
     fig, axes = plt.subplots(1, 2, figsize=(11, 4.4), dpi=110)
     markers = {"30°/45°": "o", "45.5°/67.5°": "s"}
     for ax, corr in zip(axes, ["gaussian", "exponential"]):
@@ -82,5 +82,5 @@ def estimator_figure(rows, out):
         ax.grid(True, alpha=0.3, which="both")
         ax.legend(fontsize=8)
     fig.tight_layout()
-    _save(fig, out)
+    save(fig, out)
     plt.close(fig)

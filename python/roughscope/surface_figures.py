@@ -13,7 +13,8 @@ import math
 
 import numpy as np
 
-from .curet_figures import _pyplot, _save
+from . import _core
+from ._plotting import pyplot, save
 
 
 def image_from_heights(heights_um, dx_um, dy_um=None, max_side=512):
@@ -35,8 +36,6 @@ def image_from_heights(heights_um, dx_um, dy_um=None, max_side=512):
 def document(heights_um, dx_um, dy_um=None, **options):
     """The figure's document from heights: :func:`roughscope.surface_statistics` with curves and
     the heights as given (not levelled) as the image."""
-    from . import _core
-
     stats = _core.surface_statistics(heights_um, dx_um, dy_um, curves=True, **options)
     stats["image"] = image_from_heights(heights_um, dx_um, dy_um)
     return stats
@@ -65,7 +64,7 @@ def check_document(doc):
 def stats_figure(doc, path):
     """Draw the three panels (height image, ACF with fits and 1/e line, PSD) into `path`."""
     check_document(doc)
-    plt = _pyplot()
+    plt = pyplot()
     fig, axes = plt.subplots(1, 3, figsize=(15.0, 4.6))
     try:
         # Height image.
@@ -93,14 +92,12 @@ def stats_figure(doc, path):
         t = np.linspace(0.0, tau.max() if tau.size else 1.0, 400)
         tg, te = doc.get("T_fit_gaussian_um"), doc.get("T_fit_exponential_um")
         best = doc.get("correlation")
-        if tg:
-            ax.plot(t, np.exp(-(t / tg) ** 2), "C0", lw=2 if best == "gaussian" else 1,
-                    label=f"Gaussian fit, T = {tg:.4g} µm" + (" (AIC)" if best == "gaussian"
-                                                              else ""))
-        if te:
-            ax.plot(t, np.exp(-t / te), "C3", lw=2 if best == "exponential" else 1,
-                    label=f"exponential fit, T = {te:.4g} µm" + (" (AIC)" if best ==
-                                                                  "exponential" else ""))
+        for T_fit, correlation, name, colour in ((tg, "gaussian", "Gaussian", "C0"),
+                                                 (te, "exponential", "exponential", "C3")):
+            if T_fit:  # the model ACF of §3.1 with the fitted T
+                chosen = best == correlation
+                ax.plot(t, _core.acf_model(t, T_fit, correlation), colour, lw=2 if chosen else 1,
+                        label=f"{name} fit, T = {T_fit:.4g} µm" + (" (AIC)" if chosen else ""))
         ax.axhline(math.exp(-1.0), color="C2", ls="--", lw=1, label="1/e")
         if doc.get("T_um"):
             ax.axvline(doc["T_um"], color="C2", ls=":", lw=1,
@@ -128,7 +125,7 @@ def stats_figure(doc, path):
         if ax.get_legend_handles_labels()[0]:
             ax.legend(fontsize=8)
         fig.tight_layout()
-        _save(fig, path)
+        save(fig, path)
     finally:
         plt.close(fig)
     return str(path)

@@ -201,18 +201,18 @@ std::optional<double> correlation_length_1e(const Curve& acf) {
     return std::nullopt;
 }
 
-namespace {
-
-double model_acf(Correlation model, double tau, double T) {
-    const double r = std::abs(tau) / T;
+double acf_model(Correlation model, double lag_um, double T_um) {
+    const double r = std::abs(lag_um) / T_um;
     return model == Correlation::Gaussian ? std::exp(-r * r) : std::exp(-r);
 }
+
+namespace {
 
 double residual_sum(const std::vector<double>& x, const std::vector<double>& y, Correlation model,
                     double T) {
     double rss = 0;
     for (std::size_t j = 0; j < x.size(); ++j) {
-        const double d = y[j] - model_acf(model, x[j], T);
+        const double d = y[j] - acf_model(model, x[j], T);
         rss += d * d;
     }
     return rss;

@@ -1,6 +1,6 @@
 """Tests of `roughscope measure CAPTURE.json` (roughness from photographs, docs/measure.md).
 
-The photographs are synthetic captures of known σ/T (roughscope.report_measure.write_demo_sample:
+The photographs are synthetic captures of known σ/T (roughscope.demo.write_sample:
 the simulation topic's camera, written as 16-bit linear TIFF, 8-bit sRGB PNG or DNG). Each
 success test has a failure companion asserting the exit code and the one-line message.
 """
@@ -39,19 +39,19 @@ def fails(code, *args, cwd=None):
 
 @pytest.fixture(scope="module", params=[0, 1, 2], ids=["srgb8-png", "linear16-tiff", "dng"])
 def sample(request, tmp_path_factory):
-    from roughscope import report_measure
+    from roughscope import demo
 
-    spec = report_measure.DEMO_SAMPLES[request.param]
+    spec = demo.SAMPLES[request.param]
     folder = tmp_path_factory.mktemp(spec["name"])
-    return spec, report_measure.write_demo_sample(spec, folder)
+    return spec, demo.write_sample(spec, folder)
 
 
 @pytest.fixture(scope="module")
 def linear_sample(tmp_path_factory):
-    from roughscope import report_measure
+    from roughscope import demo
 
-    spec = report_measure.DEMO_SAMPLES[1]
-    return spec, report_measure.write_demo_sample(spec, tmp_path_factory.mktemp("linear"))
+    spec = demo.SAMPLES[1]
+    return spec, demo.write_sample(spec, tmp_path_factory.mktemp("linear"))
 
 
 def edited(capture_file, tmp_path, change):
@@ -208,16 +208,16 @@ def test_report_into_a_file_fails_and_leaves_it(linear_sample, tmp_path):
 
 
 def test_three_captures_are_fitted(linear_sample, tmp_path):
-    from roughscope import _core, report_measure as rm
+    from roughscope import _core, demo
 
     spec, capture_file = linear_sample
     folder = pathlib.Path(capture_file).parent
     first = json.loads(pathlib.Path(capture_file).read_text())["captures"][0]
     (folder / "capture3").mkdir(exist_ok=True)
-    _core.write_capture(str(folder / "capture3"), "tiff", scene="plane", width=rm.DEMO_SIZE,
-                        height=rm.DEMO_SIZE, theta_i_deg=60.0, exposure_s=first["exposure_s"],
-                        seed=99, **rm._surface(spec),
-                        **rm._camera(spec, electrons_per_unit_s=rm.demo_lamp(spec)))
+    _core.write_capture(str(folder / "capture3"), "tiff", scene="plane", width=demo.SIZE,
+                        height=demo.SIZE, theta_i_deg=60.0, exposure_s=first["exposure_s"],
+                        seed=99, **demo.surface_keywords(spec),
+                        **demo.sample_camera(spec, electrons_per_unit_s=demo.lamp(spec)))
     path = edited(capture_file, tmp_path, lambda d: d["captures"].append(
         {"image": "capture3/capture.tiff", "theta_i_deg": 60.0,
          "exposure_s": first["exposure_s"]}))

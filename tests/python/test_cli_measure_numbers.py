@@ -60,10 +60,10 @@ def test_a_larger_region_keeps_its_standard_errors_and_notes_eq5(tmp_path):
     assert any("Eq. 5" in w and "exact Kirchhoff series" in w for w in doc["warnings"])
 
 
-@pytest.mark.parametrize("writer", ["write_cylinder_demo", "write_map_demo"])
+@pytest.mark.parametrize("writer", ["write_cylinder", "write_map"])
 def test_a_cylinder_profile_and_a_map_with_an_exponential_value_note_eq5(tmp_path, writer):
-    from roughscope import report_objects
+    from roughscope import demo
 
-    doc = run_json(getattr(report_objects, writer)(tmp_path))
+    doc = run_json(getattr(demo, writer)(tmp_path))
     assert doc["sigma_over_T_exponential"] is not None or doc["map"] is not None
     assert sum("exact Kirchhoff series" in w for w in doc["warnings"]) == 1

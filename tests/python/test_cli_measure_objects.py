@@ -1,9 +1,9 @@
 """Tests of `roughscope measure` on curved objects and maps (docs/measure.md "Curved objects and
 maps"): a cylinder (§5.2), a sphere, a flat sample with three regions made into a roughness map.
 
-The photographs are the report's synthetic demo captures (roughscope.report_objects: 14-bit
-linear TIFF with shot and read noise, V–H truth of known σ/T). Each success test has a failure
-companion asserting the exit code and the one-line message.
+The photographs are the report's synthetic demo captures (roughscope.demo: 14-bit linear TIFF
+with shot and read noise, V–H truth of known σ/T). Each success test has a failure companion
+asserting the exit code and the one-line message.
 """
 
 import json
@@ -45,30 +45,30 @@ def edited(capture_file, name, change):
 
 @pytest.fixture(scope="module")
 def cylinder(tmp_path_factory):
-    from roughscope import report_objects
+    from roughscope import demo
 
-    return report_objects.write_cylinder_demo(tmp_path_factory.mktemp("cylinder"))
+    return demo.write_cylinder(tmp_path_factory.mktemp("cylinder"))
 
 
 @pytest.fixture(scope="module")
 def sphere(tmp_path_factory):
-    from roughscope import report_objects
+    from roughscope import demo
 
-    return report_objects.write_sphere_demo(tmp_path_factory.mktemp("sphere"))
+    return demo.write_sphere(tmp_path_factory.mktemp("sphere"))
 
 
 @pytest.fixture(scope="module")
 def flat_map(tmp_path_factory):
-    from roughscope import report_objects
+    from roughscope import demo
 
-    return report_objects.write_map_demo(tmp_path_factory.mktemp("map"))
+    return demo.write_map(tmp_path_factory.mktemp("map"))
 
 
 # --------------------------------------------------------------------------------------------
 # Cylinder
 
 def test_cylinder_profile_keys_and_the_fitted_sigma_over_T(cylinder):
-    from roughscope import report_objects
+    from roughscope import demo
 
     doc = json.loads(run(cylinder, "--json").stdout)
     cyl = doc["cylinder"]
@@ -81,7 +81,7 @@ def test_cylinder_profile_keys_and_the_fitted_sigma_over_T(cylinder):
     assert theta == sorted(theta) and 0 <= theta[0] < 5 and theta[-1] > 70
     # Normalised as the paper (§2): the brightest bin is 1.
     assert max(r["brightness"] for r in rows) == pytest.approx(1.0)
-    truth = report_objects.CYLINDER_SIGMA_OVER_T
+    truth = demo.CYLINDER_SIGMA_OVER_T
     value, err = cyl["sigma_over_T_gaussian"], cyl["sigma_over_T_gaussian_stderr"]
     assert err > 0 and abs(value - truth) <= 4 * err, (value, err)
     assert doc["sigma_over_T_gaussian"] == value
@@ -162,7 +162,7 @@ def test_an_image_without_an_object_is_a_data_error(cylinder, tmp_path):
 # Sphere
 
 def test_sphere_comparison_prefers_the_true_model(sphere):
-    from roughscope import report_objects
+    from roughscope import demo
 
     doc = json.loads(run(sphere, "--json").stdout)
     sph = doc["sphere"]
@@ -171,7 +171,7 @@ def test_sphere_comparison_prefers_the_true_model(sphere):
     assert comp["winner"] in ("vh_gaussian_fit",), comp["winner"]
     fit = comp["models"]["vh_gaussian_fit"]
     value, err = fit["parameters"]["sigma_over_T"], fit["standard_errors"]["sigma_over_T"]
-    assert err > 0 and abs(value - report_objects.SPHERE_SIGMA_OVER_T) <= 4 * err, (value, err)
+    assert err > 0 and abs(value - demo.SPHERE_SIGMA_OVER_T) <= 4 * err, (value, err)
     assert sph["circle"]["source"] == "given" and sph["circle"]["radius_px"] == 64
 
 
@@ -184,14 +184,14 @@ def test_sphere_with_a_map_request_is_refused(sphere):
 # Maps
 
 def test_map_regions_recover_the_truth_and_files_are_written(flat_map, tmp_path):
-    from roughscope import report_objects
+    from roughscope import demo
 
     out = tmp_path / "maps"
     doc = json.loads(run(flat_map, "--json", "--maps", out).stdout)
     m = doc["map"]
-    assert m["window_px"] == report_objects.MAP_WINDOW_PX
-    assert m["width"] == report_objects.MAP_SIZE // report_objects.MAP_WINDOW_PX
-    truth = dict(report_objects.MAP_REGIONS)
+    assert m["window_px"] == demo.MAP_WINDOW_PX
+    assert m["width"] == demo.MAP_SIZE // demo.MAP_WINDOW_PX
+    truth = dict(demo.MAP_REGIONS)
     classes = {"slightly rough": "slightly_rough", "moderately rough": "moderately_rough",
                "very rough": "very_rough"}
     for r in m["regions"]:
@@ -214,7 +214,7 @@ def test_map_regions_recover_the_truth_and_files_are_written(flat_map, tmp_path)
     layer = np.load(out / "sigma_over_T_gaussian.npy")
     assert layer.shape == (m["height"], m["width"]) and layer.dtype == np.float32
     # The .npy agrees with the region statistics: the mean over the top right quarter's tiles.
-    q = report_objects.MAP_SIZE // 2 // report_objects.MAP_WINDOW_PX
+    q = demo.MAP_SIZE // 2 // demo.MAP_WINDOW_PX
     quarter = layer[1:q - 1, q + 1:2 * q - 1]
     assert np.nanmean(quarter) == pytest.approx(truth["moderately rough"], rel=0.1)
     # The Python module returns the same layers.
@@ -267,13 +267,13 @@ def test_map_layers_of_both_correlations_and_the_ratio_on_request(flat_map, tmp_
 def test_a_shifted_pair_is_refused_with_the_shift(flat_map, tmp_path):
     folder = pathlib.Path(flat_map).parent
     spec = json.loads(pathlib.Path(flat_map).read_text())
-    from roughscope import report_objects
+    from roughscope import demo
 
     # The second photograph moved 5 px to the right.
     shifted_dir = folder / "shifted"
     shifted_dir.mkdir(exist_ok=True)
-    report_objects.write_map_capture(shifted_dir, 1, 45.0, spec["captures"][1]["exposure_s"],
-                                     shift_px=5)
+    demo.write_map_capture(shifted_dir, 1, 45.0, spec["captures"][1]["exposure_s"],
+                           shift_px=5)
     spec["captures"][1]["image"] = "shifted/capture.tiff"
     path = folder / "shifted.json"
     path.write_text(json.dumps(spec))

@@ -49,17 +49,17 @@ def snapshot(folder):
 
 @pytest.fixture()
 def sample(tmp_path):
-    from roughscope import report_measure
+    from roughscope import demo
 
-    spec = report_measure.DEMO_SAMPLES[1]
-    return report_measure.write_demo_sample(spec, tmp_path / "photos")
+    spec = demo.SAMPLES[1]
+    return demo.write_sample(spec, tmp_path / "photos")
 
 
 @pytest.fixture(scope="module")
 def flat_map(tmp_path_factory):
-    from roughscope import report_objects
+    from roughscope import demo
 
-    return report_objects.write_map_demo(tmp_path_factory.mktemp("map"))
+    return demo.write_map(tmp_path_factory.mktemp("map"))
 
 
 def test_report_into_a_folder_of_the_users_touches_nothing_else(sample, tmp_path):

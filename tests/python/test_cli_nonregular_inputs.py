@@ -136,10 +136,10 @@ def test_an_endless_pipe_as_a_height_file_stops_at_the_memory_limit(tmp_path, re
 
 @pytest.fixture(scope="module")
 def capture_file(tmp_path_factory):
-    from roughscope import report_measure
+    from roughscope import demo
 
-    spec = report_measure.DEMO_SAMPLES[1]
-    return report_measure.write_demo_sample(spec, tmp_path_factory.mktemp("sample"))
+    spec = demo.SAMPLES[1]
+    return demo.write_sample(spec, tmp_path_factory.mktemp("sample"))
 
 
 # A file the capture file names: the first capture's image, the region's mask, the dark frame.

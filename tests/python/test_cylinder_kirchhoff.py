@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 import roughscope as rs
-from roughscope import _core, report_objects
+from roughscope import _core, demo
 
 SIGMA_OVER_T = 0.4  # θK = 90° − atan(√2 · 0.4) = 60.5°
 THETA_K_DEG = 90.0 - np.degrees(np.arctan(np.sqrt(2.0) * SIGMA_OVER_T))
@@ -25,10 +25,10 @@ def measure_cylinder(folder, **truth):
     folder.mkdir(parents=True, exist_ok=True)
     scene = dict(scene="cylinder", width=400, height=200, theta_i_deg=0.0,
                  correlation="gaussian", factor="vh", sigma_over_T=SIGMA_OVER_T, **truth)
-    exposure = report_objects._exposure(report_objects._peak(**scene))
+    exposure = demo.exposure_for_peak(demo.peak_brightness(**scene))
     _core.write_capture(str(folder), "tiff", exposure_s=exposure, seed=5, **scene,
-                        **report_objects._camera())
-    spec = {"format": "roughscope-measure", "black_level_dn": report_objects.DEMO_BLACK,
+                        **demo.object_camera())
+    spec = {"format": "roughscope-measure", "black_level_dn": demo.OBJECT_BLACK_LEVEL,
             "object": {"shape": "cylinder",
                        "axis": {"point_px": [200, 100], "direction": [0, 1], "radius_px": 80}},
             "captures": [{"image": "capture.tiff", "light": [0, 0, 1], "view": [0, 0, 1]}]}

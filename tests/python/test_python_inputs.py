@@ -61,6 +61,7 @@ COMPARISON_OPTIONS = dict(theta1_deg=20.0, theta2_deg=50.0, pair=(1, 2), on_sigm
 # name -> list of (args, kwargs): calls that succeed. Functions of CuretDatabase are under
 # "CuretDatabase.<method>" and called on the loaded database.
 GOOD_CALLS = {
+    "acf_model": [((TI, 2.0), dict(correlation="gaussian"))],
     "brdf_compare_arrays": [((TI, PI, TS, PS, BRIGHTNESS),
                              dict(weight=np.ones(4), **COMPARISON_OPTIONS))],
     "brdf_compare_csv": [((TABLE_CSV,), COMPARISON_OPTIONS)],
@@ -143,6 +144,7 @@ GOOD_CALLS = {
     "shared_data_required": [((), {})],
     "shared_dir_candidates": [((), {})],
     "shared_search_description": [(("data/curet",), {})],
+    "srgb_encode": [(([0.0, 0.002, 0.5, 1.0],), {})],
     "sigma_from_specular": [((0.5, 10.0), dict(wavelength_um=0.555, R0=1.0))],
     "read_image": [((_HEIGHT_DIR + "/cap0.png",), dict(response="gamma", gamma=2.2,
                                                          black_level_dn=64.0))],

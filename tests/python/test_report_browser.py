@@ -62,10 +62,10 @@ def probe(page, tmp_path):
 
 @pytest.fixture(scope="module")
 def report(tmp_path_factory):
-    from roughscope import report_measure
+    from roughscope import demo
 
     folder = tmp_path_factory.mktemp("browser")
-    capture_file = report_measure.write_demo_sample(report_measure.DEMO_SAMPLES[0], folder)
+    capture_file = demo.write_sample(demo.SAMPLES[0], folder)
     out = folder / "report"
     proc = subprocess.run([cli_path(), "measure", str(capture_file), "--report", str(out)],
                           capture_output=True, text=True, timeout=300)

@@ -135,6 +135,10 @@ Curve acf_along_y(const HeightMap& levelled, AcfEstimator estimator);
 // the crossing; none when the curve never falls to 1/e.
 std::optional<double> correlation_length_1e(const Curve& acf);
 
+// The model autocorrelation functions of §3.1: C(τ) = exp(−τ²/T²) (Gaussian) or exp(−|τ|/T)
+// (exponential), for a lag τ and a correlation length T > 0 (µm).
+double acf_model(Correlation model, double lag_um, double T_um);
+
 // Least-squares fits of C = exp(−τ²/T²) and C = exp(−|τ|/T) to the points of `acf` with
 // τ ≤ max_lag_um; AIC = n ln(RSS/n) + 2k (k = 1 for both) names the better model. A fit needs 3
 // points; InvalidArgument when max_lag_um is not > 0 or x and y differ in size.
