@@ -284,155 +284,10 @@ std::vector<LafortuneLobe> lafortune_lobes(const Args& a) {
     return lobes;
 }
 
-// A result record: its keys (string literals) in output order and their values. Unlike a JSON
-// object it allocates no key, and one record is reused row after row (clear() keeps the slots and
-// their strings' storage); to_json() gives the object, and RecordWriter formats the record
-// directly with the bytes the object's dump would give.
-class Record {
-  public:
-    // A number to record: null when unknown or not finite, as serialize::number gives it.
-    struct NumberOrNull {
-        std::optional<double> value;
-    };
-    // A JSON value: null, a boolean, a number, a string, or (Nested) any other JSON value.
-    struct Value {
-        enum class Kind { Null, Boolean, Number, Text, Nested };
-        Kind kind = Kind::Null;
-        bool boolean = false;
-        double number = 0.0;
-        std::string text;
-        json nested;
-        // The writer's last formatted number and its text: a record is reused row after row and
-        // most of its numbers (the options echoed) repeat, so each is formatted once.
-        enum class Style : std::uint8_t { None, Csv };
-        mutable Style formatted_style = Style::None;
-        mutable std::uint8_t formatted_size = 0;
-        mutable std::uint64_t formatted_bits = 0;  // of the number formatted
-        mutable std::array<char, 64> formatted{};
-
-        // The text of `number` in `style`, by `format(buffer) -> end` when not the cached one.
-        template <class Format>
-        std::string_view number_text(Style style, Format&& format) const {
-            const auto bits = std::bit_cast<std::uint64_t>(number);
-            if (formatted_style != style || formatted_bits != bits) {
-                const char* end = format(formatted.data());
-                formatted_size = static_cast<std::uint8_t>(end - formatted.data());
-                formatted_bits = bits;
-                formatted_style = style;
-            }
-            return {formatted.data(), formatted_size};
-        }
-
-        Value& operator=(std::nullptr_t) {
-            kind = Kind::Null;
-            return *this;
-        }
-        Value& operator=(bool b) {
-            kind = Kind::Boolean;
-            boolean = b;
-            return *this;
-        }
-        Value& operator=(std::string_view t) {
-            kind = Kind::Text;
-            text.assign(t);
-            return *this;
-        }
-        Value& operator=(const char* t) { return *this = std::string_view(t); }
-        // Numbers come as NumberOrNull (serialize::number's rule: finite, else null): a bare
-        // double would otherwise convert to bool.
-        Value& operator=(NumberOrNull n) {
-            if (n.value && std::isfinite(*n.value)) {
-                kind = Kind::Number;
-                number = *n.value;
-            } else {
-                kind = Kind::Null;
-            }
-            return *this;
-        }
-        Value& operator=(double) = delete;
-        Value& operator=(int) = delete;
-        Value& operator=(const std::string& t) { return *this = std::string_view(t); }
-        Value& operator=(const json& j) {
-            if (j.is_null()) return *this = nullptr;
-            if (j.is_boolean()) return *this = j.get<bool>();
-            if (j.is_string()) return *this = std::string_view(j.get_ref<const std::string&>());
-            if (j.is_number_float()) {
-                kind = Kind::Number;
-                number = j.get<double>();
-                return *this;
-            }
-            kind = Kind::Nested;
-            nested = j;
-            return *this;
-        }
-        json to_json() const {
-            switch (kind) {
-                case Kind::Null:
-                    return nullptr;
-                case Kind::Boolean:
-                    return boolean;
-                case Kind::Number:
-                    return number;
-                case Kind::Text:
-                    return text;
-                case Kind::Nested:
-                    break;
-            }
-            return nested;
-        }
-    };
-    struct Item {
-        std::string_view key;
-        Value value;
-    };
-
-    Record() { items_.reserve(32); }  // every key of a record without regrowing
-    void clear() {
-        previous_size_ = size_;
-        size_ = 0;
-        same_prefix_ = true;
-    }
-    Value& operator[](std::string_view key) {
-        // Row after row the keys come in the same order: while this record's keys so far are the
-        // previous record's, a key that was new at this position then (it is not among them) is
-        // new now, found without a search. Keys are literals, compared by address first.
-        if (same_prefix_ && size_ < previous_size_) {
-            const std::string_view slot = items_[size_].key;
-            if (slot.data() == key.data() && slot.size() == key.size()) {
-                Item& item = items_[size_++];
-                item.value = nullptr;
-                return item.value;
-            }
-        }
-        for (std::size_t k = 0; k < size_; ++k)
-            if (items_[k].key == key) return items_[k].value;
-        same_prefix_ = false;
-        if (size_ == items_.size()) items_.emplace_back();
-        Item& item = items_[size_++];
-        item.key = key;
-        item.value = nullptr;
-        return item.value;
-    }
-    bool contains(std::string_view key) const {
-        return std::any_of(items_.begin(), items_.begin() + static_cast<std::ptrdiff_t>(size_),
-                           [key](const Item& item) { return item.key == key; });
-    }
-    std::span<const Item> items() const { return {items_.data(), size_}; }
-    json to_json() const {
-        json out = json::object();
-        for (const Item& item : items()) out[std::string(item.key)] = item.value.to_json();
-        return out;
-    }
-
-  private:
-    std::vector<Item> items_;
-    std::size_t size_ = 0;
-    std::size_t previous_size_ = 0;  // the keys of the record before clear()
-    bool same_prefix_ = false;       // items_[0, size_) are that record's first keys
-};
+using serialize::ModelRecord;
 
 // B–K model (Eq. 1–5, §3.2–3.3) at one point: adds its keys to `out`, returns the brightness.
-double evaluate_bk(const Args& a, const Point& p, const Roughness& r, Record& out) {
+double evaluate_bk(const Args& a, const Point& p, const Roughness& r, ModelRecord& out) {
     const bool absolute = r.sigma_um.has_value();
     std::optional<double> coherent, diffuse, total, g;
     std::optional<std::string> regime, roughness_class;
@@ -450,17 +305,9 @@ double evaluate_bk(const Args& a, const Point& p, const Roughness& r, Record& ou
         options.patch_x_um = a.patch_x_um;
         options.patch_y_um = a.patch_y_um;
         if (p.geom) {
-            // The keys of serialize::to_json(ScatteredPower), set directly (once per CSV row).
             const ScatteredPower power = mean_scattered_power(*p.geom, surface, options);
             brightness = serialize::number(power.brightness).get<double>();
-            out["coherent"] = Record::NumberOrNull{power.coherent};
-            out["diffuse"] = Record::NumberOrNull{power.diffuse};
-            out["total"] = Record::NumberOrNull{power.total};
-            out["g"] = Record::NumberOrNull{power.g};
-            out["regime"] = to_string(power.regime);
-            out["roughness_class"] = to_string(power.roughness_class);
-            out["method"] = to_string(power.method);
-            out["relative_error_bound"] = Record::NumberOrNull{power.relative_error_bound};
+            serialize::set_power(out, power);
         } else {
             coherent = diffuse = total = 0.0;  // light or viewer below the horizon
         }
@@ -489,36 +336,36 @@ double evaluate_bk(const Args& a, const Point& p, const Roughness& r, Record& ou
     }
 
     if (!out.contains("coherent")) {  // not from the serialized ScatteredPower
-        out["coherent"] = Record::NumberOrNull{coherent};
-        out["diffuse"] = Record::NumberOrNull{diffuse};
-        out["total"] = Record::NumberOrNull{total};
-        out["g"] = Record::NumberOrNull{g};
+        out["coherent"] = ModelRecord::NumberOrNull{coherent};
+        out["diffuse"] = ModelRecord::NumberOrNull{diffuse};
+        out["total"] = ModelRecord::NumberOrNull{total};
+        out["g"] = ModelRecord::NumberOrNull{g};
         out["regime"] = regime ? json(*regime) : json(nullptr);
         out["roughness_class"] = roughness_class ? json(*roughness_class) : json(nullptr);
         out["method"] = to_string(DiffuseMethod::ClosedForm);
-        out["relative_error_bound"] = Record::NumberOrNull{0.0};
+        out["relative_error_bound"] = ModelRecord::NumberOrNull{0.0};
     }
     out["scale"] = absolute ? "absolute" : "relative";
     out["correlation"] = to_string(a.correlation);
     out["factor"] = to_string(a.factor);
     out["radiometry"] = to_string(a.radiometry);
-    out["wavelength_um"] = Record::NumberOrNull{a.wavelength_um};
-    out["patch_x_um"] = Record::NumberOrNull{a.patch_x_um};
-    out["patch_y_um"] = Record::NumberOrNull{a.patch_y_um};
-    out["sigma_um"] = Record::NumberOrNull{r.sigma_um};
-    out["T_um"] = Record::NumberOrNull{r.T_um};
-    out["sigma_over_T"] = Record::NumberOrNull{m};
+    out["wavelength_um"] = ModelRecord::NumberOrNull{a.wavelength_um};
+    out["patch_x_um"] = ModelRecord::NumberOrNull{a.patch_x_um};
+    out["patch_y_um"] = ModelRecord::NumberOrNull{a.patch_y_um};
+    out["sigma_um"] = ModelRecord::NumberOrNull{r.sigma_um};
+    out["T_um"] = ModelRecord::NumberOrNull{r.T_um};
+    out["sigma_over_T"] = ModelRecord::NumberOrNull{m};
     // §3.5: Caron's angle of RMS slope (Gaussian height distribution and correlation only).
     std::optional<double> theta_K_deg;
     if (a.correlation == Correlation::Gaussian && m) {
         theta_K_deg = rad_to_deg(caron_theta_K_rad(*m));
     }
-    out["caron_theta_K_deg"] = Record::NumberOrNull{theta_K_deg};
+    out["caron_theta_K_deg"] = ModelRecord::NumberOrNull{theta_K_deg};
     return brightness;
 }
 
 // Evaluates the chosen model at one point into `out` (keys in output order).
-void evaluate(const Args& a, const Point& p, const Roughness& r, Record& out) {
+void evaluate(const Args& a, const Point& p, const Roughness& r, ModelRecord& out) {
     out.clear();
     out["model"] = model_name(a.model);
     // Angles of a geometry echoed as the shortest degrees that map to the same radians.
@@ -547,8 +394,8 @@ void evaluate(const Args& a, const Point& p, const Roughness& r, Record& out) {
                                  ? oren_nayar_radiance(*p.geom, params)
                                  : oren_nayar_qualitative_radiance(*p.geom, params);
             }
-            out["on_sigma_rad"] = Record::NumberOrNull{a.on_sigma_rad};
-            out["albedo"] = Record::NumberOrNull{a.albedo};
+            out["on_sigma_rad"] = ModelRecord::NumberOrNull{a.on_sigma_rad};
+            out["albedo"] = ModelRecord::NumberOrNull{a.albedo};
             break;
         }
         case ModelKind::Lafortune: {
@@ -560,289 +407,27 @@ void evaluate(const Args& a, const Point& p, const Roughness& r, Record& out) {
                         ? lafortune_diffuse_brightness(*p.geom, a.lafortune_n)
                         : lafortune_brdf(*p.geom, lobes, a.rho_d) * std::cos(p.geom->theta_i_rad);
             }
-            json lobes_json = json::array();
-            for (const auto& l : lobes) {
-                lobes_json.push_back({{"Cx", serialize::number(l.Cx)},
-                                      {"Cy", serialize::number(l.Cy)},
-                                      {"Cz", serialize::number(l.Cz)},
-                                      {"n", serialize::number(l.n)},
-                                      {"rho", serialize::number(l.albedo)}});
-            }
-            out["rho_d"] = Record::NumberOrNull{a.rho_d};
-            out["lobes"] = lobes_json;
+            out["rho_d"] = ModelRecord::NumberOrNull{a.rho_d};
+            out["lobes"] = serialize::to_json(lobes);
             break;
         }
     }
-    out["brightness"] = Record::NumberOrNull{brightness};
+    out["brightness"] = ModelRecord::NumberOrNull{brightness};
 }
 
 // ---------------------------------------------------------------------------------------------
 // Output formatting
 
-std::string cell_text(const json& v) {
-    if (v.is_null()) return "";
-    if (v.is_boolean()) return v.get<bool>() ? "true" : "false";
-    if (v.is_string()) return v.get<std::string>();
-    if (v.is_number()) return format_result(v.get<double>());
-    return v.dump();  // arrays/objects (Lafortune lobes)
-}
-
 std::string human_text(const json& record) {
     std::vector<std::pair<std::string, std::string>> items;
     for (const auto& [key, value] : record.items()) {
-        items.emplace_back(key, value.is_null() ? "unknown" : cell_text(value));
+        items.emplace_back(
+            key, value.is_null() ? "unknown" : serialize::model_cell_text(value, kPrintDigits));
     }
     std::ostringstream os;
     print_key_values(os, items);
     return os.str();
 }
-
-// CSV header line: the keys of a record.
-std::string csv_header(const json& record) {
-    std::string out;
-    bool first = true;
-    for (const auto& [key, value] : record.items()) {
-        if (!first) out += ',';
-        out += csv_field(key);
-        first = false;
-    }
-    out += '\n';
-    return out;
-}
-
-// One CSV line: the values of a record.
-void append_csv_line(std::string& out, const json& record) {
-    bool first = true;
-    for (const auto& [key, value] : record.items()) {
-        if (!first) out += ',';
-        const std::string cell = cell_text(value);
-        if (cell.find_first_of(",\"\n\r") == std::string::npos)
-            out += cell;  // csv_field would return it unchanged
-        else
-            out += csv_field(cell);
-        first = false;
-    }
-    out += '\n';
-}
-
-std::string csv_text(const json& record) {
-    std::string out = csv_header(record);
-    append_csv_line(out, record);
-    return out;
-}
-
-// A string that JSON and CSV output write as its bytes: printable ASCII without quote, backslash
-// or CSV separator (every key and word of a record). One table look-up per character.
-bool plain_text(std::string_view text) {
-    static constexpr auto kPlain = [] {
-        std::array<bool, 256> plain{};
-        for (int c = 0x20; c < 0x7f; ++c) plain[static_cast<std::size_t>(c)] = true;
-        for (char c : {'"', '\\', ','}) plain[static_cast<unsigned char>(c)] = false;
-        return plain;
-    }();
-    for (char c : text)
-        if (!kPlain[static_cast<unsigned char>(c)]) return false;
-    return true;
-}
-
-// Appends the CSV cell of a value (cell_text, quoted by csv_field when needed).
-void append_csv_cell(std::string& out, const Record::Value& v) {
-    using Kind = Record::Value::Kind;
-    if (v.kind == Kind::Number && std::isfinite(v.number)) {
-        // format_result's "%.10g" (no "-0"), without a temporary string.
-        static_assert(roughscope::kSignificantBufferSize <= 64);
-        out += v.number_text(Record::Value::Style::Csv, [&](char* buf) {
-            return roughscope::write_significant(buf, v.number == 0.0 ? 0.0 : v.number,
-                                                 kPrintDigits);
-        });
-        return;
-    }
-    if (v.kind == Kind::Null) return;  // cell_text: ""
-    if (v.kind == Kind::Boolean) {
-        out += v.boolean ? "true" : "false";
-        return;
-    }
-    if (v.kind == Kind::Text && plain_text(v.text)) {
-        out += v.text;
-        return;
-    }
-    const std::string cell = cell_text(v.to_json());
-    if (cell.find_first_of(",\"\n\r") == std::string::npos)
-        out += cell;  // csv_field would return it unchanged
-    else
-        out += csv_field(cell);
-}
-
-// Writes the records of `model --csv` one at a time: CSV (header from the first record) or a JSON
-// array byte-identical to serialize::dump of the whole array, without holding the records. Each
-// record is formatted straight into the chunk of rows that goes to the output once it holds
-// kChunkBytes.
-class RecordWriter {
-  public:
-    RecordWriter(io::OutputFile& out, bool json_output) : out_(out), json_(json_output) {}
-
-    void add(const Record& record) {
-        if (json_) {
-            chunk_.append(count_ == 0 ? "[\n" : ",\n");
-            if (!append_json_element(record)) {
-                // Nested values (Lafortune lobes) or strings to escape: the element as the whole
-                // array's dump indents it: "[\n" + element + "\n]\n".
-                json one = json::array();
-                one.push_back(serialize::versioned(record.to_json()));
-                const std::string text = serialize::dump(one);
-                chunk_.append(text, 2, text.size() - 5);
-            }
-        } else {
-            if (count_ == 0) {
-                bool first = true;
-                for (const auto& item : record.items()) {
-                    if (!first) chunk_ += ',';
-                    chunk_ += csv_field(std::string(item.key));
-                    first = false;
-                }
-                chunk_ += '\n';
-            }
-            bool first = true;
-            for (const auto& item : record.items()) {
-                if (!first) chunk_ += ',';
-                append_csv_cell(chunk_, item.value);
-                first = false;
-            }
-            chunk_ += '\n';
-        }
-        ++count_;
-        if (chunk_.size() >= kChunkBytes) {
-            out_.write(chunk_);
-            chunk_.clear();
-        }
-    }
-
-    // Closes the array (JSON) and writes what is pending; the caller commits the output.
-    void finish() {
-        if (json_ && count_ > 0) chunk_ += "\n]\n";
-        out_.write(chunk_);
-        chunk_.clear();
-    }
-
-    std::size_t count() const { return count_; }
-
-  private:
-    // Rows are written out in chunks of this size: large enough that the output file writes
-    // them through without copying (io::OutputFile), small enough to stay in the cache.
-    static constexpr std::size_t kChunkBytes = std::size_t{64} << 10;
-
-    // The text before a record's value at one position: ",\n    \"key\": ", made once; `usable` is
-    // false for a key that needs escaping or does not fit (the element then goes the slow way).
-    static constexpr std::size_t kBlock = 64;
-    struct KeyText {
-        std::string_view key;
-        bool usable = false;
-        std::uint8_t size = 0;
-        std::array<char, kBlock> text{};
-    };
-
-    // Numbers formatted before, in a direct-mapped cache by their bits: the B-K records'
-    // brightness, diffuse and total are often the same double, and the angles of a table of
-    // measurements repeat from row to row (a grid of geometries).
-    struct CachedNumber {
-        std::uint64_t bits = 0;
-        std::uint8_t size = 0;  // 0: empty
-        std::array<char, serialize::kNumberBufferSize> text{};
-    };
-    static constexpr int kCacheBits = 10;
-
-    // serialize::dump's own number formatter (the same bytes by construction), unless the same
-    // double is in the cache.
-    char* write_number(char* out, double value) {
-        const auto bits = std::bit_cast<std::uint64_t>(value);
-        CachedNumber& c = cache_[(bits * 0x9E3779B97F4A7C15ULL) >> (64 - kCacheBits)];
-        if (c.size != 0 && c.bits == bits) return std::copy_n(c.text.data(), c.size, out);
-        char* const end = serialize::write_number(out, value);
-        c.bits = bits;
-        c.size = static_cast<std::uint8_t>(end - out);
-        std::copy(out, end, c.text.data());
-        return end;
-    }
-
-    // The key texts of the record's positions, made when a position's key is new: keys are
-    // literals, so the same address and size is the same key.
-    void update_keys(std::span<const Record::Item> items) {
-        if (keys_.size() < items.size()) keys_.resize(items.size());
-        for (std::size_t k = 0; k < items.size(); ++k) {
-            const std::string_view key = items[k].key;
-            KeyText& slot = keys_[k];
-            if (slot.key.data() == key.data() && slot.key.size() == key.size()) continue;
-            slot.key = key;
-            constexpr std::string_view kBefore = ",\n    \"", kAfter = "\": ";
-            const std::size_t size = kBefore.size() + key.size() + kAfter.size();
-            slot.usable = plain_text(key) && size <= kBlock;
-            if (!slot.usable) continue;
-            char* p = std::copy(kBefore.begin(), kBefore.end(), slot.text.data());
-            p = std::copy(key.begin(), key.end(), p);
-            std::copy(kAfter.begin(), kAfter.end(), p);
-            slot.size = static_cast<std::uint8_t>(size);
-        }
-    }
-
-    // The element "  {\n    \"key\": value,\n ...\n  }" as dump(2) indents it inside the array;
-    // false (chunk_ unchanged) when a value is nested or a key or string needs escaping.
-    bool append_json_element(const Record& record) {
-        using Kind = Record::Value::Kind;
-        static constexpr std::string_view kTail = "\n  }";
-        const std::string_view head = head_;
-        const std::span<const Record::Item> items = record.items();
-        update_keys(items);
-        // Pass 1: whether every value is written as is, and room for the text (whole blocks).
-        std::size_t room = head.size() + kTail.size();
-        for (std::size_t k = 0; k < items.size(); ++k) {
-            const Record::Value& v = items[k].value;
-            if (!keys_[k].usable || v.kind == Kind::Nested) return false;
-            if (v.kind == Kind::Text && !plain_text(v.text)) return false;
-            room += keys_[k].size +
-                    (v.kind == Kind::Text ? v.text.size() + 2 : serialize::kNumberBufferSize);
-        }
-        // Pass 2: the text, straight into the chunk.
-        const std::size_t mark = chunk_.size();
-        chunk_.resize(mark + room);
-        char* p = std::copy(head.begin(), head.end(), chunk_.data() + mark);
-        for (std::size_t k = 0; k < items.size(); ++k) {
-            const KeyText& key = keys_[k];
-            p = std::copy_n(key.text.data(), key.size, p);
-            const Record::Value& v = items[k].value;
-            switch (v.kind) {
-                case Kind::Null:
-                    p = std::copy_n("null", 4, p);
-                    break;
-                case Kind::Boolean:
-                    p = v.boolean ? std::copy_n("true", 4, p) : std::copy_n("false", 5, p);
-                    break;
-                case Kind::Number:
-                    p = write_number(p, v.number);
-                    break;
-                case Kind::Text:
-                    *p++ = '"';
-                    p = std::copy(v.text.begin(), v.text.end(), p);
-                    *p++ = '"';
-                    break;
-                case Kind::Nested:
-                    break;  // refused in pass 1
-            }
-        }
-        p = std::copy(kTail.begin(), kTail.end(), p);
-        chunk_.resize(static_cast<std::size_t>(p - chunk_.data()));
-        return true;
-    }
-
-    io::OutputFile& out_;
-    bool json_;
-    // serialize::versioned: the version first in every element.
-    const std::string head_ = std::string("  {\n    \"") + serialize::kVersionKey +
-                              "\": \"" ROUGHSCOPE_VERSION_STRING "\"";
-    std::size_t count_ = 0;
-    std::string chunk_;
-    std::vector<KeyText> keys_;  // by position in the record
-    std::vector<CachedNumber> cache_ = std::vector<CachedNumber>(std::size_t{1} << kCacheBits);
-};
 
 Roughness roughness_from_flags(const Args& a) {
     Roughness r;
@@ -906,14 +491,14 @@ void run_model(const Args& a) {
 
     if (!given(a.o_csv)) {
         const Point p = point_from_flags(a);
-        Record result;
+        ModelRecord result;
         evaluate(a, p, roughness_from_flags(a), result);
         const json record = result.to_json();
         std::string text;
         if (a.json_output) {
             text = serialize::dump(serialize::versioned(record));
         } else if (output) {
-            text = csv_text(record);
+            text = serialize::model_record_csv(record, kPrintDigits);
         } else {
             text = human_text(record);
         }
@@ -930,8 +515,8 @@ void run_model(const Args& a) {
     const std::size_t c_ts = *reader.column_index("theta_s");
     const std::size_t c_ps = *reader.column_index("phi_s");
     io::OutputFile out = io::open_output(output);
-    RecordWriter writer(out, a.json_output);
-    Record record;  // reused row after row
+    serialize::ModelRecordWriter writer(out, a.json_output, kPrintDigits);
+    ModelRecord record;  // reused row after row
     CsvRow row;
     while (reader.next(row)) {
         const double ti = *row.value(c_ti), ts = *row.value(c_ts), ps = *row.value(c_ps);

@@ -142,11 +142,10 @@ BrdfTable table_from_arrays(const DoubleArray& ti, const DoubleArray& pi, const 
     return t;
 }
 
-}  // namespace
-
-void bind_curet(py::module_& m) {
-    py::class_<CuretDatabase>(m, "CuretDatabase",
-                              "The CUReT BRDF database for one channel (load with curet_load).")
+// The database's contents as read-only properties: directory, channel, samples, brdf, overflow
+// and the angles in both frames.
+void add_curet_contents(py::class_<CuretDatabase>& database) {
+    database
         .def_property_readonly("directory",
                                [](const CuretDatabase& db) { return db.directory.string(); })
         .def_property_readonly(
@@ -197,7 +196,12 @@ void bind_curet(py::module_& m) {
                 return d;
             },
             "table.txt in degrees (sample frame) plus theta_s_deg, phi_s_deg in the paper's frame "
-            "(theta_s = theta_v, phi_s = phi_v - phi_i + 180)")
+            "(theta_s = theta_v, phi_s = phi_v - phi_i + 180)");
+}
+
+// One sample's table and the model comparisons of one sample or of all of them.
+void add_curet_comparisons(py::class_<CuretDatabase>& database) {
+    database
         .def(
             "sample_table",
             [](const CuretDatabase& db, py::handle sample) {
@@ -259,6 +263,15 @@ void bind_curet(py::module_& m) {
             py::arg("max_overflow") = py::none(), py::arg("threads") = 0,
             py::arg("format") = "dict", py::arg("series") = false,
             "Compare every sample: a list of dicts (format='dict'), or CSV or Markdown text");
+}
+
+}  // namespace
+
+void bind_curet_database(py::module_& m) {
+    py::class_<CuretDatabase> database(
+        m, "CuretDatabase", "The CUReT BRDF database for one channel (load with curet_load).");
+    add_curet_contents(database);
+    add_curet_comparisons(database);
 
     m.def(
         "curet_find_directory",
@@ -295,7 +308,9 @@ void bind_curet(py::module_& m) {
             return py::make_tuple(p->sigma_rad, p->albedo);
         },
         py::arg("sample"), "(sigma_rad, albedo) of the paper's Table 3, or None");
+}
 
+void bind_brdf_tables(py::module_& m) {
     m.def(
         "brdf_read_csv",
         [](const std::string& path, std::optional<std::string> channel) {

@@ -191,7 +191,7 @@ std::vector<Measurement> measurements_from(py::handle theta_i_deg, py::handle th
 
 }  // namespace
 
-void bind_estimation(py::module_& m) {
+void bind_paper_tables(py::module_& m) {
     m.def(
         "recompute_paper_tables",
         [](py::handle reference, const std::string& where) {
@@ -203,6 +203,9 @@ void bind_estimation(py::module_& m) {
         "paper-tables.json) with the section-4 estimators: for each quantity {printed, "
         "recomputed, rounding_interval, agreement} with agreement 'exact', 'within_rounding' or "
         "'differs'. The document of `roughscope paper tables --json` (without 'reference').");
+}
+
+void bind_closed_form_estimators(py::module_& m) {
     using py::arg;
 
     // ---- §4.2 closed forms (vectorised) -----------------------------------------------------
@@ -309,6 +312,10 @@ void bind_estimation(py::module_& m) {
         "Eq. 15: correlation length T (um) of a slightly rough surface (Gaussian correlation) "
         "from E1/E2 at theta1, theta2 (degrees, viewer on the normal) with sigma known. "
         "Vectorised.");
+}
+
+void bind_two_geometry_solvers(py::module_& m) {
+    using py::arg;
 
     // ---- General two-geometry solvers (vectorised) ------------------------------------------
     m.def(
@@ -365,6 +372,10 @@ void bind_estimation(py::module_& m) {
         "Correlation length T (um) with sigma known from E1/E2 at two arbitrary geometries, from "
         "the diffuse term in the chosen regime (slightly_rough = Eq. 3; series/auto = exact "
         "series; both correlations). TOMS 748 root finding. Vectorised.");
+}
+
+void bind_estimates(py::module_& m) {
+    using py::arg;
 
     // ---- Estimates with uncertainty and derived quantities (scalar, dict) -------------------
     // Standard errors (`*_stderr` keys) are reported when a noise level (or sigma_um_stderr) is
@@ -491,6 +502,10 @@ void bind_estimation(py::module_& m) {
         "T (Eq. 15, or the two-geometry solver) with sigma known, with standard errors when the "
         "brightness noise or sigma_um_stderr is given; sigma/T, theta_K, xi_K, g, class, "
         "warnings. Returns the dict of `roughscope estimate correlation-length --json`.");
+}
+
+void bind_fits(py::module_& m) {
+    using py::arg;
 
     // ---- Least-squares fits -----------------------------------------------------------------
     // The options become a FitOptions in one place: serialize::fit_options_from (the CLI calls

@@ -128,7 +128,7 @@ surface::SurfaceStatistics statistics_from_dict(py::handle stats) {
 
 }  // namespace
 
-void bind_surface(py::module_& m) {
+void bind_height_files(py::module_& m) {
     using py::arg;
 
     m.def(
@@ -200,6 +200,10 @@ void bind_surface(py::module_& m) {
         "Write heights (a (ny, nx) array in um, NaN = missing; 1-D = a profile) with spacings "
         "dx_um, dy_um (default dx_um) to `path`, in the format of its extension unless given. "
         "Written atomically: nothing half-written on error.");
+}
+
+void bind_surface_analysis(py::module_& m) {
+    using py::arg;
 
     m.def(
         "surface_statistics",

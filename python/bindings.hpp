@@ -14,10 +14,28 @@
 
 namespace roughscope::python {
 
-void bind_core(pybind11::module_& m);        // python/bind_core.cpp: models, geometry (§2–3)
-void bind_estimation(pybind11::module_& m);  // python/bind_estimation.cpp: §4 estimators, fits
-void bind_curet(pybind11::module_& m);       // python/bind_curet.cpp: CUReT / BRDF tables
-void bind_surface(pybind11::module_& m);     // python/bind_surface.cpp: height data (§3.1)
+// python/bind_core.cpp: named choices, reference data, geometry (§2), v, g and F (§3.1–3.2)
+void bind_names_and_shared_data(pybind11::module_& m);
+void bind_geometry(pybind11::module_& m);
+void bind_scattering_vector(pybind11::module_& m);
+// python/bind_power.cpp: the mean scattered power (Eq. 1–5), series sums and diffuse terms
+void bind_mean_scattered_power(pybind11::module_& m);
+void bind_diffuse_terms(pybind11::module_& m);
+// python/bind_models.cpp: retro-scattering forms (Eq. 7–11), validity, comparison models (§5)
+void bind_retro_and_validity(pybind11::module_& m);
+void bind_reflectance_models(pybind11::module_& m);
+// python/bind_estimation.cpp: the paper's tables recomputed, §4 estimators, fits
+void bind_paper_tables(pybind11::module_& m);
+void bind_closed_form_estimators(pybind11::module_& m);
+void bind_two_geometry_solvers(pybind11::module_& m);
+void bind_estimates(pybind11::module_& m);
+void bind_fits(pybind11::module_& m);
+// python/bind_curet.cpp: the CUReT database, BRDF tables and their comparison with the models
+void bind_curet_database(pybind11::module_& m);
+void bind_brdf_tables(pybind11::module_& m);
+// python/bind_surface.cpp: height files; statistics, generation and prediction (§3.1)
+void bind_height_files(pybind11::module_& m);
+void bind_surface_analysis(pybind11::module_& m);
 void bind_simulation(pybind11::module_& m);  // python/bind_simulation.cpp: Kirchhoff Monte Carlo
 void bind_capture(pybind11::module_& m);     // python/bind_capture.cpp: synthetic captures
 void bind_image(pybind11::module_& m);       // python/bind_image.cpp: photographs to roughness

@@ -328,10 +328,22 @@ PYBIND11_MODULE(_core, m) {
 
     m.attr("__version__") = ROUGHSCOPE_VERSION_STRING;
 
-    roughscope::python::bind_core(m);
-    roughscope::python::bind_estimation(m);
-    roughscope::python::bind_curet(m);
-    roughscope::python::bind_surface(m);
+    roughscope::python::bind_names_and_shared_data(m);
+    roughscope::python::bind_geometry(m);
+    roughscope::python::bind_scattering_vector(m);
+    roughscope::python::bind_mean_scattered_power(m);
+    roughscope::python::bind_diffuse_terms(m);
+    roughscope::python::bind_retro_and_validity(m);
+    roughscope::python::bind_reflectance_models(m);
+    roughscope::python::bind_paper_tables(m);
+    roughscope::python::bind_closed_form_estimators(m);
+    roughscope::python::bind_two_geometry_solvers(m);
+    roughscope::python::bind_estimates(m);
+    roughscope::python::bind_fits(m);
+    roughscope::python::bind_curet_database(m);
+    roughscope::python::bind_brdf_tables(m);
+    roughscope::python::bind_height_files(m);
+    roughscope::python::bind_surface_analysis(m);
     roughscope::python::bind_simulation(m);
     roughscope::python::bind_capture(m);
     roughscope::python::bind_image(m);

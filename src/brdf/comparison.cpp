@@ -19,6 +19,7 @@
 
 #include <Eigen/Dense>
 
+#include "comparison_data.hpp"
 #include "roughscope/core/errors.hpp"
 #include "roughscope/core/names.hpp"
 #include "roughscope/core/numbers.hpp"
@@ -526,67 +527,6 @@ void fit_oren_nayar(Prepared& p, ModelResult& r, double sigma_max) {
 
 // ---------------------------------------------------------------------------------------------
 
-TwoPointEstimate two_point_estimate(const BrdfTable& table, const std::vector<bool>& used,
-                                    const ComparisonOptions& o) {
-    TwoPointEstimate t;
-    t.measurement1 = o.measurement1;
-    t.measurement2 = o.measurement2;
-    const std::optional<std::size_t> k1 = table.find(o.measurement1);
-    const std::optional<std::size_t> k2 = table.find(o.measurement2);
-    if (!k1 || !k2) {
-        t.reason = "measurement " + std::to_string(!k1 ? o.measurement1 : o.measurement2) +
-                   " is not in the table";
-        return t;
-    }
-    const BrdfMeasurement& m1 = table.measurements[*k1];
-    const BrdfMeasurement& m2 = table.measurements[*k2];
-    t.theta1_rad = o.theta1_rad.value_or(m1.theta_i_rad);
-    t.theta2_rad = o.theta2_rad.value_or(m2.theta_i_rad);
-    t.E1 = brightness_from_brdf(m1.value, t.theta1_rad);
-    t.E2 = brightness_from_brdf(m2.value, t.theta2_rad);
-    for (const BrdfMeasurement* m : {&m1, &m2}) {
-        if (!used[m == &m1 ? *k1 : *k2]) {
-            t.reason = "measurement " + std::to_string(m->index) +
-                       " is excluded (zero weight or saturated)";
-            return t;
-        }
-        if (m->theta_v_rad > o.normal_view_tolerance_rad) {
-            t.reason = "measurement " + std::to_string(m->index) +
-                       " has theta_v = " + format_significant(rad_to_deg(m->theta_v_rad), 6) +
-                       " deg: Eq. 16-19 need the viewer on the normal (theta_v <= " +
-                       format_significant(rad_to_deg(o.normal_view_tolerance_rad), 6) + " deg)";
-            return t;
-        }
-    }
-    std::string bad;
-    for (const BrdfMeasurement* m : {&m1, &m2})
-        if (!(m->value > 0.0))
-            bad += (bad.empty() ? "" : " and ") + std::string("measurement ") +
-                   std::to_string(m->index) + " has f = " + format_significant(m->value, 6) +
-                   " <= 0";
-    if (!bad.empty()) {
-        t.reason = bad +
-                   ": the ratio E1/E2 needs two positive brightness values (non-positive "
-                   "BRDF values are calibration noise)";
-        return t;
-    }
-    t.available = true;
-    t.E1_over_E2 = *t.E1 / *t.E2;
-    try {
-        t.sigma_over_T_gaussian = sigma_over_T_gaussian_from_ratio(
-            *t.E1_over_E2, t.theta1_rad, t.theta2_rad, GeometricFactor::VernoldHarvey);
-    } catch (const Error& e) {
-        t.gaussian_reason = e.what();
-    }
-    try {
-        t.sigma_over_T_exponential = sigma_over_T_exponential_from_ratio(
-            *t.E1_over_E2, t.theta1_rad, t.theta2_rad, GeometricFactor::VernoldHarvey);
-    } catch (const Error& e) {
-        t.exponential_reason = e.what();
-    }
-    return t;
-}
-
 void pick_winners(Comparison& c) {
     double best = kInf, best_paper = kInf;
     for (const ModelResult& r : c.models) {
@@ -739,108 +679,27 @@ void validate(const ComparisonOptions& o) {
 
 namespace {
 
-// compare_brdf; `release`, when given, is `table` itself, whose measurements are released as soon
-// as the comparison has taken what it needs of them.
-Comparison compare(const BrdfTable& table, const ComparisonOptions& o, BrdfTable* release) {
-    validate(o);
-    if (table.measurements.empty())
-        throw InvalidArgument("BRDF table '" + table.name + "' has no measurements");
-
-    Comparison c;
-    c.name = table.name;
-    c.channel = table.channel;
-    c.total_measurements = table.size();
-
-    // Which measurements are used, and why not.
-    std::vector<bool> used(table.size(), true);
-    for (std::size_t k = 0; k < table.size(); ++k) {
-        const BrdfMeasurement& m = table.measurements[k];
-        if (m.weight == 0.0) {
-            used[k] = false;
-            c.data_issues.push_back({m.index,
-                                     m.value,
-                                     "zero_weight",
-                                     {"all"},
-                                     "weight 0: left out of every sum and fit"});
-            continue;
-        }
-        if (o.max_overflow_fraction && m.overflow_fraction &&
-            *m.overflow_fraction > *o.max_overflow_fraction) {
-            used[k] = false;
-            c.data_issues.push_back({m.index,
-                                     m.value,
-                                     "saturated",
-                                     {"all"},
-                                     "overflow fraction " +
-                                         format_significant(*m.overflow_fraction, 6) + " > " +
-                                         format_significant(*o.max_overflow_fraction, 6) +
-                                         ": left out of every sum, fit and estimate"});
-            continue;
-        }
-        if (!(m.value > 0.0)) {
-            const bool pair = m.index == o.measurement1 || m.index == o.measurement2;
-            DataIssue issue{m.index, m.value, "non_positive", {}, ""};
-            if (pair) {
-                issue.excluded_from = {"two_point_estimate"};
-                issue.note =
-                    "non-positive BRDF (noise): no ratio E1/E2, so no two-point "
-                    "estimate; kept in the error sums and fits";
-            } else {
-                issue.note =
-                    "non-positive BRDF (noise around zero): kept in the error sums "
-                    "and fits";
-            }
-            c.data_issues.push_back(issue);
-        }
-    }
-    double dmax = -kInf;
-    const auto num_used = static_cast<std::size_t>(std::count(used.begin(), used.end(), true));
-    c.measurement.reserve(num_used);
-    c.geometry.reserve(num_used);
-    c.brightness.reserve(num_used);
-    c.weight.reserve(num_used);
-    for (std::size_t k = 0; k < table.size(); ++k) {
-        if (!used[k]) continue;
-        const BrdfMeasurement& m = table.measurements[k];
-        c.measurement.push_back(m.index);
-        c.geometry.push_back(m.geometry);
-        c.brightness.push_back(brightness_from_brdf(m.value, m.theta_i_rad));
-        c.weight.push_back(m.weight);
-        dmax = std::max(dmax, c.brightness.back());
-    }
-
-    c.two_point = two_point_estimate(table, used, o);
-    if (release) std::vector<BrdfMeasurement>().swap(release->measurements);
-
-    c.models.reserve(kComparisonModels.size());
+// One ModelResult per model, in kComparisonModels order (indexed by the enum).
+std::vector<ModelResult> empty_results() {
+    std::vector<ModelResult> models;
+    models.reserve(kComparisonModels.size());
     for (ComparisonModel m : kComparisonModels) {
         ModelResult r;
         r.model = m;
-        c.models.push_back(r);
+        models.push_back(r);
     }
-    auto result = [&](ComparisonModel m) -> ModelResult& {
-        return c.models[static_cast<std::size_t>(m)];
-    };
+    return models;
+}
 
-    if (c.measurement.empty() || !(dmax > 0.0)) {
-        const std::string why = c.measurement.empty()
-                                    ? "no measurement is used (all excluded)"
-                                    : "no positive brightness among the used measurements: the "
-                                      "data cannot be normalised";
-        for (ModelResult& r : c.models) r.reason = why;
-        return c;
-    }
-    std::vector<double> d(c.brightness.size());
-    for (std::size_t j = 0; j < d.size(); ++j) d[j] = c.brightness[j] / dmax;
-    Prepared p = prepare(c.geometry, std::move(d), c.weight, o.radiometry);
-    p.keep_predictions = o.keep_predictions;
+ModelResult& result_of(Comparison& c, ComparisonModel m) {
+    return c.models[static_cast<std::size_t>(m)];
+}
 
-    // One model family at a time (Prepared): its terms, its paper method, its fit. Each model's
-    // result depends on its own computation only, so the order does not change any number.
+// Oren–Nayar with the given parameters, then (with fits) its least-squares fit.
+void compare_oren_nayar(Prepared& p, Comparison& c, const ComparisonOptions& o) {
     p.oren_nayar = OrenNayarTerms(p.geom);
-    // Oren–Nayar with given parameters.
     {
-        ModelResult& r = result(ComparisonModel::OrenNayar);
+        ModelResult& r = result_of(c, ComparisonModel::OrenNayar);
         if (o.oren_nayar) {
             r.available = true;
             r.method = "given parameters (" + o.oren_nayar_source + ")";
@@ -863,126 +722,141 @@ Comparison compare(const BrdfTable& table, const ComparisonOptions& o, BrdfTable
         }
     }
     if (o.fits) {
-        ModelResult& r = result(ComparisonModel::OrenNayarFit);
+        ModelResult& r = result_of(c, ComparisonModel::OrenNayarFit);
         r.method = "least squares over sigma_rad, albedo and the gain";
         fit_oren_nayar(p, r, o.fit_oren_nayar_sigma_max_rad);
     }
     p.oren_nayar = OrenNayarTerms();
+}
 
-    prepare_lafortune(p);
-    // Lafortune: the paper's exhaustive search for the lowest Table-4 error.
-    {
-        ModelResult& r = result(ComparisonModel::Lafortune);
-        const auto steps = static_cast<long>(
-            std::floor((o.lafortune_n_max - o.lafortune_n_min) / o.lafortune_n_step + 1e-9));
-        const LafortuneGroups groups = lafortune_groups(p);
-        // Every n's error on fixed bands of the grid (one slot each), then the lowest in grid
-        // order: the same n whatever the number of threads.
-        const auto grid_size = static_cast<std::size_t>(steps + 1);
-        const auto n_of = [&o](std::size_t k) {
-            return o.lafortune_n_min + static_cast<double>(k) * o.lafortune_n_step;
-        };
-        std::vector<double> error(grid_size);
-        constexpr std::size_t kBand = 64;
-        run_bands((grid_size + kBand - 1) / kBand, o.threads, [&](std::size_t band) {
-            std::vector<double> M;
-            for (std::size_t k = band * kBand; k < std::min(grid_size, (band + 1) * kBand); ++k)
-                error[k] = lafortune_paper_sse(p, groups, n_of(k), M);
-        });
-        double best_err = kInf, worst_err = -kInf, best_n = o.lafortune_n_min;
-        long best_k = 0;
-        for (std::size_t k = 0; k < grid_size; ++k) {
-            const double e = error[k];
-            worst_err = std::max(worst_err, e);
-            if (e < best_err) {
-                best_err = e;
-                best_n = n_of(k);
-                best_k = static_cast<long>(k);
-            }
+// The Table-4 error of every n_d of the Lafortune search grid (n_min + k · n_step, k = 0..steps),
+// on fixed bands of the grid (one slot each): the same values whatever the number of threads.
+std::vector<double> lafortune_search_errors(const Prepared& p, const ComparisonOptions& o,
+                                            long steps) {
+    const LafortuneGroups groups = lafortune_groups(p);
+    const auto grid_size = static_cast<std::size_t>(steps + 1);
+    std::vector<double> error(grid_size);
+    constexpr std::size_t kBand = 64;
+    run_bands((grid_size + kBand - 1) / kBand, o.threads, [&](std::size_t band) {
+        std::vector<double> M;
+        for (std::size_t k = band * kBand; k < std::min(grid_size, (band + 1) * kBand); ++k)
+            error[k] = lafortune_paper_sse(
+                p, groups, o.lafortune_n_min + static_cast<double>(k) * o.lafortune_n_step, M);
+    });
+    return error;
+}
+
+// Lafortune: the paper's exhaustive search for the lowest Table-4 error (the lowest in grid
+// order), with a verdict on whether the data determine n_d.
+void lafortune_search(const Prepared& p, ModelResult& r, const ComparisonOptions& o) {
+    const auto steps = static_cast<long>(
+        std::floor((o.lafortune_n_max - o.lafortune_n_min) / o.lafortune_n_step + 1e-9));
+    const std::vector<double> error = lafortune_search_errors(p, o, steps);
+    double best_err = kInf, worst_err = -kInf, best_n = o.lafortune_n_min;
+    long best_k = 0;
+    for (std::size_t k = 0; k < error.size(); ++k) {
+        const double e = error[k];
+        worst_err = std::max(worst_err, e);
+        if (e < best_err) {
+            best_err = e;
+            best_n = o.lafortune_n_min + static_cast<double>(k) * o.lafortune_n_step;
+            best_k = static_cast<long>(k);
         }
-        // The data do not determine n_d when every n of the search gives the same error (to
-        // rounding): one geometry (the normalised model is 1 there whatever n), or several with
-        // the same cos θi cos θs.
-        const bool flat =
-            std::isfinite(worst_err) && worst_err - best_err <= 1e-12 * std::max(1.0, worst_err);
-        r.available = true;
-        r.method = "exhaustive search of n_d in [" + format_significant(o.lafortune_n_min, 6) +
-                   ", " + format_significant(o.lafortune_n_max, 6) + "] in steps of " +
-                   format_significant(o.lafortune_n_step, 6) + " for the lowest Table-4 error (" +
-                   std::to_string(steps + 1) + " values)";
-        r.evaluations = static_cast<int>(steps + 1);
-        const bool at_bound = best_k == 0 || best_k == steps;
-        r.fit_status = flat       ? SolverStatus::NotIdentifiable
-                       : at_bound ? SolverStatus::AtBound
-                                  : SolverStatus::Converged;
-        r.fit_message = flat ? "not identifiable: every n_d of the search gives the same Table-4 "
-                               "error (" +
-                                   distinct_geometries_text(p.geom) + ")"
-                        : at_bound ? "n_d = " + format_significant(best_n, 6) +
-                                         " is an end of the search interval"
-                                   : "interior minimum of the search";
-        r.parameters = {{"n", best_n, std::nullopt, !flat}};
-        r.prediction.resize(p.size());
-        lafortune_prediction(p, best_n, r.prediction);
-        set_errors(p, r);
     }
+    // The data do not determine n_d when every n of the search gives the same error (to
+    // rounding): one geometry (the normalised model is 1 there whatever n), or several with
+    // the same cos θi cos θs.
+    const bool flat =
+        std::isfinite(worst_err) && worst_err - best_err <= 1e-12 * std::max(1.0, worst_err);
+    r.available = true;
+    r.method = "exhaustive search of n_d in [" + format_significant(o.lafortune_n_min, 6) + ", " +
+               format_significant(o.lafortune_n_max, 6) + "] in steps of " +
+               format_significant(o.lafortune_n_step, 6) + " for the lowest Table-4 error (" +
+               std::to_string(steps + 1) + " values)";
+    r.evaluations = static_cast<int>(steps + 1);
+    const bool at_bound = best_k == 0 || best_k == steps;
+    r.fit_status = flat       ? SolverStatus::NotIdentifiable
+                   : at_bound ? SolverStatus::AtBound
+                              : SolverStatus::Converged;
+    r.fit_message =
+        flat ? "not identifiable: every n_d of the search gives the same Table-4 "
+               "error (" +
+                   distinct_geometries_text(p.geom) + ")"
+        : at_bound ? "n_d = " + format_significant(best_n, 6) + " is an end of the search interval"
+                   : "interior minimum of the search";
+    r.parameters = {{"n", best_n, std::nullopt, !flat}};
+    r.prediction.resize(p.size());
+    lafortune_prediction(p, best_n, r.prediction);
+    set_errors(p, r);
+}
+
+// Lafortune's search, then (with fits) its least-squares fit.
+void compare_lafortune(Prepared& p, Comparison& c, const ComparisonOptions& o) {
+    prepare_lafortune(p);
+    lafortune_search(p, result_of(c, ComparisonModel::Lafortune), o);
     if (o.fits) {
-        ModelResult& r = result(ComparisonModel::LafortuneFit);
+        ModelResult& r = result_of(c, ComparisonModel::LafortuneFit);
         r.method = "least squares over n and the gain";
         fit_lafortune(p, r, o.fit_lafortune_n_min, o.fit_lafortune_n_max);
     }
     release_lafortune(p);
+}
 
-    // B–K (F_Beck) and V–H (F_VH) at the two-point estimate.
-    struct VeryRoughVariant {
-        ComparisonModel model, fit;
-        GeometricFactor factor;
-        Correlation correlation;
-    };
-    const VeryRoughVariant variants[] = {
-        {ComparisonModel::BkGaussian, ComparisonModel::BkGaussianFit, GeometricFactor::Beckmann,
-         Correlation::Gaussian},
-        {ComparisonModel::BkExponential, ComparisonModel::BkExponentialFit,
-         GeometricFactor::Beckmann, Correlation::Exponential},
-        {ComparisonModel::VhGaussian, ComparisonModel::VhGaussianFit,
-         GeometricFactor::VernoldHarvey, Correlation::Gaussian},
-        {ComparisonModel::VhExponential, ComparisonModel::VhExponentialFit,
-         GeometricFactor::VernoldHarvey, Correlation::Exponential},
-    };
-    auto two_point_model = [&](const VeryRoughVariant& v) {
-        ModelResult& r = result(v.model);
-        const bool gaussian = v.correlation == Correlation::Gaussian;
-        const std::optional<double> sigma_over_T =
-            gaussian ? c.two_point.sigma_over_T_gaussian : c.two_point.sigma_over_T_exponential;
-        if (!sigma_over_T) {
-            r.reason = "two-point estimate unavailable: " +
-                       (!c.two_point.available ? c.two_point.reason
-                                               : (gaussian ? c.two_point.gaussian_reason
-                                                           : c.two_point.exponential_reason));
-            return;
-        }
-        r.available = true;
-        r.method = std::string("two-point estimate of sigma/T (") +
-                   (gaussian ? "Eq. 17" : "Eq. 19") + ", F_VH, measurements " +
-                   std::to_string(o.measurement1) + " and " + std::to_string(o.measurement2) +
-                   "); " + (gaussian ? "Eq. 4" : "Eq. 5") + " with " +
-                   (v.factor == GeometricFactor::Beckmann ? "F_Beck" : "F_VH") + ", " +
-                   std::string(to_string(o.radiometry));
-        r.parameters = {{"sigma_over_T", *sigma_over_T, std::nullopt, true}};
-        r.evaluations = 1;
-        very_rough_prediction(p, v.factor, v.correlation, *sigma_over_T, r.prediction);
-        set_errors(p, r);
-    };
-    // Per factor (F_Beck, then F_VH): its terms, the two-point models, the fits.
+// One very-rough model of Table 4: B–K (F_Beck) or V–H (F_VH), Gaussian or exponential.
+struct VeryRoughVariant {
+    ComparisonModel model, fit;
+    GeometricFactor factor;
+    Correlation correlation;
+};
+
+constexpr VeryRoughVariant kVeryRoughVariants[] = {
+    {ComparisonModel::BkGaussian, ComparisonModel::BkGaussianFit, GeometricFactor::Beckmann,
+     Correlation::Gaussian},
+    {ComparisonModel::BkExponential, ComparisonModel::BkExponentialFit, GeometricFactor::Beckmann,
+     Correlation::Exponential},
+    {ComparisonModel::VhGaussian, ComparisonModel::VhGaussianFit, GeometricFactor::VernoldHarvey,
+     Correlation::Gaussian},
+    {ComparisonModel::VhExponential, ComparisonModel::VhExponentialFit,
+     GeometricFactor::VernoldHarvey, Correlation::Exponential},
+};
+
+// The very-rough model `v` at the two-point estimate of σ/T (unavailable without it).
+void very_rough_at_two_point(const Prepared& p, Comparison& c, const ComparisonOptions& o,
+                             const VeryRoughVariant& v) {
+    ModelResult& r = result_of(c, v.model);
+    const bool gaussian = v.correlation == Correlation::Gaussian;
+    const std::optional<double> sigma_over_T =
+        gaussian ? c.two_point.sigma_over_T_gaussian : c.two_point.sigma_over_T_exponential;
+    if (!sigma_over_T) {
+        r.reason = "two-point estimate unavailable: " +
+                   (!c.two_point.available ? c.two_point.reason
+                                           : (gaussian ? c.two_point.gaussian_reason
+                                                       : c.two_point.exponential_reason));
+        return;
+    }
+    r.available = true;
+    r.method = std::string("two-point estimate of sigma/T (") + (gaussian ? "Eq. 17" : "Eq. 19") +
+               ", F_VH, measurements " + std::to_string(o.measurement1) + " and " +
+               std::to_string(o.measurement2) + "); " + (gaussian ? "Eq. 4" : "Eq. 5") + " with " +
+               (v.factor == GeometricFactor::Beckmann ? "F_Beck" : "F_VH") + ", " +
+               std::string(to_string(o.radiometry));
+    r.parameters = {{"sigma_over_T", *sigma_over_T, std::nullopt, true}};
+    r.evaluations = 1;
+    very_rough_prediction(p, v.factor, v.correlation, *sigma_over_T, r.prediction);
+    set_errors(p, r);
+}
+
+// B–K (F_Beck) and V–H (F_VH), per factor: its terms, the two-point models, the fits.
+void compare_very_rough(Prepared& p, Comparison& c, const ComparisonOptions& o) {
     for (const GeometricFactor factor :
          {GeometricFactor::Beckmann, GeometricFactor::VernoldHarvey}) {
         prepare_very_rough(p, factor);
-        for (const VeryRoughVariant& v : variants)
-            if (v.factor == factor) two_point_model(v);
+        for (const VeryRoughVariant& v : kVeryRoughVariants)
+            if (v.factor == factor) very_rough_at_two_point(p, c, o, v);
         if (!o.fits) continue;
-        for (const VeryRoughVariant& v : variants) {
+        for (const VeryRoughVariant& v : kVeryRoughVariants) {
             if (v.factor != factor) continue;
-            ModelResult& r = result(v.fit);
+            ModelResult& r = result_of(c, v.fit);
             r.method = std::string("least squares over sigma/T and the gain; ") +
                        (v.correlation == Correlation::Gaussian ? "Eq. 4" : "Eq. 5") + " with " +
                        (v.factor == GeometricFactor::Beckmann ? "F_Beck" : "F_VH") + ", " +
@@ -992,6 +866,43 @@ Comparison compare(const BrdfTable& table, const ComparisonOptions& o, BrdfTable
         }
     }
     p.very_rough_terms = VeryRoughTerms();
+}
+
+// compare_brdf; `release`, when given, is `table` itself, whose measurements are released as soon
+// as the comparison has taken what it needs of them.
+Comparison compare(const BrdfTable& table, const ComparisonOptions& o, BrdfTable* release) {
+    validate(o);
+    if (table.measurements.empty())
+        throw InvalidArgument("BRDF table '" + table.name + "' has no measurements");
+
+    Comparison c;
+    c.name = table.name;
+    c.channel = table.channel;
+    c.total_measurements = table.size();
+    const std::vector<bool> used = detail::select_measurements(table, o, c.data_issues);
+    const double dmax = detail::copy_used_measurements(table, used, c);
+    c.two_point = detail::two_point_estimate(table, used, o);
+    if (release) std::vector<BrdfMeasurement>().swap(release->measurements);
+
+    c.models = empty_results();
+    if (c.measurement.empty() || !(dmax > 0.0)) {
+        const std::string why = c.measurement.empty()
+                                    ? "no measurement is used (all excluded)"
+                                    : "no positive brightness among the used measurements: the "
+                                      "data cannot be normalised";
+        for (ModelResult& r : c.models) r.reason = why;
+        return c;
+    }
+    std::vector<double> d(c.brightness.size());
+    for (std::size_t j = 0; j < d.size(); ++j) d[j] = c.brightness[j] / dmax;
+    Prepared p = prepare(c.geometry, std::move(d), c.weight, o.radiometry);
+    p.keep_predictions = o.keep_predictions;
+
+    // One model family at a time (Prepared): its terms, its paper method, its fit. Each model's
+    // result depends on its own computation only, so the order does not change any number.
+    compare_oren_nayar(p, c, o);
+    compare_lafortune(p, c, o);
+    compare_very_rough(p, c, o);
     if (!o.fits)
         for (ModelResult& r : c.models)
             if (is_fit(r.model)) r.reason = "fits not requested";
@@ -1007,67 +918,6 @@ Comparison compare_brdf(const BrdfTable& table, const ComparisonOptions& o) {
 
 Comparison compare_brdf(BrdfTable&& table, const ComparisonOptions& o) {
     return compare(table, o, &table);
-}
-
-Comparison compare_curet_sample(const CuretDatabase& db, int sample,
-                                const ComparisonOptions& options) {
-    const BrdfTable table = db.sample_table(sample);  // throws for an unknown sample
-    ComparisonOptions o = options;
-    if (!o.oren_nayar) {
-        if (const auto on = paper_oren_nayar_params(sample)) {
-            o.oren_nayar = on;
-            o.oren_nayar_source = "the paper's Table 3, from the CUReT database";
-        }
-    }
-    Comparison c = compare_brdf(table, o);
-    c.sample = sample;
-    const std::string_view name = curet_sample_name(sample);
-    if (!name.empty()) c.name = std::string(name);
-    return c;
-}
-
-std::vector<Comparison> compare_curet_all(const CuretDatabase& db, const ComparisonOptions& options,
-                                          int threads) {
-    validate(options);
-    if (threads < 0)
-        throw InvalidArgument("threads = " + std::to_string(threads) + " must be >= 0");
-    const std::size_t n = db.samples.size();
-    std::vector<Comparison> out(n);
-    std::size_t workers = threads > 0 ? static_cast<std::size_t>(threads)
-                                      : std::max(1u, std::thread::hardware_concurrency());
-    workers = std::max<std::size_t>(1, std::min(workers, n));
-    // Samples in parallel, each comparison on one thread; one worker: `threads` for the
-    // comparison itself unless its options set their own.
-    ComparisonOptions sample_options = options;
-    if (workers > 1)
-        sample_options.threads = 1;
-    else if (threads > 0 && sample_options.threads == 0)
-        sample_options.threads = static_cast<std::size_t>(threads);
-    std::atomic<std::size_t> next{0};
-    std::exception_ptr error;
-    std::mutex error_mutex;
-    auto work = [&] {
-        while (true) {
-            const std::size_t k = next.fetch_add(1);
-            if (k >= n) return;
-            try {
-                out[k] = compare_curet_sample(db, db.samples[k], sample_options);
-            } catch (...) {
-                std::lock_guard<std::mutex> lock(error_mutex);
-                if (!error) error = std::current_exception();
-                next.store(n);
-            }
-        }
-    };
-    if (workers == 1) {
-        work();
-    } else {
-        std::vector<std::thread> pool;
-        for (std::size_t t = 0; t < workers; ++t) pool.emplace_back(work);
-        for (std::thread& t : pool) t.join();
-    }
-    if (error) std::rethrow_exception(error);
-    return out;
 }
 
 }  // namespace roughscope

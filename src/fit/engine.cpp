@@ -7,18 +7,18 @@
 #include <cmath>
 #include <exception>
 #include <memory>
-#include <mutex>
 #include <numeric>
 #include <string>
 #include <vector>
 
 #include <Eigen/Dense>
 #include <ceres/ceres.h>
-#include <glog/logging.h>
 
+#include "rank.hpp"
 #include "roughscope/core/errors.hpp"
 #include "roughscope/core/names.hpp"
 #include "roughscope/core/numbers.hpp"
+#include "solver_log.hpp"
 
 namespace roughscope {
 
@@ -56,6 +56,11 @@ ResidualType parse_residual_type(std::string_view name) {
 LossType parse_loss_type(std::string_view name) { return parse_name(kLossNames, "loss", name); }
 
 namespace {
+
+using detail::inverse_normal_matrix;
+using detail::SolverLogCapture;
+using detail::triangular_factor;
+using detail::unidentified;
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
@@ -414,78 +419,6 @@ class EngineCost final : public ceres::CostFunction {
     mutable std::vector<double> last_x_, last_r_;
 };
 
-// ---------------------------------------------------------------------------------------------
-// Ceres' own log lines (glog): kept off the terminal and put in the result's message instead.
-//
-// Ceres writes through glog whatever the solver options say (e.g. "Terminating: Residual and
-// Jacobian evaluation failed." at ERROR). Before glog is initialised every such line goes to
-// stderr, so on the first solve, if the host program has not initialised glog itself, the library
-// does: no log files, nothing on stderr below FATAL (the environment's GLOG_* settings still
-// apply). A host that initialised glog keeps its own configuration. Either way one process-wide
-// sink copies each line logged by a thread inside solve_least_squares into that solve's capture.
-
-thread_local std::vector<std::string>* t_solver_log = nullptr;
-
-class SolverLogSink final : public google::LogSink {
-  public:
-    void send(google::LogSeverity /*severity*/, const char* /*full_filename*/,
-              const char* /*base_filename*/, int /*line*/, const google::LogMessageTime& /*time*/,
-              const char* message, std::size_t message_len) override {
-        if (t_solver_log != nullptr) t_solver_log->emplace_back(message, message_len);
-    }
-};
-
-void quiet_solver_logging() {
-    static std::once_flag once;
-    std::call_once(once, [] {
-        if (!google::IsGoogleLoggingInitialized()) {
-            google::InitGoogleLogging("roughscope");
-            for (int severity = google::GLOG_INFO; severity < google::NUM_SEVERITIES; ++severity)
-                google::SetLogDestination(severity, "");
-            FLAGS_stderrthreshold = google::GLOG_FATAL;
-        }
-        static SolverLogSink sink;
-        google::AddLogSink(&sink);
-    });
-}
-
-// Collects the lines Ceres logs on this thread while alive.
-class SolverLogCapture {
-  public:
-    SolverLogCapture() : previous_(t_solver_log) {
-        quiet_solver_logging();
-        t_solver_log = &lines_;
-    }
-    ~SolverLogCapture() { t_solver_log = previous_; }
-    SolverLogCapture(const SolverLogCapture&) = delete;
-    SolverLogCapture& operator=(const SolverLogCapture&) = delete;
-
-    // "; solver log: <line> (N times); <line>" with each distinct line once, in order; empty
-    // when nothing was logged.
-    std::string summary() const {
-        std::vector<std::pair<std::string, int>> distinct;
-        for (const std::string& line : lines_) {
-            auto it = std::find_if(distinct.begin(), distinct.end(),
-                                   [&](const auto& d) { return d.first == line; });
-            if (it == distinct.end())
-                distinct.emplace_back(line, 1);
-            else
-                ++it->second;
-        }
-        std::string out;
-        for (const auto& [line, count] : distinct) {
-            out += out.empty() ? "; solver log: " : "; ";
-            out += line;
-            if (count > 1) out += " (" + std::to_string(count) + " times)";
-        }
-        return out;
-    }
-
-  private:
-    std::vector<std::string> lines_;
-    std::vector<std::string>* previous_;
-};
-
 // Ceres solve from start x (size n, or n + 1 with a free gain).
 struct Run {
     std::vector<double> x;
@@ -680,69 +613,6 @@ bool jacobian(const Evaluator& e, const LeastSquaresProblem& P, std::vector<doub
     return J.allFinite();
 }
 
-// The upper-triangular factor R (p×p) of the thin QR decomposition J = QR of a tall J (rows ≥
-// columns), computed in place: J is overwritten (and released by the caller's reassignment).
-Eigen::MatrixXd triangular_factor(Eigen::MatrixXd& J) {
-    const Eigen::Index p = J.cols();
-    const Eigen::HouseholderQR<Eigen::Ref<Eigen::MatrixXd>> qr(J);
-    return qr.matrixQR().topRows(p).triangularView<Eigen::Upper>();
-}
-
-// Identifiability of the columns `cols` of J: the names of the parameters that the data do not
-// determine (empty when J restricted to cols has full column rank).
-std::vector<int> unidentified(const Eigen::MatrixXd& J, const std::vector<int>& cols, double tol) {
-    std::vector<int> bad;
-    if (cols.empty()) return bad;
-    Eigen::VectorXd norms(static_cast<Eigen::Index>(cols.size()));
-    for (std::size_t a = 0; a < cols.size(); ++a)
-        norms(static_cast<Eigen::Index>(a)) = J.col(cols[a]).norm();
-    const double max_norm = norms.maxCoeff();
-    std::vector<int> live;
-    for (std::size_t a = 0; a < cols.size(); ++a) {
-        if (!(norms(static_cast<Eigen::Index>(a)) > tol * max_norm))
-            bad.push_back(cols[a]);  // no effect on the residuals
-        else
-            live.push_back(cols[a]);
-    }
-    if (live.size() >= 2) {
-        Eigen::MatrixXd S(J.rows(), static_cast<Eigen::Index>(live.size()));
-        for (std::size_t a = 0; a < live.size(); ++a)
-            S.col(static_cast<Eigen::Index>(a)) = J.col(live[a]) / J.col(live[a]).norm();
-        Eigen::JacobiSVD<Eigen::MatrixXd> svd(S, Eigen::ComputeThinV);
-        const Eigen::VectorXd& sv = svd.singularValues();
-        const Eigen::MatrixXd& V = svd.matrixV();
-        std::vector<bool> flagged(live.size(), false);
-        for (Eigen::Index k = 0; k < sv.size(); ++k) {
-            if (sv(k) > tol * sv(0)) continue;
-            for (std::size_t a = 0; a < live.size(); ++a)
-                if (std::abs(V(static_cast<Eigen::Index>(a), k)) >= 0.1) flagged[a] = true;
-        }
-        for (std::size_t a = 0; a < live.size(); ++a)
-            if (flagged[a]) bad.push_back(live[a]);
-    }
-    std::sort(bad.begin(), bad.end());
-    return bad;
-}
-
-// (JᵀJ)⁻¹ over the columns `cols` (others zero), from an SVD; false when rank deficient.
-bool inverse_normal_matrix(const Eigen::MatrixXd& J, const std::vector<int>& cols,
-                           Eigen::MatrixXd& C) {
-    C.setZero(J.cols(), J.cols());
-    if (cols.empty()) return true;
-    Eigen::MatrixXd S(J.rows(), static_cast<Eigen::Index>(cols.size()));
-    for (std::size_t a = 0; a < cols.size(); ++a)
-        S.col(static_cast<Eigen::Index>(a)) = J.col(cols[a]);
-    Eigen::JacobiSVD<Eigen::MatrixXd> svd(S, Eigen::ComputeThinV);
-    const Eigen::VectorXd& sv = svd.singularValues();
-    if (!(sv(sv.size() - 1) > 1e-12 * sv(0))) return false;
-    const Eigen::VectorXd inv2 = sv.array().square().inverse();
-    const Eigen::MatrixXd Cs = svd.matrixV() * inv2.asDiagonal() * svd.matrixV().transpose();
-    for (std::size_t a = 0; a < cols.size(); ++a)
-        for (std::size_t b = 0; b < cols.size(); ++b)
-            C(cols[a], cols[b]) = Cs(static_cast<Eigen::Index>(a), static_cast<Eigen::Index>(b));
-    return C.allFinite();
-}
-
 std::string join_names(const std::vector<FitParameter>& ps, const std::vector<int>& idx) {
     std::string s;
     for (int j : idx) s += (s.empty() ? "" : ", ") + ps[static_cast<std::size_t>(j)].name;
@@ -838,6 +708,193 @@ std::string LeastSquaresResult::brief_report() const {
     return s + brief_report_tail(parameters, covariance_available, sse, aic, message);
 }
 
+namespace {
+
+// One Ceres run per start (with a free gain, the profiled one as its start); the run with the
+// lowest final cost among the usable ones (not failed) wins. `iterations` adds up every run's.
+Run best_run(const Evaluator& e, const LeastSquaresProblem& P, const LeastSquaresOptions& O,
+             GainMode mode, int& iterations) {
+    const std::vector<std::vector<double>> starts = grid_starts(e, P, O, O.num_starts);
+    bool have_run = false;
+    Run best;
+    for (std::vector<double> x : starts) {
+        if (mode == GainMode::Free) {
+            double K = 1.0;
+            std::vector<double> r_start(e.size());
+            if (!e.residuals(x.data(), GainMode::Profiled, false, r_start.data(), &K)) K = 1.0;
+            x.push_back(K);
+        }
+        Run run = solve_from(e, O, std::move(x));
+        iterations += run.iterations;
+        const bool usable = run.summary.termination_type != ceres::FAILURE &&
+                            run.summary.termination_type != ceres::USER_FAILURE;
+        const bool best_usable = have_run && best.summary.termination_type != ceres::FAILURE &&
+                                 best.summary.termination_type != ceres::USER_FAILURE;
+        if (!have_run ||
+            (usable && (!best_usable || run.summary.final_cost < best.summary.final_cost))) {
+            best = std::move(run);
+            have_run = true;
+        }
+    }
+    return best;
+}
+
+SolverStatus status_of(ceres::TerminationType termination) {
+    switch (termination) {
+        case ceres::CONVERGENCE:
+            return SolverStatus::Converged;
+        case ceres::NO_CONVERGENCE:
+            return SolverStatus::NoConvergence;
+        default:
+            return SolverStatus::Failed;
+    }
+}
+
+// The solution x: the model M, the gain K and the unrobustified residuals r (resized to N);
+// false when the model or the residuals cannot be evaluated there.
+bool evaluate_solution(const Evaluator& e, const LeastSquaresProblem& P, GainMode mode,
+                       const std::vector<double>& x, std::vector<double>& M, double& K,
+                       std::vector<double>& r) {
+    const int n = e.n();
+    const bool has_gain = P.gain != GainMode::None;
+    r.resize(e.size());
+    K = 1.0;
+    bool finite = e.model(x.data(), M);
+    if (finite) {
+        if (mode == GainMode::Profiled)
+            K = optimal_gain(M, P.data, e.weights(), P.residual);
+        else if (mode == GainMode::Free)
+            K = x[static_cast<std::size_t>(n)];
+        std::vector<double> xk(x.begin(), x.begin() + n);
+        if (has_gain) xk.push_back(K);
+        finite =
+            std::isfinite(K) &&
+            e.residuals(xk.data(), has_gain ? GainMode::Free : GainMode::None, false, r.data());
+    }
+    return finite;
+}
+
+// The Jacobian at the solution and what the rank test and the covariance need of it.
+struct SolutionJacobian {
+    bool available = false;
+    Eigen::MatrixXd R;       // triangular factor of J (RᵀR = JᵀJ)
+    Eigen::MatrixXd R_rank;  // R with the gain's column as ∂r/∂ln K
+    std::vector<int> free_cols;
+};
+
+// Whether parameter j, on a bound, is held there: the gradient of the cost pushes it out of the
+// box (|cos(J_j, r)| > 1e-4 with the outward sign).
+bool held_on_bound(const Evaluator& e, const Eigen::MatrixXd& J, const Eigen::VectorXd& rv, int j,
+                   double uj) {
+    const double g = J.col(j).dot(rv);
+    const double scale = J.col(j).norm() * rv.norm();
+    const bool at_lower = std::abs(uj - e.lower(j)) <= 1e-9 * std::max(1.0, std::abs(uj));
+    return scale > 0.0 && (at_lower ? g : -g) > 1e-4 * scale;
+}
+
+// Identifiability. A parameter on a bound is "held" there (held_on_bound) when fixed by the bound
+// and left out of the rank test. One on a bound with no such pull (a flat direction that drifted
+// to the bound) is tested like a free one. Returns the indices of the parameters the data do not
+// determine, noting why in res.message.
+std::vector<int> identifiability(const Evaluator& e, const LeastSquaresProblem& P,
+                                 const LeastSquaresOptions& O, const std::vector<double>& x,
+                                 double K, const std::vector<double>& M,
+                                 const std::vector<double>& r, LeastSquaresResult& res,
+                                 SolutionJacobian& jac) {
+    const int n = e.n();
+    const int N = res.num_data, p = res.num_parameters;
+    const bool has_gain = P.gain != GainMode::None;
+    std::vector<int> bad;
+    if (N < p) {
+        bad.resize(static_cast<std::size_t>(p));
+        std::iota(bad.begin(), bad.end(), 0);
+        res.message += "; " + std::to_string(N) + " data points (with weight > 0) for " +
+                       std::to_string(p) + " parameters: at least " + std::to_string(p) +
+                       " are needed";
+        return bad;
+    }
+    Eigen::MatrixXd J;
+    jac.available = jacobian(e, P, std::vector<double>(x.begin(), x.begin() + n), K, M, r, J);
+    if (jac.available) {
+        const Eigen::Map<const Eigen::VectorXd> rv(r.data(), static_cast<Eigen::Index>(r.size()));
+        for (int j = 0; j < p; ++j)
+            if (!res.parameters[static_cast<std::size_t>(j)].at_bound ||
+                !held_on_bound(e, J, rv, j, x[static_cast<std::size_t>(j)]))
+                jac.free_cols.push_back(j);
+        // Everything below depends on J only through JᵀJ: J = QR (thin, Householder, in
+        // place) gives the p×p factor R with RᵀR = JᵀJ, the same column norms and singular
+        // values, so that no further copy of the N×p Jacobian is needed (N can be 1e6).
+        jac.R = triangular_factor(J);
+        // The rank test compares relative effects: the gain's column as ∂r/∂ln K = K ∂r/∂K,
+        // like a Log parameter's (∂r/∂ln θ); in natural units a large K would make its column
+        // look like one "without effect" and hide the parameter it trades off with.
+        jac.R_rank = jac.R;
+        if (has_gain) jac.R_rank.col(n) *= std::abs(K);
+        bad = unidentified(jac.R_rank, jac.free_cols, O.rank_tolerance);
+    }
+    if (!bad.empty())
+        res.message += "; the Jacobian is rank deficient: the data do not determine " +
+                       join_names(res.parameters, bad) +
+                       " (a parameter without effect, repeated geometries or constant "
+                       "data, or parameters that trade off exactly)";
+    return bad;
+}
+
+// The covariance of the parameters in natural units (scaled by the residual variance when
+// O.scale_covariance) and their standard errors, or a note in res.message on why not.
+void set_covariance(const LeastSquaresProblem& P, const LeastSquaresOptions& O,
+                    const SolutionJacobian& jac, bool identified, LeastSquaresResult& res) {
+    const int n = static_cast<int>(P.parameters.size());
+    const int N = res.num_data, p = res.num_parameters;
+    res.covariance = Eigen::MatrixXd::Zero(p, p);
+    if (jac.available && identified) {
+        std::vector<int> all(static_cast<std::size_t>(p));
+        std::iota(all.begin(), all.end(), 0);
+        Eigen::MatrixXd C;
+        const bool full = unidentified(jac.R_rank, all, O.rank_tolerance).empty() &&
+                          inverse_normal_matrix(jac.R, all, C);
+        const bool ok = full || inverse_normal_matrix(jac.R, jac.free_cols, C);
+        if (ok && (N > p || !O.scale_covariance)) {
+            const double scale = O.scale_covariance ? res.sse / (N - p) : 1.0;
+            std::vector<double> d(static_cast<std::size_t>(p), 1.0);  // dθ/du
+            for (int j = 0; j < n; ++j)
+                if (P.parameters[static_cast<std::size_t>(j)].transform == Transform::Log)
+                    d[static_cast<std::size_t>(j)] =
+                        res.parameters[static_cast<std::size_t>(j)].value;
+            for (int a = 0; a < p; ++a)
+                for (int b = 0; b < p; ++b)
+                    res.covariance(a, b) = scale * C(a, b) * d[static_cast<std::size_t>(a)] *
+                                           d[static_cast<std::size_t>(b)];
+            res.covariance_available = res.covariance.allFinite();
+        }
+        if (!res.covariance_available)
+            res.message += N > p ? "; covariance unavailable (singular Jacobian)"
+                                 : "; covariance unavailable (N = p: no degrees of freedom)";
+    } else if (!jac.available && N >= p) {
+        res.message += "; covariance unavailable (the Jacobian cannot be evaluated)";
+    }
+    if (res.covariance_available)
+        for (int j = 0; j < p; ++j)
+            res.parameters[static_cast<std::size_t>(j)].std_error =
+                std::sqrt(std::max(0.0, res.covariance(j, j)));
+}
+
+// Notes the parameters (not the gain) that end on a bound; a converged fit becomes AtBound.
+void note_bounds(int n, LeastSquaresResult& res) {
+    std::string list;
+    for (int j = 0; j < n; ++j) {
+        const FitParameter& fp = res.parameters[static_cast<std::size_t>(j)];
+        if (!fp.at_bound) continue;
+        list += (list.empty() ? "" : ", ") + fp.name + " = " + format_message(fp.value, 6) +
+                " in [" + format_message(fp.lower, 6) + ", " + format_message(fp.upper, 6) + "]";
+    }
+    if (list.empty()) return;
+    res.message += "; on a bound: " + list;
+    if (res.status == SolverStatus::Converged) res.status = SolverStatus::AtBound;
+}
+
+}  // namespace
+
 LeastSquaresResult solve_least_squares(const LeastSquaresProblem& P, const LeastSquaresOptions& O) {
     validate(P, O);
     const GainMode mode =
@@ -861,63 +918,18 @@ LeastSquaresResult solve_least_squares(const LeastSquaresProblem& P, const Least
 
     // Starts, then one Ceres run per start; the lowest final cost wins.
     SolverLogCapture solver_log;
-    const std::vector<std::vector<double>> starts = grid_starts(e, P, O, O.num_starts);
-    // The residuals at the solution; allocated after the solves (N can be 1e6: not beside
-    // Ceres' working set).
-    std::vector<double> r;
-    bool have_run = false;
-    Run best;
-    for (std::vector<double> x : starts) {
-        if (mode == GainMode::Free) {
-            double K = 1.0;
-            std::vector<double> r_start(e.size());
-            if (!e.residuals(x.data(), GainMode::Profiled, false, r_start.data(), &K)) K = 1.0;
-            x.push_back(K);
-        }
-        Run run = solve_from(e, O, std::move(x));
-        res.iterations += run.iterations;
-        const bool usable = run.summary.termination_type != ceres::FAILURE &&
-                            run.summary.termination_type != ceres::USER_FAILURE;
-        const bool best_usable = have_run && best.summary.termination_type != ceres::FAILURE &&
-                                 best.summary.termination_type != ceres::USER_FAILURE;
-        if (!have_run ||
-            (usable && (!best_usable || run.summary.final_cost < best.summary.final_cost))) {
-            best = std::move(run);
-            have_run = true;
-        }
-    }
+    const Run best = best_run(e, P, O, mode, res.iterations);
     res.initial_cost = best.summary.initial_cost;
     res.final_cost = best.summary.final_cost;
     res.message = best.summary.message + solver_log.summary();
-    switch (best.summary.termination_type) {
-        case ceres::CONVERGENCE:
-            res.status = SolverStatus::Converged;
-            break;
-        case ceres::NO_CONVERGENCE:
-            res.status = SolverStatus::NoConvergence;
-            break;
-        default:
-            res.status = SolverStatus::Failed;
-            break;
-    }
+    res.status = status_of(best.summary.termination_type);
 
-    // The solution: model, gain, residuals (unrobustified).
+    // The solution: model, gain, residuals (unrobustified). The residuals are allocated after the
+    // solves (N can be 1e6: not beside Ceres' working set).
     const std::vector<double>& x = best.x;
-    r.resize(e.size());
-    std::vector<double> M;
+    std::vector<double> M, r;
     double K = 1.0;
-    bool finite = e.model(x.data(), M);
-    if (finite) {
-        if (mode == GainMode::Profiled)
-            K = optimal_gain(M, P.data, w, P.residual);
-        else if (mode == GainMode::Free)
-            K = x[static_cast<std::size_t>(n)];
-        std::vector<double> xk(x.begin(), x.begin() + n);
-        if (has_gain) xk.push_back(K);
-        finite =
-            std::isfinite(K) &&
-            e.residuals(xk.data(), has_gain ? GainMode::Free : GainMode::None, false, r.data());
-    }
+    const bool finite = evaluate_solution(e, P, mode, x, M, K, r);
     res.evaluations = e.evaluations();
     for (int j = 0; j < n; ++j) {
         const ParameterSpec& s = P.parameters[static_cast<std::size_t>(j)];
@@ -941,55 +953,8 @@ LeastSquaresResult solve_least_squares(const LeastSquaresProblem& P, const Least
     res.aic = N * std::log(sse_floor) + 2.0 * p;
     res.aicc = N - p - 1 > 0 ? res.aic + 2.0 * p * (p + 1) / double(N - p - 1) : kInf;
 
-    // Identifiability and covariance. A parameter on a bound is "held" there when the gradient of
-    // the cost pushes it out of the box (|cos(J_j, r)| > 1e-4 with the outward sign): it is then
-    // fixed by the bound and left out of the rank test. One on a bound with no such pull (a flat
-    // direction that drifted to the bound) is tested like a free one.
-    std::vector<int> all(static_cast<std::size_t>(p)), free_cols;
-    std::iota(all.begin(), all.end(), 0);
-    std::vector<int> bad;
-    Eigen::MatrixXd J, J_rank;
-    bool have_J = false;
-    if (N < p) {
-        bad = all;
-        res.message += "; " + std::to_string(N) + " data points (with weight > 0) for " +
-                       std::to_string(p) + " parameters: at least " + std::to_string(p) +
-                       " are needed";
-    } else {
-        std::vector<double> u(x.begin(), x.begin() + n);
-        have_J = jacobian(e, P, u, K, M, r, J);
-        if (have_J) {
-            const Eigen::Map<const Eigen::VectorXd> rv(r.data(),
-                                                       static_cast<Eigen::Index>(r.size()));
-            for (int j = 0; j < p; ++j) {
-                bool held = false;
-                if (res.parameters[static_cast<std::size_t>(j)].at_bound) {
-                    const double g = J.col(j).dot(rv);
-                    const double scale = J.col(j).norm() * rv.norm();
-                    const double uj = x[static_cast<std::size_t>(j)];
-                    const bool at_lower =
-                        std::abs(uj - e.lower(j)) <= 1e-9 * std::max(1.0, std::abs(uj));
-                    held = scale > 0.0 && (at_lower ? g : -g) > 1e-4 * scale;
-                }
-                if (!held) free_cols.push_back(j);
-            }
-            // Everything below depends on J only through JᵀJ: J = QR (thin, Householder, in
-            // place) gives the p×p factor R with RᵀR = JᵀJ, the same column norms and singular
-            // values, so that no further copy of the N×p Jacobian is needed (N can be 1e6).
-            J = triangular_factor(J);
-            // The rank test compares relative effects: the gain's column as ∂r/∂ln K = K ∂r/∂K,
-            // like a Log parameter's (∂r/∂ln θ); in natural units a large K would make its column
-            // look like one "without effect" and hide the parameter it trades off with.
-            J_rank = J;
-            if (has_gain) J_rank.col(n) *= std::abs(K);
-            bad = unidentified(J_rank, free_cols, O.rank_tolerance);
-        }
-        if (!bad.empty())
-            res.message += "; the Jacobian is rank deficient: the data do not determine " +
-                           join_names(res.parameters, bad) +
-                           " (a parameter without effect, repeated geometries or constant "
-                           "data, or parameters that trade off exactly)";
-    }
+    SolutionJacobian jac;
+    const std::vector<int> bad = identifiability(e, P, O, x, K, M, r, res, jac);
     for (int j : bad) {
         res.not_identifiable.push_back(res.parameters[static_cast<std::size_t>(j)].name);
         res.parameters[static_cast<std::size_t>(j)].identified = false;
@@ -997,51 +962,8 @@ LeastSquaresResult solve_least_squares(const LeastSquaresProblem& P, const Least
     if (!bad.empty() && res.status != SolverStatus::Failed)
         res.status = SolverStatus::NotIdentifiable;
     res.evaluations = e.evaluations();
-
-    res.covariance = Eigen::MatrixXd::Zero(p, p);
-    if (have_J && bad.empty()) {
-        Eigen::MatrixXd C;
-        const bool full =
-            unidentified(J_rank, all, O.rank_tolerance).empty() && inverse_normal_matrix(J, all, C);
-        const bool ok = full || inverse_normal_matrix(J, free_cols, C);
-        if (ok && (N > p || !O.scale_covariance)) {
-            const double scale = O.scale_covariance ? sse / (N - p) : 1.0;
-            std::vector<double> d(static_cast<std::size_t>(p), 1.0);  // dθ/du
-            for (int j = 0; j < n; ++j)
-                if (P.parameters[static_cast<std::size_t>(j)].transform == Transform::Log)
-                    d[static_cast<std::size_t>(j)] =
-                        res.parameters[static_cast<std::size_t>(j)].value;
-            for (int a = 0; a < p; ++a)
-                for (int b = 0; b < p; ++b)
-                    res.covariance(a, b) = scale * C(a, b) * d[static_cast<std::size_t>(a)] *
-                                           d[static_cast<std::size_t>(b)];
-            res.covariance_available = res.covariance.allFinite();
-        }
-        if (!res.covariance_available)
-            res.message += N > p ? "; covariance unavailable (singular Jacobian)"
-                                 : "; covariance unavailable (N = p: no degrees of freedom)";
-    } else if (!have_J && N >= p) {
-        res.message += "; covariance unavailable (the Jacobian cannot be evaluated)";
-    }
-    if (res.covariance_available)
-        for (int j = 0; j < p; ++j)
-            res.parameters[static_cast<std::size_t>(j)].std_error =
-                std::sqrt(std::max(0.0, res.covariance(j, j)));
-
-    std::vector<int> at;
-    for (int j = 0; j < n; ++j)
-        if (res.parameters[static_cast<std::size_t>(j)].at_bound) at.push_back(j);
-    if (!at.empty()) {
-        std::string list;
-        for (int j : at) {
-            const FitParameter& fp = res.parameters[static_cast<std::size_t>(j)];
-            list += (list.empty() ? "" : ", ") + fp.name + " = " + format_message(fp.value, 6) +
-                    " in [" + format_message(fp.lower, 6) + ", " + format_message(fp.upper, 6) +
-                    "]";
-        }
-        res.message += "; on a bound: " + list;
-        if (res.status == SolverStatus::Converged) res.status = SolverStatus::AtBound;
-    }
+    set_covariance(P, O, jac, bad.empty(), res);
+    note_bounds(n, res);
     // The N-sized outputs last: the Jacobian and its factor are gone by now (N can be 1e6).
     res.predicted.resize(M.size());
     for (std::size_t i = 0; i < M.size(); ++i) res.predicted[i] = K * M[i];

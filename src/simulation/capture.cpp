@@ -359,11 +359,11 @@ std::function<double(const Geometry&)> table_brightness(BrightnessTable table) {
 // ---------------------------------------------------------------------------------------------
 // Rendering
 
-Capture render_capture(const Scene& scene, const std::vector<SurfaceTruth>& truths,
-                       const std::vector<std::int32_t>& labels, const CameraModel& camera,
-                       const CaptureOptions& options) {
-    check_scene(scene);
-    check_camera(camera);
+namespace {
+
+// The truths and labels checked against the image and each other.
+void check_truths(const Scene& scene, const std::vector<SurfaceTruth>& truths,
+                  const std::vector<std::int32_t>& labels) {
     if (truths.empty()) throw InvalidArgument("truths: at least one surface truth is needed");
     const std::size_t W = scene.width, H = scene.height, N = W * H;
     if (!labels.empty()) {
@@ -389,10 +389,15 @@ Capture render_capture(const Scene& scene, const std::vector<SurfaceTruth>& trut
         if (t.model == BrightnessModel::Tabulated && !t.tabulated)
             throw InvalidArgument(concat(which, "model tabulated needs a table or a callback"));
     }
+}
 
+// A capture of the scene's size with the layers the options keep, all zero.
+Capture empty_capture(const Scene& scene, const CameraModel& camera,
+                      const CaptureOptions& options) {
+    const std::size_t N = scene.width * scene.height;
     Capture out;
-    out.width = W;
-    out.height = H;
+    out.width = scene.width;
+    out.height = scene.height;
     out.bit_depth = camera.bit_depth;
     if (options.keep_radiance) assign_large(out.radiance, N, 0.0F);
     if (options.keep_expected_dn) assign_large(out.expected_dn, N, 0.0F);
@@ -405,129 +410,196 @@ Capture render_capture(const Scene& scene, const std::vector<SurfaceTruth>& trut
         out.phi_s_rad.resize(N);
         out.normal.resize(3 * N);
     }
+    return out;
+}
 
-    const CameraAxes frame = camera_axes(scene.view);
-    const double radius = scene_radius_um(scene);
-    const double s = scene.pixel_size_um;
-    const double half_w = 0.5 * static_cast<double>(W), half_h = 0.5 * static_cast<double>(H);
-    const double half_diag2 = half_w * half_w + half_h * half_h;
-    const double white = camera.white_level_dn();
-    const double k_t = camera.electrons_per_unit_s * camera.exposure_s;
-    const double full_well = camera.full_well_e;
-
-    // Rows [row_begin, row_end) with their own caches and counts; each row draws from its own
-    // stream, so the split into blocks does not change the result.
-    struct BlockCounts {
-        std::size_t object = 0, saturated = 0;
-    };
-    auto render_rows = [&](std::size_t row_begin, std::size_t row_end, BlockCounts& counts) {
-        // The last brightness computed (a plane, or neighbouring pixels of one region on a flat
-        // patch, repeat the same normal) and the last shot-noise distribution (same mean).
-        Eigen::Vector3d last_normal(kNaN, kNaN, kNaN);
-        std::int32_t last_label = -2;
-        double last_brightness = 0.0;
-        std::optional<Geometry> last_geometry;
-        boost::random::poisson_distribution<std::int64_t, double> shot(1.0);
-        PoissonTable table;
-
-        for (std::size_t row = row_begin; row < row_end; ++row) {
-            boost::random::mt19937_64 engine(splitmix64(camera.seed ^ splitmix64(row)));
-            boost::random::normal_distribution<double> read_noise(0.0, 1.0);
-            double previous_mu = -1.0;
-            const double y_img = (half_h - static_cast<double>(row) - 0.5) * s;
-            const double dy = static_cast<double>(row) + 0.5 - half_h;
-            for (std::size_t col = 0; col < W; ++col) {
-                const std::size_t i = row * W + col;
-                const double x_img = (static_cast<double>(col) + 0.5 - half_w) * s;
-                const Eigen::Vector3d p = x_img * frame.right + y_img * frame.up;
-                const auto normal = surface_normal(scene.shape, p, scene.view, radius);
-                double radiance = scene.background_radiance;
-                std::int32_t label = -1;
-                std::optional<Geometry> geometry;
-                if (normal) {
-                    ++counts.object;
-                    label = labels.empty() ? 0 : labels[i];
-                    if (label == last_label && *normal == last_normal) {
-                        radiance = last_brightness;
-                        geometry = last_geometry;
-                    } else {
-                        geometry = geometry_from_vectors(*normal, scene.light, scene.view);
-                        radiance = geometry
-                                       ? surface_brightness(truths[static_cast<std::size_t>(label)],
-                                                            *geometry)
-                                       : 0.0;
-                        last_normal = *normal;
-                        last_label = label;
-                        last_brightness = radiance;
-                        last_geometry = geometry;
-                    }
-                }
-                // Camera (docs/simulation-captures.md, "Camera").
-                const double dx = static_cast<double>(col) + 0.5 - half_w;
-                const double vignette =
-                    camera.vignetting > 0.0
-                        ? 1.0 - camera.vignetting * (dx * dx + dy * dy) / half_diag2
-                        : 1.0;
-                const double mu_e = k_t * radiance * vignette;
-                double n_e = mu_e;
-                if (!(mu_e <= 1e300)) {
-                    n_e = full_well;  // overflowed: saturated whatever the draw
-                } else if (camera.shot_noise && mu_e > 0.0) {
-                    if (mu_e - full_well > 40.0 * std::sqrt(mu_e)) {
-                        n_e = full_well;  // a draw below the full well has probability < 1e-300
-                    } else {
-                        // The same mean as the previous pixel of this row: the inversion table
-                        // (exact; the rule depends on the row alone, so threads do not matter).
-                        const bool repeated = mu_e == previous_mu &&
-                                              mu_e >= PoissonTable::kMinMean &&
-                                              mu_e <= PoissonTable::kMaxMean;
-                        if (repeated) {
-                            if (table.mean() != mu_e) table.build(mu_e);
-                            n_e = static_cast<double>(table(engine));
-                        } else {
-                            if (shot.mean() != mu_e)
-                                shot =
-                                    boost::random::poisson_distribution<std::int64_t, double>(mu_e);
-                            n_e = static_cast<double>(shot(engine));
-                        }
-                    }
-                }
-                previous_mu = mu_e;
-                bool saturated = false;
-                if (n_e >= full_well) {
-                    n_e = full_well;
-                    saturated = true;
-                }
-                const double x_e = camera.read_noise_e > 0.0
-                                       ? n_e + camera.read_noise_e * read_noise(engine)
-                                       : n_e;
-                const double signal = camera.gain_dn_per_e * x_e + camera.black_level_dn;
-                if (signal >= white) saturated = true;
-                const double clipped = std::clamp(signal, 0.0, white);
-                const double encoded = camera.response == Response::Linear
-                                           ? clipped
-                                           : white * encode_response(camera, clipped / white);
-                out.dn[i] = static_cast<std::uint16_t>(std::floor(encoded + 0.5));
-                out.saturated[i] = saturated ? 1 : 0;
-                counts.saturated += saturated ? 1 : 0;
-                if (options.keep_radiance) out.radiance[i] = static_cast<float>(radiance);
-                if (options.keep_expected_dn)
-                    out.expected_dn[i] =
-                        static_cast<float>(camera.gain_dn_per_e * mu_e + camera.black_level_dn);
-                if (options.keep_geometry) {
-                    out.label[i] = label;
-                    out.theta_i_rad[i] =
-                        geometry ? static_cast<float>(geometry->theta_i_rad) : kNaNf;
-                    out.theta_s_rad[i] =
-                        geometry ? static_cast<float>(geometry->theta_s_rad) : kNaNf;
-                    out.phi_s_rad[i] = geometry ? static_cast<float>(geometry->phi_s_rad) : kNaNf;
-                    for (int c = 0; c < 3; ++c)
-                        out.normal[3 * i + static_cast<std::size_t>(c)] =
-                            normal ? static_cast<float>((*normal)[c]) : kNaNf;
+// One row's shot noise: the electrons collected for the mean mu_e, capped at the full well
+// (docs/simulation-captures.md, "Camera"). A mean repeated from the previous pixel of the row
+// draws from the inversion table (exact; the rule depends on the row alone, so threads do not
+// matter), any other from Boost's Poisson distribution.
+class ShotNoise {
+  public:
+    template <class Engine>
+    double electrons(const CameraModel& camera, double mu_e, Engine& engine) {
+        double n_e = mu_e;
+        if (!(mu_e <= 1e300)) {
+            n_e = camera.full_well_e;  // overflowed: saturated whatever the draw
+        } else if (camera.shot_noise && mu_e > 0.0) {
+            if (mu_e - camera.full_well_e > 40.0 * std::sqrt(mu_e)) {
+                n_e = camera.full_well_e;  // a draw below the full well has probability < 1e-300
+            } else {
+                const bool repeated = mu_e == previous_mu_ && mu_e >= PoissonTable::kMinMean &&
+                                      mu_e <= PoissonTable::kMaxMean;
+                if (repeated) {
+                    if (table_.mean() != mu_e) table_.build(mu_e);
+                    n_e = static_cast<double>(table_(engine));
+                } else {
+                    if (shot_.mean() != mu_e)
+                        shot_ = boost::random::poisson_distribution<std::int64_t, double>(mu_e);
+                    n_e = static_cast<double>(shot_(engine));
                 }
             }
         }
-    };
+        previous_mu_ = mu_e;
+        return n_e;
+    }
+    // A new row: no previous mean.
+    void new_row() { previous_mu_ = -1.0; }
+
+  private:
+    boost::random::poisson_distribution<std::int64_t, double> shot_{1.0};
+    PoissonTable table_;
+    double previous_mu_ = -1.0;
+};
+
+// Everything the rows of one capture share.
+struct RenderJob {
+    const Scene& scene;
+    const std::vector<SurfaceTruth>& truths;
+    const std::vector<std::int32_t>& labels;
+    const CameraModel& camera;
+    const CaptureOptions& options;
+    Capture& out;
+    CameraAxes frame;
+    double radius = 0.0;
+    double half_w = 0.0, half_h = 0.0, half_diag2 = 0.0;
+    double white = 0.0;
+    double k_t = 0.0;  // electrons per unit radiance
+};
+
+// The pixel counts of a block of rows.
+struct BlockCounts {
+    std::size_t object = 0, saturated = 0;
+};
+
+// The last brightness computed: a plane, or neighbouring pixels of one region on a flat patch,
+// repeat the same normal.
+struct LastBrightness {
+    Eigen::Vector3d normal{kNaN, kNaN, kNaN};
+    std::int32_t label = -2;
+    double brightness = 0.0;
+    std::optional<Geometry> geometry;
+};
+
+// The camera's DN of `radiance` at pixel i (column col) of one row, with its saturation flag and
+// the kept layers (docs/simulation-captures.md, "Camera").
+template <class Engine>
+bool expose_pixel(const RenderJob& job, std::size_t i, std::size_t col, double dy, double radiance,
+                  ShotNoise& shot, Engine& engine,
+                  boost::random::normal_distribution<double>& read_noise) {
+    const CameraModel& camera = job.camera;
+    const double dx = static_cast<double>(col) + 0.5 - job.half_w;
+    const double vignette = camera.vignetting > 0.0
+                                ? 1.0 - camera.vignetting * (dx * dx + dy * dy) / job.half_diag2
+                                : 1.0;
+    const double mu_e = job.k_t * radiance * vignette;
+    double n_e = shot.electrons(camera, mu_e, engine);
+    bool saturated = false;
+    if (n_e >= camera.full_well_e) {
+        n_e = camera.full_well_e;
+        saturated = true;
+    }
+    const double x_e =
+        camera.read_noise_e > 0.0 ? n_e + camera.read_noise_e * read_noise(engine) : n_e;
+    const double signal = camera.gain_dn_per_e * x_e + camera.black_level_dn;
+    if (signal >= job.white) saturated = true;
+    const double clipped = std::clamp(signal, 0.0, job.white);
+    const double encoded = camera.response == Response::Linear
+                               ? clipped
+                               : job.white * encode_response(camera, clipped / job.white);
+    job.out.dn[i] = static_cast<std::uint16_t>(std::floor(encoded + 0.5));
+    job.out.saturated[i] = saturated ? 1 : 0;
+    if (job.options.keep_expected_dn)
+        job.out.expected_dn[i] =
+            static_cast<float>(camera.gain_dn_per_e * mu_e + camera.black_level_dn);
+    return saturated;
+}
+
+// The geometry layers of pixel i (NaN off the object).
+void keep_geometry(Capture& out, std::size_t i, std::int32_t label,
+                   const std::optional<Geometry>& geometry,
+                   const std::optional<Eigen::Vector3d>& normal) {
+    out.label[i] = label;
+    out.theta_i_rad[i] = geometry ? static_cast<float>(geometry->theta_i_rad) : kNaNf;
+    out.theta_s_rad[i] = geometry ? static_cast<float>(geometry->theta_s_rad) : kNaNf;
+    out.phi_s_rad[i] = geometry ? static_cast<float>(geometry->phi_s_rad) : kNaNf;
+    for (int c = 0; c < 3; ++c)
+        out.normal[3 * i + static_cast<std::size_t>(c)] =
+            normal ? static_cast<float>((*normal)[c]) : kNaNf;
+}
+
+// Rows [row_begin, row_end) with their own caches and counts; each row draws from its own
+// stream, so the split into blocks does not change the result.
+void render_rows(const RenderJob& job, std::size_t row_begin, std::size_t row_end,
+                 BlockCounts& counts) {
+    const Scene& scene = job.scene;
+    const std::size_t W = scene.width;
+    const double s = scene.pixel_size_um;
+    LastBrightness last;
+    ShotNoise shot;
+    for (std::size_t row = row_begin; row < row_end; ++row) {
+        boost::random::mt19937_64 engine(splitmix64(job.camera.seed ^ splitmix64(row)));
+        boost::random::normal_distribution<double> read_noise(0.0, 1.0);
+        shot.new_row();
+        const double y_img = (job.half_h - static_cast<double>(row) - 0.5) * s;
+        const double dy = static_cast<double>(row) + 0.5 - job.half_h;
+        for (std::size_t col = 0; col < W; ++col) {
+            const std::size_t i = row * W + col;
+            const double x_img = (static_cast<double>(col) + 0.5 - job.half_w) * s;
+            const Eigen::Vector3d p = x_img * job.frame.right + y_img * job.frame.up;
+            const auto normal = surface_normal(scene.shape, p, scene.view, job.radius);
+            double radiance = scene.background_radiance;
+            std::int32_t label = -1;
+            std::optional<Geometry> geometry;
+            if (normal) {
+                ++counts.object;
+                label = job.labels.empty() ? 0 : job.labels[i];
+                if (label == last.label && *normal == last.normal) {
+                    radiance = last.brightness;
+                    geometry = last.geometry;
+                } else {
+                    geometry = geometry_from_vectors(*normal, scene.light, scene.view);
+                    radiance = geometry
+                                   ? surface_brightness(job.truths[static_cast<std::size_t>(label)],
+                                                        *geometry)
+                                   : 0.0;
+                    last = {*normal, label, radiance, geometry};
+                }
+            }
+            const bool saturated =
+                expose_pixel(job, i, col, dy, radiance, shot, engine, read_noise);
+            counts.saturated += saturated ? 1 : 0;
+            if (job.options.keep_radiance) job.out.radiance[i] = static_cast<float>(radiance);
+            if (job.options.keep_geometry) keep_geometry(job.out, i, label, geometry, normal);
+        }
+    }
+}
+
+}  // namespace
+
+Capture render_capture(const Scene& scene, const std::vector<SurfaceTruth>& truths,
+                       const std::vector<std::int32_t>& labels, const CameraModel& camera,
+                       const CaptureOptions& options) {
+    check_scene(scene);
+    check_camera(camera);
+    check_truths(scene, truths, labels);
+    const std::size_t W = scene.width, H = scene.height, N = W * H;
+    Capture out = empty_capture(scene, camera, options);
+
+    const double half_w = 0.5 * static_cast<double>(W), half_h = 0.5 * static_cast<double>(H);
+    const RenderJob job{scene,
+                        truths,
+                        labels,
+                        camera,
+                        options,
+                        out,
+                        camera_axes(scene.view),
+                        scene_radius_um(scene),
+                        half_w,
+                        half_h,
+                        half_w * half_w + half_h * half_h,
+                        camera.white_level_dn(),
+                        camera.electrons_per_unit_s * camera.exposure_s};
 
     std::size_t threads =
         options.threads != 0 ? options.threads : std::max(1U, std::thread::hardware_concurrency());
@@ -535,14 +607,14 @@ Capture render_capture(const Scene& scene, const std::vector<SurfaceTruth>& trut
     if (N < 65536) threads = 1;  // not worth a thread
     std::vector<BlockCounts> counts(threads);
     if (threads == 1) {
-        render_rows(0, H, counts[0]);
+        render_rows(job, 0, H, counts[0]);
     } else {
         std::vector<std::exception_ptr> errors(threads);
         std::vector<std::thread> workers;
         for (std::size_t t = 0; t < threads; ++t) {
             workers.emplace_back([&, t] {
                 try {
-                    render_rows(H * t / threads, H * (t + 1) / threads, counts[t]);
+                    render_rows(job, H * t / threads, H * (t + 1) / threads, counts[t]);
                 } catch (...) {
                     errors[t] = std::current_exception();
                 }

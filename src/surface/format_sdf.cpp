@@ -271,23 +271,29 @@ HeightMap decode_binary(std::string_view bytes, const std::string& name) {
     return assemble(h, trailer, std::move(heights));
 }
 
-HeightMap decode_text(std::string_view bytes, const std::string& name) {
+// The lines of a text file with their numbers (from 1), split at '\n'.
+std::vector<TextLine> split_lines(std::string_view bytes) {
     std::vector<TextLine> lines;
-    {
-        std::size_t start = 0;
-        std::size_t number = 1;
-        while (start < bytes.size()) {
-            std::size_t end = bytes.find('\n', start);
-            if (end == std::string_view::npos) end = bytes.size();
-            lines.push_back({bytes.substr(start, end - start), number++});
-            start = end + 1;
-        }
+    std::size_t start = 0;
+    std::size_t number = 1;
+    while (start < bytes.size()) {
+        std::size_t end = bytes.find('\n', start);
+        if (end == std::string_view::npos) end = bytes.size();
+        lines.push_back({bytes.substr(start, end - start), number++});
+        start = end + 1;
     }
-    // Header: line 1 is the version; then Key = value lines up to a `*` line.
+    return lines;
+}
+
+// The header of a text SDF: line 1 is the version; then Key = value lines up to a `*` line. `li`
+// ends at the line after the `*`, `star_line` is the `*` line's number; every required key must
+// be there and the header valid (check_header).
+SdfHeader read_text_header(const std::vector<TextLine>& lines, const std::string& name,
+                           std::size_t& li, std::size_t& star_line) {
     SdfHeader h;
     bool have[6] = {};  // NumPoints, NumProfiles, Xscale, Yscale, Zscale, DataType
-    std::size_t li = 1;
-    std::size_t star_line = 0;
+    li = 1;
+    star_line = 0;
     for (; li < lines.size(); ++li) {
         const TextLine& line = lines[li];
         const std::string_view t = trim_space(line.text);
@@ -363,26 +369,20 @@ HeightMap decode_text(std::string_view bytes, const std::string& name) {
         }
     }
     check_header(name, h, "header");
-    const std::size_t n = h.nx * h.ny;
-    // Every value takes at least one character and one separator: bound the allocation by the
-    // file before making it.
-    const std::size_t data_start =
-        li < lines.size() ? static_cast<std::size_t>(lines[li].text.data() - bytes.data())
-                          : bytes.size();
-    if (n - 1 > (bytes.size() - data_start) / 2) {
-        std::string what = "NumPoints x NumProfiles = ";
-        what.append(std::to_string(n))
-            .append(" values cannot fit in the ")
-            .append(std::to_string(bytes.size() - data_start))
-            .append(" bytes after the header (truncated file?)");
-        throw tab::error_at(name, star_line, 0, what);
-    }
+    return h;
+}
 
+// The `n` values of a text SDF from line `li` on, up to the closing `*` (the trailer starts on
+// `trailer_line`, 0 without one), in µm (× Zscale · 1e6; the data type's missing-point marker and
+// NaN as missing points). `li` ends after the line of the `*`.
+std::vector<double> read_text_values(const std::vector<TextLine>& lines, const std::string& name,
+                                     const SdfHeader& h, std::size_t n, std::size_t& li,
+                                     std::size_t& trailer_line) {
     std::vector<double> heights;
     heights.reserve(n);
     const auto marker = missing_marker(h.data_type);
     const double factor = h.zscale_m * 1e6;
-    std::size_t trailer_line = 0;
+    trailer_line = 0;
     for (; li < lines.size() && trailer_line == 0; ++li) {
         const TextLine& line = lines[li];
         std::size_t i = 0;
@@ -429,6 +429,31 @@ HeightMap decode_text(std::string_view bytes, const std::string& name) {
         const std::size_t at = lines.empty() ? 1 : lines.back().number;
         throw tab::error_at(name, at, 0, what);
     }
+    return heights;
+}
+
+HeightMap decode_text(std::string_view bytes, const std::string& name) {
+    const std::vector<TextLine> lines = split_lines(bytes);
+    std::size_t li = 1;
+    std::size_t star_line = 0;
+    const SdfHeader h = read_text_header(lines, name, li, star_line);
+    const std::size_t n = h.nx * h.ny;
+    // Every value takes at least one character and one separator: bound the allocation by the
+    // file before making it.
+    const std::size_t data_start =
+        li < lines.size() ? static_cast<std::size_t>(lines[li].text.data() - bytes.data())
+                          : bytes.size();
+    if (n - 1 > (bytes.size() - data_start) / 2) {
+        std::string what = "NumPoints x NumProfiles = ";
+        what.append(std::to_string(n))
+            .append(" values cannot fit in the ")
+            .append(std::to_string(bytes.size() - data_start))
+            .append(" bytes after the header (truncated file?)");
+        throw tab::error_at(name, star_line, 0, what);
+    }
+
+    std::size_t trailer_line = 0;
+    std::vector<double> heights = read_text_values(lines, name, h, n, li, trailer_line);
     Trailer trailer;
     if (trailer_line != 0 && li < lines.size()) {
         const std::size_t from = static_cast<std::size_t>(lines[li].text.data() - bytes.data());
