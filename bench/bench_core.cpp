@@ -24,6 +24,7 @@
 
 #include <benchmark/benchmark.h>
 
+#include "bench_timing.hpp"
 #include "roughscope/scattering/beckmann.hpp"
 #include "roughscope/scattering/brightness_batch.hpp"
 #include "roughscope/scattering/factors.hpp"
@@ -177,7 +178,9 @@ BENCHMARK(BM_very_rough_brightness<false>)
     ->Unit(benchmark::kMillisecond);
 
 // The batch kernel over the same geometries (structure of arrays), with the ratios to the scalar
-// API and to the Lambert baseline measured in the same process.
+// API and to the Lambert baseline measured in the same process, and time_vs_generic: the kernel
+// in the processor's best build (core/target_clones.hpp, libmvec's exp) over its baseline build
+// (std::exp), the best of 7 runs each, alternating.
 template <bool kGaussian>
 void BM_very_rough_batch(benchmark::State& state) {
     const std::vector<Geometry>& geoms = random_geometries();
@@ -217,6 +220,17 @@ void BM_very_rough_batch(benchmark::State& state) {
         state.counters["speedup_vs_scalar"] = scalar_s / per_run;
         state.counters["time_vs_lambert"] = per_run / lambert_s;
     }
+    const auto [t_generic, t_best] = roughscope::bench::seconds_of_interleaved(
+        [&] {
+            set_vector_isa_cap(VectorIsa::Generic);
+            very_rough_brightness_batch({ti, ts, ps, m}, out, {c});
+        },
+        [&] {
+            set_vector_isa_cap(VectorIsa::Avx512);
+            very_rough_brightness_batch({ti, ts, ps, m}, out, {c});
+        },
+        7);
+    state.counters["time_vs_generic"] = t_best / t_generic;
     state.SetLabel(std::string(to_string(active_vector_isa())));
 }
 BENCHMARK(BM_very_rough_batch<true>)

@@ -9,6 +9,10 @@
 //        maps/map_pixels/<rows>      read_image of both + roughness_map, per pixel (the default
 //                                    layers: σ/T of one correlation, its error, the class)
 //        maps/map_pixels_every_layer/<rows>  the same with both correlations and E1/E2
+//        maps/builds/<what>/<rows>   roughness_map of the decoded pair (no decode) in the
+//                                    processor's best build of the row loops against their
+//                                    baseline build (limit_map_instruction_set), what = pixels
+//                                    (the default layers), pixels_every_layer or tiles8
 // <rows> = 4096 is the 24-MP pair (5859 x 4096 = 24.0 MP, the size of the other image benchmarks;
 // 6000 x 4000 has the same pixel count); 256 a small one (the smoke run skips /4096).
 // Counters: time_vs_decode = (decode + map) / decode of the two files by read_image (one after
@@ -20,6 +24,8 @@
 // resident memory of decode + map above the resident memory before it, divided by that of
 // decoding one image. The peak is Linux's VmHWM of /proc/self/status, reset before each
 // measurement by writing 5 to /proc/self/clear_refs (0 when the kernel does not allow it).
+// maps/builds: time_vs_baseline = map in the best build / map in the baseline build (x86-64:
+// SSE2), the best of 7 runs each, alternating; the label names the processor's best.
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
@@ -116,6 +122,21 @@ img::RoughnessMap decode_and_map(const PairFiles& p, std::size_t window, bool ev
     return img::roughness_map(c, o);
 }
 
+img::RoughnessMap map_of(const img::LinearImage& a, const img::LinearImage& b, std::size_t window,
+                         bool every_layer) {
+    std::vector<img::MapCapture> c(2);
+    c[0].image = &a;
+    c[0].geometry = roughscope::normal_view_geometry(roughscope::deg_to_rad(30.0));
+    c[1].image = &b;
+    c[1].geometry = roughscope::normal_view_geometry(roughscope::deg_to_rad(45.0));
+    img::MapOptions o;
+    o.window_px = window;
+    o.both_correlations = every_layer;
+    o.ratio_layer = every_layer;
+    o.check_registration = false;  // (the same in both builds: not what is compared)
+    return img::roughness_map(c, o);
+}
+
 // Resident memory (kB) of this process: "VmRSS" now or "VmHWM" (peak since the last reset).
 long status_kb(const std::string& key) {
     std::ifstream in("/proc/self/status");
@@ -173,6 +194,34 @@ void BM_maps_registration(benchmark::State& state) {
     state.counters["time_vs_decode"] = t_registration / t_decode;
 }
 
+// The row loops' builds (core/target_clones.hpp): the map of the decoded pair in the processor's
+// best build against the baseline build, in the same run.
+void BM_maps_builds(benchmark::State& state, std::size_t window, bool every_layer) {
+    PairFiles p;
+    make_pair(p, static_cast<std::size_t>(state.range(0)));
+    const img::LinearImage a = img::read_image(p.files[0].string(), read_options());
+    const img::LinearImage b = img::read_image(p.files[1].string(), read_options());
+    const img::MapInstructionSet before = img::map_instruction_set();
+    for (auto _ : state) benchmark::DoNotOptimize(map_of(a, b, window, every_layer).valid);
+    const auto [t_baseline, t_best] = seconds_of_interleaved(
+        [&] {
+            img::limit_map_instruction_set(img::MapInstructionSet::Baseline);
+            (void)map_of(a, b, window, every_layer);
+        },
+        [&] {
+            img::limit_map_instruction_set(img::MapInstructionSet::Best);
+            (void)map_of(a, b, window, every_layer);
+        },
+        7);
+    img::limit_map_instruction_set(before);
+    state.counters["time_vs_baseline"] = t_best / t_baseline;
+#if defined(__x86_64__)
+    state.SetLabel(__builtin_cpu_supports("avx512f") ? "best: AVX-512"
+                   : __builtin_cpu_supports("avx2")  ? "best: AVX2"
+                                                     : "best: baseline");
+#endif
+}
+
 BENCHMARK(BM_maps_registration)
     ->Name("maps/registration")
     ->Arg(256)
@@ -193,6 +242,22 @@ BENCHMARK_CAPTURE(BM_maps_map, pixels_every_layer, 1, true)
     ->Name("maps/map_pixels_every_layer")
     ->Arg(256)
     ->Arg(4096)
+    ->Unit(benchmark::kMillisecond);
+
+BENCHMARK_CAPTURE(BM_maps_builds, pixels, 1, false)
+    ->Name("maps/builds/pixels")
+    ->Arg(256)
+    ->Arg(2048)
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_maps_builds, pixels_every_layer, 1, true)
+    ->Name("maps/builds/pixels_every_layer")
+    ->Arg(256)
+    ->Arg(2048)
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_maps_builds, tiles8, 8, false)
+    ->Name("maps/builds/tiles8")
+    ->Arg(256)
+    ->Arg(2048)
     ->Unit(benchmark::kMillisecond);
 
 }  // namespace

@@ -7,9 +7,11 @@
 #include <bit>
 #include <cmath>
 #include <cstdint>
+#include <exception>
 #include <limits>
 #include <string>
 
+#include "../core/target_clones.hpp"  // (private to the library: src/core/)
 #include "roughscope/core/errors.hpp"
 #include "roughscope/core/names.hpp"
 #include "roughscope/scattering/geometry.hpp"
@@ -27,7 +29,9 @@ namespace {
 using Index = std::ptrdiff_t;
 
 // =============================================================================================
-// Vector math: e^x and x^(−3/2) over arrays, per instruction set
+// Vector math: e^x and x^(−3/2) over arrays, per instruction set (glibc's libmvec has one entry
+// point per instruction set, the vector function ABI's; the kernel's own loops are built by the
+// compiler for each, core/target_clones.hpp)
 // =============================================================================================
 
 enum class MathFn { Exp, InvPow32 };  // e^x; x^(−3/2) for x > 0
@@ -131,12 +135,13 @@ VectorIsa detect_cpu_isa() { return VectorIsa::Generic; }
 
 std::atomic<VectorIsa> g_isa_cap{VectorIsa::Avx512};
 
-template <VectorIsa I>
-inline void apply_math(MathFn fn, const double* x, double* y, Index n) {
+// `isa`: the instruction set the processor runs (never above cpu_vector_isa()).
+inline void apply_math(VectorIsa isa, MathFn fn, const double* x, double* y, Index n) {
 #if ROUGHSCOPE_HAVE_LIBMVEC
-    if constexpr (I == VectorIsa::Avx512) return apply_avx512(fn, x, y, n);
-    if constexpr (I == VectorIsa::Avx2) return apply_avx2(fn, x, y, n);
+    if (isa == VectorIsa::Avx512) return apply_avx512(fn, x, y, n);
+    if (isa == VectorIsa::Avx2) return apply_avx2(fn, x, y, n);
 #endif
+    (void)isa;
     apply_generic(fn, x, y, n);
 }
 
@@ -254,17 +259,18 @@ template <AngleUnit U>
     return select(upper, 1.0 - s2, s2);
 }
 
-// Brightness for elements [begin, end), one block of kBlock elements at a time. Inlined into one
-// wrapper per instruction set so that the loops are auto-vectorised for it. One pass per block
+// Brightness for elements [begin, end), one block of kBlock elements at a time. Inlined into the
+// kernel's builds (kernel_best, kernel_baseline) so that the loops are auto-vectorised for each;
+// `math` is the instruction set of the exponential and w^(−3/2) (apply_math). One pass per block
 // reads the inputs where they are (a repeated scalar is read from a block filled once), validates
 // them (branch-free; nothing is returned unless all are valid) and computes everything but the
 // exponential (Gaussian, libmvec) or w^(−3/2) (exponential); a last pass writes the result. Per
 // element: one reduction and two short polynomials per polar angle (sin and cos together), one
 // polynomial for sin²(φs/2) after a reduction of φs modulo one turn, one division at most
 // (Gaussian: 1/q_z²; exponential: none); no general-purpose sin/cos, no pow.
-template <Correlation C, GeometricFactor F, Radiometry R, AngleUnit U, VectorIsa I>
+template <Correlation C, GeometricFactor F, Radiometry R, AngleUnit U>
 [[gnu::always_inline]] inline void body(const Inputs& in, Index begin, Index end,
-                                        double* __restrict out, Index& at) {
+                                        double* __restrict out, Index& at, VectorIsa math) {
     using Un = Unit<U>;
     constexpr double kHalfPi = kPi / 2.0;
     constexpr double kMax = std::numeric_limits<double>::max();
@@ -369,73 +375,72 @@ template <Correlation C, GeometricFactor F, Radiometry R, AngleUnit U, VectorIsa
         if (bad) validate<U>(in, start, start + n, at);
         double* __restrict o = out + start;
         if constexpr (C == Correlation::Gaussian) {
-            apply_math<I>(MathFn::Exp, arg, arg, n);
+            apply_math(math, MathFn::Exp, arg, arg, n);
             for (Index j = 0; j < n; ++j) o[j] = pref[j] * arg[j];
         } else {
-            apply_math<I>(MathFn::InvPow32, arg, aux, n);  // w^(−3/2)
+            apply_math(math, MathFn::InvPow32, arg, aux, n);  // w^(−3/2)
             for (Index j = 0; j < n; ++j) o[j] = pref[j] * aux[j];
         }
     }
 }
 
-template <Correlation C, GeometricFactor F, Radiometry R, AngleUnit U>
-void kernel_generic(const Inputs& in, Index begin, Index end, double* out, Index& at) {
-    body<C, F, R, U, VectorIsa::Generic>(in, begin, end, out, at);
-}
-#if ROUGHSCOPE_HAVE_LIBMVEC
-template <Correlation C, GeometricFactor F, Radiometry R, AngleUnit U>
-__attribute__((target("avx2,fma"))) void kernel_avx2(const Inputs& in, Index begin, Index end,
-                                                     double* out, Index& at) {
-    body<C, F, R, U, VectorIsa::Avx2>(in, begin, end, out, at);
-}
-template <Correlation C, GeometricFactor F, Radiometry R, AngleUnit U>
-__attribute__((target("avx512f"))) void kernel_avx512(const Inputs& in, Index begin, Index end,
-                                                      double* out, Index& at) {
-    body<C, F, R, U, VectorIsa::Avx512>(in, begin, end, out, at);
-}
-#endif
-
-using Kernel = void (*)(const Inputs&, Index, Index, double*, Index&);
-
-template <Correlation C, GeometricFactor F, Radiometry R, AngleUnit U>
-Kernel pick_isa(VectorIsa isa) {
-#if ROUGHSCOPE_HAVE_LIBMVEC
-    if (isa == VectorIsa::Avx512) return kernel_avx512<C, F, R, U>;
-    if (isa == VectorIsa::Avx2) return kernel_avx2<C, F, R, U>;
-#endif
-    (void)isa;
-    return kernel_generic<C, F, R, U>;
-}
-
+// The kernel of the model and unit (their instance of body).
 template <Correlation C, Radiometry R, AngleUnit U>
-Kernel pick_factor(GeometricFactor f, VectorIsa isa) {
+[[gnu::always_inline]] inline void run_factor(GeometricFactor f, const Inputs& in, Index begin,
+                                              Index end, double* out, Index& at, VectorIsa math) {
     switch (f) {
         case GeometricFactor::Beckmann:
-            return pick_isa<C, GeometricFactor::Beckmann, R, U>(isa);
+            return body<C, GeometricFactor::Beckmann, R, U>(in, begin, end, out, at, math);
         case GeometricFactor::VernoldHarvey:
-            return pick_isa<C, GeometricFactor::VernoldHarvey, R, U>(isa);
+            return body<C, GeometricFactor::VernoldHarvey, R, U>(in, begin, end, out, at, math);
         case GeometricFactor::Ogilvy:
-            return pick_isa<C, GeometricFactor::Ogilvy, R, U>(isa);
+            return body<C, GeometricFactor::Ogilvy, R, U>(in, begin, end, out, at, math);
         case GeometricFactor::Kirchhoff:
-            return pick_isa<C, GeometricFactor::Kirchhoff, R, U>(isa);
+            return body<C, GeometricFactor::Kirchhoff, R, U>(in, begin, end, out, at, math);
     }
-    return nullptr;
 }
 
 template <AngleUnit U>
-Kernel pick_model(const BrightnessBatchModel& m, VectorIsa isa) {
+[[gnu::always_inline]] inline void run_model(const BrightnessBatchModel& m, const Inputs& in,
+                                             Index begin, Index end, double* out, Index& at,
+                                             VectorIsa math) {
     using enum Correlation;
     using enum Radiometry;
-    if (m.correlation == Gaussian)
-        return m.radiometry == Radiance ? pick_factor<Gaussian, Radiance, U>(m.factor, isa)
-                                        : pick_factor<Gaussian, Intensity, U>(m.factor, isa);
-    return m.radiometry == Radiance ? pick_factor<Exponential, Radiance, U>(m.factor, isa)
-                                    : pick_factor<Exponential, Intensity, U>(m.factor, isa);
+    if (m.correlation == Gaussian) {
+        if (m.radiometry == Radiance)
+            return run_factor<Gaussian, Radiance, U>(m.factor, in, begin, end, out, at, math);
+        return run_factor<Gaussian, Intensity, U>(m.factor, in, begin, end, out, at, math);
+    }
+    if (m.radiometry == Radiance)
+        return run_factor<Exponential, Radiance, U>(m.factor, in, begin, end, out, at, math);
+    return run_factor<Exponential, Intensity, U>(m.factor, in, begin, end, out, at, math);
 }
 
-Kernel pick_kernel(const BrightnessBatchModel& m, AngleUnit unit, VectorIsa isa) {
-    return unit == AngleUnit::Degrees ? pick_model<AngleUnit::Degrees>(m, isa)
-                                      : pick_model<AngleUnit::Radians>(m, isa);
+[[gnu::always_inline]] inline void run_kernel(const BrightnessBatchModel& m, AngleUnit unit,
+                                              const Inputs& in, Index begin, Index end, double* out,
+                                              Index& at, VectorIsa math) {
+    if (unit == AngleUnit::Degrees)
+        return run_model<AngleUnit::Degrees>(m, in, begin, end, out, at, math);
+    run_model<AngleUnit::Radians>(m, in, begin, end, out, at, math);
+}
+
+// The kernel built for every instruction set of the clones' list (the processor's best runs) and
+// for the baseline alone (VectorIsa::Generic). The clones return the validation's error instead
+// of throwing it (core/target_clones.hpp: no exception may leave a cloned function).
+ROUGHSCOPE_TARGET_CLONES std::exception_ptr kernel_best(const BrightnessBatchModel& m,
+                                                        AngleUnit unit, const Inputs& in,
+                                                        Index begin, Index end, double* out,
+                                                        Index& at, VectorIsa math) {
+    try {
+        run_kernel(m, unit, in, begin, end, out, at, math);
+    } catch (...) {
+        return std::current_exception();
+    }
+    return nullptr;
+}
+void kernel_baseline(const BrightnessBatchModel& m, AngleUnit unit, const Inputs& in, Index begin,
+                     Index end, double* out, Index& at) {
+    run_kernel(m, unit, in, begin, end, out, at, VectorIsa::Generic);
 }
 
 Index step_of(std::span<const double> s, std::size_t n, const char* name) {
@@ -464,7 +469,12 @@ VectorIsa cpu_vector_isa() {
     static const VectorIsa isa = detect_cpu_isa();
     return isa;
 }
-VectorIsa active_vector_isa() { return std::min(cpu_vector_isa(), g_isa_cap.load()); }
+// The CPU's best, or (a cap below it) the baseline build: the kernel's builds for instruction
+// sets between the two are chosen by the program's loader, not at run time.
+VectorIsa active_vector_isa() {
+    const VectorIsa cpu = cpu_vector_isa();
+    return g_isa_cap.load() >= cpu ? cpu : VectorIsa::Generic;
+}
 VectorIsa set_vector_isa_cap(VectorIsa cap) {
     g_isa_cap.store(cap);
     return active_vector_isa();
@@ -483,10 +493,16 @@ void very_rough_brightness_batch(const BrightnessBatchInput& in, std::span<doubl
                         in.theta_s.data(),      step_of(in.theta_s, n, "theta_s"),
                         in.phi_s.data(),        step_of(in.phi_s, n, "phi_s"),
                         in.sigma_over_T.data(), step_of(in.sigma_over_T, n, "sigma_over_T")};
-    const Kernel kernel = pick_kernel(model, in.unit, active_vector_isa());
+    const VectorIsa isa = active_vector_isa();
     Index bad_at = static_cast<Index>(begin);
     try {
-        kernel(inputs, static_cast<Index>(begin), static_cast<Index>(end), out.data(), bad_at);
+        if (isa == VectorIsa::Generic)
+            kernel_baseline(model, in.unit, inputs, static_cast<Index>(begin),
+                            static_cast<Index>(end), out.data(), bad_at);
+        else if (const std::exception_ptr error =
+                     kernel_best(model, in.unit, inputs, static_cast<Index>(begin),
+                                 static_cast<Index>(end), out.data(), bad_at, isa))
+            std::rethrow_exception(error);
     } catch (...) {
         at = static_cast<std::size_t>(bad_at);
         throw;

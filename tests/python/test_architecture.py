@@ -41,7 +41,6 @@ KNOWN_OVER = {
     "src/estimation/estimation.cpp",
     "src/fit/engine.cpp",
     "src/fit/engine.cpp:solve_least_squares",
-    "src/maps/maps.cpp",
     "src/objects/cylinder.cpp",
     "src/objects/cylinder.cpp:measure_cylinder_profile",
     "src/objects/sphere.cpp:measure_sphere_table",

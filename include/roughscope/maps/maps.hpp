@@ -67,11 +67,13 @@ inline constexpr std::size_t kPixelNoiseRadius = 2;
 //
 // For two fixed geometries the model ratio M(x) (x = σ/T, or T with σ known) is monotone in x.
 // The table holds nodes x_j = exp(ln lower + j h) (h = ln(upper/lower)/(nodes − 1)) with
-// y_j = ln M(x_j) and dy/dx_j (analytic for Eq. 16/18, a central difference of ln M otherwise);
-// x(y) between two nodes is the cubic Hermite interpolant in y with the slopes dx/dy = 1/(dy/dx).
-// With the defaults (x in [1e-4, 1e4], 4097 nodes) its error against Eq. 17/19 is below 1e-9
-// relative (tests/cpp/maps/test_maps.cpp measures it); ratios outside [y_0, y_last] (outside the
-// model's range, or σ/T outside [lower, upper]) have no solution.
+// y_j = ln M(x_j) and dy/dx_j (M of estimation.hpp: model_ratio_very_rough, whose slope at
+// normal view is that of Eq. 17/19, d_sigma_over_T_*_d_log_ratio; a central difference of ln M
+// otherwise), the nodes where M is a finite double; x(y) between two nodes is the cubic Hermite
+// interpolant in y with the slopes dx/dy = 1/(dy/dx). With the defaults (x in [1e-4, 1e4], 4097
+// nodes) its error against Eq. 17/19 is below 1e-9 relative (tests/cpp/maps/test_maps.cpp
+// measures it); ratios outside [y_0, y_last] (outside the model's range, or σ/T outside [lower,
+// upper]) have no solution.
 struct RatioInverseTableOptions {
     double lower = 1e-4;  // the unknown's range
     double upper = 1e4;
@@ -80,9 +82,9 @@ struct RatioInverseTableOptions {
 
 class RatioInverseTable {
   public:
-    // σ/T at two geometries (Eq. 16/18 in closed form when both are normal view, θs = 0; the
-    // very-rough model ratio of estimation.hpp otherwise). InvalidArgument for bad geometries,
-    // options, or two geometries the ratio cannot tell apart.
+    // σ/T at two geometries: the very-rough model ratio of estimation.hpp (Eq. 16/18 when both
+    // are normal view, θs = 0). InvalidArgument for bad geometries, options, or two geometries
+    // the ratio cannot tell apart.
     static RatioInverseTable sigma_over_T(const Geometry& geom1, const Geometry& geom2,
                                           Correlation correlation,
                                           const TwoGeometryOptions& model = {},
@@ -155,8 +157,8 @@ class RatioInverseTable {
         }
         return find(std::log(ratio), v, interval);
     }
-    // find_ratio over arrays, its bins only (a loop without branches, vectorised; AVX2 where the
-    // processor has it, the same arithmetic): x[i] and dx_dlog_ratio[i] at ratio[i] where its
+    // find_ratio over arrays, its bins only (a loop without branches, vectorised, in the build of
+    // map_instruction_set: the same numbers): x[i] and dx_dlog_ratio[i] at ratio[i] where its
     // bin is used, both NaN elsewhere. True when a ratio that is not NaN missed the bins (find
     // at its logarithm is the caller's).
     bool find_ratio_bins(std::size_t n, const double* ratio, double* x,
@@ -171,6 +173,9 @@ class RatioInverseTable {
     // The ratios E1/E2 the table inverts (open interval).
     RatioRange ratio_range() const;
     std::size_t size() const { return y_.size(); }
+    // The nodes: x_j (increasing or decreasing) and y_j = ln M(x_j) (increasing).
+    std::span<const double> node_x() const { return x_; }
+    std::span<const double> node_log_ratio() const { return y_; }
 
   private:
     void build_coefficients();
@@ -354,15 +359,17 @@ inline Correlation other_correlation(Correlation c) {
 // left to image/measure.hpp's region measurement).
 RoughnessMap roughness_map(const std::vector<MapCapture>& captures, const MapOptions& options);
 
-// The per-pixel map's row loops and RatioInverseTable::find_ratio_bins come in builds for three
-// instruction sets and run the best the processor has (AVX-512: F, DQ, VL and BW): the same
-// arithmetic (maps.cpp is compiled with -ffp-contract=off: no fused multiply-add), so the same
-// map from each.
-enum class MapInstructionSet { Baseline, Avx2, Avx512 };
-// The highest build the row loops may use, process-wide (for tests and benchmarks; default
-// Avx512); returns the previous limit.
+// The per-pixel map's row loops and RatioInverseTable::find_ratio_bins are built by the compiler
+// for several instruction sets (target clones: x86-64-v4 (AVX-512) and x86-64-v3 (AVX2) beside
+// the baseline), the best the processor runs chosen when the library is loaded, and once more
+// for the baseline alone (Baseline: the reference of the tests and benchmarks). Every build does
+// the same arithmetic (the row loops are compiled with -ffp-contract=off: no fused
+// multiply-add), so every build gives the same map.
+enum class MapInstructionSet { Baseline, Best };
+// The build the row loops use, process-wide (for tests and benchmarks; default Best); returns
+// the previous one.
 MapInstructionSet limit_map_instruction_set(MapInstructionSet highest);
-// The build the row loops use now: the processor's best up to the limit.
+// The build the row loops use now.
 MapInstructionSet map_instruction_set();
 
 }  // namespace roughscope::image

@@ -70,15 +70,19 @@ void very_rough_brightness_batch(const BrightnessBatchInput& in, std::span<doubl
                                  const BrightnessBatchModel& model, std::size_t begin,
                                  std::size_t end, std::size_t& at);
 
-// Instruction sets of the batch kernel.
+// Instruction sets of the batch kernel. Its loops are built by the compiler for several
+// instruction sets (target clones, the best the processor runs chosen when the library is
+// loaded) and once for the baseline alone (Generic); its exponential is glibc's vector math
+// library (libmvec) for AVX2 or AVX-512, std::exp for Generic.
 enum class VectorIsa { Generic, Avx2, Avx512 };
 std::string_view to_string(VectorIsa isa);          // "generic", "avx2", "avx512"
 VectorIsa parse_vector_isa(std::string_view name);  // also "best" (= Avx512, capped by the CPU)
 
 // The best instruction set the CPU offers among those compiled in.
 VectorIsa cpu_vector_isa();
-// The one in use: cpu_vector_isa(), lowered by set_vector_isa_cap (testing and benchmark aid;
-// process-wide, thread-safe). Returns the one now in use.
+// The one in use: cpu_vector_isa(), or Generic (the baseline build) when set_vector_isa_cap
+// caps it below that (testing and benchmark aid; process-wide, thread-safe). Returns the one now
+// in use.
 VectorIsa active_vector_isa();
 VectorIsa set_vector_isa_cap(VectorIsa cap);
 

@@ -1,12 +1,21 @@
-// Synthetic captures for the roughness-map tests: simulation::render_capture brought to the
-// linear scale of image/image.hpp by the camera's own formula (value = (DN − black)/(white −
-// black), flags from the clipped pixels), without a file in between.
+// Synthetic captures for the roughness-map and measurement tests: simulation::render_capture
+// brought to the linear scale of image/image.hpp by the camera's own formula (value = (DN −
+// black)/(white − black), flags from the clipped pixels), without a file in between; and pairs
+// written as 16-bit TIFFs for the measurement's capture files.
 #pragma once
 
 #include <algorithm>
 #include <cstdint>
+#include <filesystem>
+#include <string>
+#include <tuple>
+#include <utility>
 #include <vector>
 
+#include <Eigen/Core>
+
+#include "roughscope/core/text.hpp"
+#include "roughscope/io/output_file.hpp"
 #include "roughscope/photo/image.hpp"
 #include "roughscope/simulation/capture.hpp"
 
@@ -88,6 +97,74 @@ inline LitPair render_lit_pair(sim::Scene scene, const std::vector<sim::SurfaceT
     p.a = to_linear(p.c1, cam1);
     p.b = to_linear(p.c2, cam2);
     return p;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Pairs written as files (a capture file names them)
+
+inline constexpr double kFileCameraFullWell = 60000.0;
+
+// A 16-bit linear camera (black 0) whose brightest pixel, of brightness `peak`, fills 60 % of
+// the full well.
+inline sim::CameraModel linear_camera(double peak, std::uint64_t seed, bool noise = true) {
+    sim::CameraModel c;
+    c.bit_depth = 16;
+    c.full_well_e = kFileCameraFullWell;
+    c.gain_dn_per_e = 1.05 * 65535.0 / kFileCameraFullWell;
+    c.black_level_dn = 0.0;
+    c.electrons_per_unit_s = 0.6 * kFileCameraFullWell / peak;
+    c.exposure_s = 1.0;
+    c.shot_noise = noise;
+    c.read_noise_e = noise ? 3.0 : 0.0;
+    c.seed = seed;
+    return c;
+}
+
+inline double peak_brightness(const sim::Scene& scene, const sim::SurfaceTruth& truth) {
+    sim::CameraModel c;
+    c.shot_noise = false;
+    const sim::Capture probe = sim::render_capture(scene, {truth}, {}, c);
+    double peak = 0.0;
+    for (const float v : probe.radiance) peak = std::max(peak, static_cast<double>(v));
+    return peak;
+}
+
+struct Rendered {
+    std::filesystem::path file;
+    sim::Capture capture;
+};
+
+// Two 16-bit TIFFs of the scene lit from l1 (truth t1) and from l2 (truth t2), by one camera
+// whose brightest pixel of the two fills 60 % of the full well (exposure 1 s each).
+inline std::pair<Rendered, Rendered> render_pair(const std::filesystem::path& dir, sim::Scene scene,
+                                                 const Eigen::Vector3d& l1,
+                                                 const Eigen::Vector3d& l2,
+                                                 const sim::SurfaceTruth& t1,
+                                                 const sim::SurfaceTruth& t2, std::uint64_t seed,
+                                                 bool noise = true) {
+    scene.light = l1;
+    double peak = peak_brightness(scene, t1);
+    scene.light = l2;
+    peak = std::max(peak, peak_brightness(scene, t2));
+    sim::CaptureOptions options;
+    options.threads = 1;
+    std::pair<Rendered, Rendered> out;
+    int k = 0;
+    for (auto [r, light, truth] :
+         {std::tuple{&out.first, l1, &t1}, std::tuple{&out.second, l2, &t2}}) {
+        scene.light = light;
+        r->capture =
+            sim::render_capture(scene, {*truth}, {}, linear_camera(peak, seed + k, noise), options);
+        r->file = dir / concat("c", std::to_string(k), ".tiff");
+        io::write_file_atomic(r->file, sim::encode_capture_tiff(r->capture));
+        ++k;
+    }
+    return out;
+}
+
+// The light at polar angle θ (degrees) on the paper's light azimuth π.
+inline Eigen::Vector3d light_at(double theta_deg) {
+    return sim::direction_from_angles(deg_to_rad(theta_deg), kPi);
 }
 
 }  // namespace roughscope::testing

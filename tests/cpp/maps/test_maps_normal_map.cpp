@@ -16,6 +16,7 @@
 
 #include "../io/test_files.hpp"
 #include "../photo/image_files.hpp"
+#include "map_captures.hpp"
 #include "roughscope/core/errors.hpp"
 #include "roughscope/core/text.hpp"
 #include "roughscope/io/output_file.hpp"
@@ -28,80 +29,14 @@ namespace {
 
 namespace fs = std::filesystem;
 namespace sim = roughscope::simulation;
-
-constexpr double kFullWell = 60000.0;
-
-sim::SurfaceTruth very_rough(double sigma_over_T) {
-    sim::SurfaceTruth truth;
-    truth.model = sim::BrightnessModel::VeryRough;
-    truth.sigma_um = sigma_over_T;
-    truth.T_um = 1.0;
-    return truth;
-}
-
-// A 16-bit linear camera (black 0) whose brightest pixel, of brightness `peak`, fills 60 % of
-// the full well.
-sim::CameraModel camera(double peak, std::uint64_t seed, bool noise = true) {
-    sim::CameraModel c;
-    c.bit_depth = 16;
-    c.full_well_e = kFullWell;
-    c.gain_dn_per_e = 1.05 * 65535.0 / kFullWell;
-    c.black_level_dn = 0.0;
-    c.electrons_per_unit_s = 0.6 * kFullWell / peak;
-    c.exposure_s = 1.0;
-    c.shot_noise = noise;
-    c.read_noise_e = noise ? 3.0 : 0.0;
-    c.seed = seed;
-    return c;
-}
-
-double peak_brightness(const sim::Scene& scene, const sim::SurfaceTruth& truth) {
-    sim::CameraModel c;
-    c.shot_noise = false;
-    const sim::Capture probe = sim::render_capture(scene, {truth}, {}, c);
-    double peak = 0.0;
-    for (const float v : probe.radiance) peak = std::max(peak, static_cast<double>(v));
-    return peak;
-}
-
-struct Rendered {
-    fs::path file;
-    sim::Capture capture;
-};
-
-// Two 16-bit TIFFs of the scene lit from l1 (truth t1) and from l2 (truth t2), by one camera
-// whose brightest pixel of the two fills 60 % of the full well (exposure 1 s each).
-std::pair<Rendered, Rendered> render_pair(const fs::path& dir, sim::Scene scene,
-                                          const Eigen::Vector3d& l1, const Eigen::Vector3d& l2,
-                                          const sim::SurfaceTruth& t1, const sim::SurfaceTruth& t2,
-                                          std::uint64_t seed, bool noise = true) {
-    scene.light = l1;
-    double peak = peak_brightness(scene, t1);
-    scene.light = l2;
-    peak = std::max(peak, peak_brightness(scene, t2));
-    sim::CaptureOptions options;
-    options.threads = 1;
-    std::pair<Rendered, Rendered> out;
-    int k = 0;
-    for (auto [r, light, truth] :
-         {std::tuple{&out.first, l1, &t1}, std::tuple{&out.second, l2, &t2}}) {
-        scene.light = light;
-        r->capture =
-            sim::render_capture(scene, {*truth}, {}, camera(peak, seed + k, noise), options);
-        r->file = dir / concat("c", std::to_string(k), ".tiff");
-        io::write_file_atomic(r->file, sim::encode_capture_tiff(r->capture));
-        ++k;
-    }
-    return out;
-}
+using roughscope::testing::light_at;
+using roughscope::testing::render_pair;
+using roughscope::testing::Rendered;
+using roughscope::testing::very_rough_truth;
 
 std::string vec(const Eigen::Vector3d& v) {
     return concat("[", check::format_number(v.x()), ", ", check::format_number(v.y()), ", ",
                   check::format_number(v.z()), "]");
-}
-
-Eigen::Vector3d light_at(double theta_deg) {
-    return sim::direction_from_angles(deg_to_rad(theta_deg), kPi);
 }
 
 // A capture file for a map of the pair with the normals in `normal_file`.
@@ -132,8 +67,8 @@ TEST(MeasureNormalMap, AFlatNormalMapUsesEveryPixel) {
     constexpr std::size_t kSide = 32;
     sim::Scene scene;
     scene.width = scene.height = kSide;
-    const auto [a, b] = render_pair(dir, scene, light_at(30.0), light_at(45.0), very_rough(kTruth),
-                                    very_rough(kTruth), 11);
+    const auto [a, b] = render_pair(dir, scene, light_at(30.0), light_at(45.0),
+                                    very_rough_truth(kTruth), very_rough_truth(kTruth), 11);
     const std::size_t n = kSide * kSide;
     std::vector<float> up(3 * n, 0.0f);
     std::vector<std::uint16_t> codes(3 * n, 32768);
@@ -190,7 +125,8 @@ TEST(MeasureNormalMap, ASphereUnderTwoLightsUsesEveryNormalAndIsNotRefused) {
     scene.shape = sim::SceneShape::Sphere;
     scene.width = scene.height = kSide;
     const Eigen::Vector3d l1 = light_at(20.0), l2 = light_at(60.0);
-    const auto [a, b] = render_pair(dir, scene, l1, l2, very_rough(kTruth), very_rough(kTruth), 21);
+    const auto [a, b] =
+        render_pair(dir, scene, l1, l2, very_rough_truth(kTruth), very_rough_truth(kTruth), 21);
     const std::size_t n = kSide * kSide;
     std::vector<float> normals(3 * n, std::numeric_limits<float>::quiet_NaN());
     // Tiles whose pixels (at least half) have a normal lit by both lights and seen by the camera

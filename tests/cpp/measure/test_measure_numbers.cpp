@@ -33,16 +33,11 @@ namespace {
 
 namespace fs = std::filesystem;
 namespace sim = roughscope::simulation;
-
-constexpr double kFullWell = 60000.0;
-
-sim::SurfaceTruth very_rough(double sigma_over_T) {
-    sim::SurfaceTruth truth;
-    truth.model = sim::BrightnessModel::VeryRough;
-    truth.sigma_um = sigma_over_T;
-    truth.T_um = 1.0;
-    return truth;
-}
+using roughscope::testing::light_at;
+using roughscope::testing::linear_camera;
+using roughscope::testing::render_pair;
+using roughscope::testing::Rendered;
+using roughscope::testing::very_rough_truth;
 
 // The exact diffuse brightness of σ and T at 0.555 µm: the series of Eq. 2 (the coherent term
 // of Eq. 1, a finite patch's sinc² off the specular direction, is not what a photograph of a
@@ -61,66 +56,6 @@ sim::SurfaceTruth exact(double sigma_um, double T_um,
         return p.diffuse * radiometric_factor(o.radiometry, g);
     };
     return truth;
-}
-
-// A 16-bit linear camera (black 0) whose brightest pixel, of brightness `peak`, fills 60 % of
-// the full well.
-sim::CameraModel camera(double peak, std::uint64_t seed, bool noise = true) {
-    sim::CameraModel c;
-    c.bit_depth = 16;
-    c.full_well_e = kFullWell;
-    c.gain_dn_per_e = 1.05 * 65535.0 / kFullWell;
-    c.black_level_dn = 0.0;
-    c.electrons_per_unit_s = 0.6 * kFullWell / peak;
-    c.exposure_s = 1.0;
-    c.shot_noise = noise;
-    c.read_noise_e = noise ? 3.0 : 0.0;
-    c.seed = seed;
-    return c;
-}
-
-double peak_brightness(const sim::Scene& scene, const sim::SurfaceTruth& truth) {
-    sim::CameraModel c;
-    c.shot_noise = false;
-    const sim::Capture probe = sim::render_capture(scene, {truth}, {}, c);
-    double peak = 0.0;
-    for (const float v : probe.radiance) peak = std::max(peak, static_cast<double>(v));
-    return peak;
-}
-
-struct Rendered {
-    fs::path file;
-    sim::Capture capture;
-};
-
-// Two 16-bit TIFFs of the scene lit from l1 (truth t1) and from l2 (truth t2), by one camera
-// whose brightest pixel of the two fills 60 % of the full well (exposure 1 s each).
-std::pair<Rendered, Rendered> render_pair(const fs::path& dir, sim::Scene scene,
-                                          const Eigen::Vector3d& l1, const Eigen::Vector3d& l2,
-                                          const sim::SurfaceTruth& t1, const sim::SurfaceTruth& t2,
-                                          std::uint64_t seed, bool noise = true) {
-    scene.light = l1;
-    double peak = peak_brightness(scene, t1);
-    scene.light = l2;
-    peak = std::max(peak, peak_brightness(scene, t2));
-    sim::CaptureOptions options;
-    options.threads = 1;
-    std::pair<Rendered, Rendered> out;
-    int k = 0;
-    for (auto [r, light, truth] :
-         {std::tuple{&out.first, l1, &t1}, std::tuple{&out.second, l2, &t2}}) {
-        scene.light = light;
-        r->capture =
-            sim::render_capture(scene, {*truth}, {}, camera(peak, seed + k, noise), options);
-        r->file = dir / concat("c", std::to_string(k), ".tiff");
-        io::write_file_atomic(r->file, sim::encode_capture_tiff(r->capture));
-        ++k;
-    }
-    return out;
-}
-
-Eigen::Vector3d light_at(double theta_deg) {
-    return sim::direction_from_angles(deg_to_rad(theta_deg), kPi);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -239,8 +174,8 @@ TEST(MeasureStandardErrors, AOnePixelRegionHasUnknownErrors) {
     const fs::path dir = roughscope::testing::fresh_dir("measure_numbers_one_pixel");
     sim::Scene scene;
     scene.width = scene.height = 1;
-    const auto [a, b] = render_pair(dir, scene, light_at(30.0), light_at(45.0), very_rough(0.4),
-                                    very_rough(0.4), 41);
+    const auto [a, b] = render_pair(dir, scene, light_at(30.0), light_at(45.0),
+                                    very_rough_truth(0.4), very_rough_truth(0.4), 41);
     const std::string text =
         concat(R"({"roi": {"rect": [0, 0, 1, 1]}, "sigma_um": 2, "captures": [{"image": ")",
                a.file.string(), R"(", "theta_i_deg": 30, "exposure_s": 1}, {"image": ")",
@@ -286,7 +221,7 @@ TEST(MeasureStandardErrors, ANoiseFreeHighlightGivesSigmaWithAnUnknownError) {
     sim::CaptureOptions options;
     options.threads = 1;
     const sim::Capture specular = sim::render_capture(scene, {constant(1.0), constant(2.0)}, labels,
-                                                      camera(2.0, 61, false), options);
+                                                      linear_camera(2.0, 61, false), options);
     const fs::path specular_file = dir / "specular.tiff";
     io::write_file_atomic(specular_file, sim::encode_capture_tiff(specular));
     sim::Scene plane;
