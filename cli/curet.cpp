@@ -24,6 +24,7 @@
 #include "roughscope/brdf/comparison.hpp"
 #include "roughscope/brdf/table.hpp"
 #include "roughscope/core/errors.hpp"
+#include "roughscope/core/uncertainty.hpp"
 #include "roughscope/serialize/comparison.hpp"
 
 namespace roughscope::cli {
@@ -136,12 +137,15 @@ std::string text_report(const Comparison& c) {
         for (const ModelParameter& p : r.parameters) {
             if (p.name == "gain") continue;
             if (!p.identified) {  // no number for what the data do not determine
-                params += (params.empty() ? "" : " ") + p.name + "=not-identifiable";
+                params += (params.empty() ? "" : ", ") + p.name + "=not-identifiable";
                 continue;
             }
-            params += (params.empty() ? "" : " ") + p.name + "=" + short_number(p.value, p.name);
-            if (p.standard_error && std::isfinite(*p.standard_error))
-                params += "(+-" + short_number(*p.standard_error, p.name) + ")";
+            // "name=value ± error" (core/uncertainty.hpp), the value alone with 6 digits.
+            const std::string value =
+                p.value == 0.0 && std::signbit(p.value)
+                    ? short_number(p.value, p.name)
+                    : roughscope::format_uncertain(p.value, p.standard_error, 6, p.name);
+            params += (params.empty() ? "" : ", ") + p.name + "=" + value;
         }
         row.push_back(params);
         row.push_back(short_number(r.errors.paper_sse, "Table-4 error"));

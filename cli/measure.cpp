@@ -20,6 +20,7 @@
 #include "common.hpp"
 #include "python_runner.hpp"
 #include "roughscope/core/text.hpp"
+#include "roughscope/core/uncertainty.hpp"
 #include "roughscope/io/output_file.hpp"
 #include "roughscope/maps/map_files.hpp"
 #include "roughscope/serialize/json.hpp"
@@ -43,12 +44,12 @@ std::string value_with_error(const serialize::Json& doc, const std::string& key,
                              const std::string& unit = "") {
     const auto& v = doc[key];
     if (v.is_null()) return "-";
-    // The value with the CLI's 10 significant digits, its standard error with 2 (the digits
-    // beyond are noise).
-    std::string text = format_result(v.get<double>(), key);
+    // The standard error with 2 significant digits and the value to the same place (the digits
+    // beyond are noise); without one, the value with the CLI's 10 significant digits.
     const auto& e = doc[key + "_stderr"];
-    if (!e.is_null() && e.get<double>() > 0.0)
-        text = concat(text, " ± ", roughscope::format_significant(e.get<double>(), 2, key));
+    const std::string text = roughscope::format_uncertain(
+        v.get<double>(), e.is_null() ? std::nullopt : std::optional<double>(e.get<double>()),
+        kPrintDigits, key);
     return unit.empty() ? text : concat(text, " ", unit);
 }
 

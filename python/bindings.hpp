@@ -21,6 +21,7 @@ void bind_surface(pybind11::module_& m);     // python/bind_surface.cpp: height 
 void bind_simulation(pybind11::module_& m);  // python/bind_simulation.cpp: Kirchhoff Monte Carlo
 void bind_capture(pybind11::module_& m);     // python/bind_capture.cpp: synthetic captures
 void bind_image(pybind11::module_& m);       // python/bind_image.cpp: photographs to roughness
+void bind_documents(pybind11::module_& m);   // python/bind_documents.cpp: text and documents
 
 // Results cross into Python as real objects, built from the library's serializer
 // (roughscope/serialize): objects → dict (key order kept), arrays → list, numbers → int/float,

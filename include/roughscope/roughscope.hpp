@@ -12,6 +12,7 @@
 #include "roughscope/core/parallel.hpp"
 #include "roughscope/core/response.hpp"
 #include "roughscope/core/text.hpp"
+#include "roughscope/core/uncertainty.hpp"
 
 // io: the CSV reader, input-file checks, atomic output files, the reference-data locator
 #include "roughscope/io/csv.hpp"

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <utility>
@@ -11,6 +12,7 @@
 #include "roughscope/core/errors.hpp"
 #include "roughscope/core/numbers.hpp"
 #include "roughscope/core/text.hpp"
+#include "roughscope/core/uncertainty.hpp"
 #include "roughscope/scattering/factors.hpp"
 #include "roughscope/scattering/validity.hpp"
 #include "roughscope/serialize/model.hpp"
@@ -55,6 +57,15 @@ std::string with_unit(const Json& value, const char* unit) {
     std::string s = text_of(value);
     if (!value.is_null()) s.append(" ").append(unit);
     return s;
+}
+
+// "value ± error unit" (core/uncertainty.hpp; the value alone with 6 digits without an error),
+// or "-" for an unknown value.
+std::string uncertain_with_unit(const Json& value, const Json& error, const char* unit) {
+    if (value.is_null()) return "-";
+    const std::optional<double> e =
+        error.is_number() ? std::optional<double>(error.get<double>()) : std::nullopt;
+    return concat(format_uncertain(value.get<double>(), e, 6), " ", unit);
 }
 
 }  // namespace
@@ -138,11 +149,8 @@ std::string to_text(const StatisticsInput& input, const surface::SurfaceStatisti
     if (!j["cutoff_um"].is_null())
         out << ", Gaussian filter cutoff " << text_of(j["cutoff_um"]) << " um";
     out << "; " << j["acf_estimator"].get<std::string>() << " ACF\n";
-    std::string sigma = with_unit(j["sigma_um"], "um");
-    if (!j["sigma_stderr_um"].is_null())
-        sigma.append(" +- ").append(with_unit(j["sigma_stderr_um"], "um"));
-    std::string T = with_unit(j["T_um"], "um");
-    if (!j["T_stderr_um"].is_null()) T.append(" +- ").append(with_unit(j["T_stderr_um"], "um"));
+    const std::string sigma = uncertain_with_unit(j["sigma_um"], j["sigma_stderr_um"], "um");
+    const std::string T = uncertain_with_unit(j["T_um"], j["T_stderr_um"], "um");
     std::string Str = text_of(j["Str"]);
     if (!j["Str_note"].is_null())
         Str.append(" (").append(j["Str_note"].get<std::string>()).append(")");
