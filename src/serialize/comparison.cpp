@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "options.hpp"
+#include "io/json_reader.hpp"
 #include "roughscope/core/errors.hpp"
 #include "roughscope/scattering/geometry.hpp"
 #include "roughscope/scattering/validity.hpp"
@@ -189,38 +189,40 @@ std::string md_escape(const std::string& s) {
 }  // namespace
 
 ComparisonOptions comparison_options_from(const Json& options) {
-    using namespace detail;
-    check_keys(options, "comparison option",
-               {"theta1_deg", "theta2_deg", "pair", "on_sigma_rad", "on_albedo", "fits",
-                "radiometry", "max_overflow"});
+    const io::JsonNode named(options, "comparison options", io::JsonSource::Arguments);
+    if (!options.is_null())
+        named.only({"theta1_deg", "theta2_deg", "pair", "on_sigma_rad", "on_albedo", "fits",
+                    "radiometry", "max_overflow"});
+    const auto number = [&](const char* key) -> std::optional<double> {
+        if (const auto v = named.find(key)) return v->number();
+        return std::nullopt;
+    };
     ComparisonOptions o;
-    const auto theta1 = get_number(options, "theta1_deg");
-    const auto theta2 = get_number(options, "theta2_deg");
+    const auto theta1 = number("theta1_deg");
+    const auto theta2 = number("theta2_deg");
     if (theta1.has_value() != theta2.has_value())
         throw InvalidArgument("give both theta1_deg and theta2_deg (degrees) or neither");
     if (theta1) {
         o.theta1_rad = deg_to_rad(*theta1);
         o.theta2_rad = deg_to_rad(*theta2);
     }
-    if (const auto pair = get_int_pair(options, "pair")) {
-        if (pair->first < 1 || pair->second < 1)
-            throw InvalidArgument("pair = [" + std::to_string(pair->first) + ", " +
-                                  std::to_string(pair->second) +
-                                  "]: expected two measurement numbers >= 1");
-        o.measurement1 = pair->first;
-        o.measurement2 = pair->second;
+    if (const auto pair = named.find("pair")) {
+        // Two measurement numbers >= 1 (CUReT numbers them from 1).
+        const auto items = pair->array(2, 2, "measurement numbers");
+        o.measurement1 = static_cast<int>(items[0].integer(1, std::numeric_limits<int>::max()));
+        o.measurement2 = static_cast<int>(items[1].integer(1, std::numeric_limits<int>::max()));
     }
-    const auto on_sigma = get_number(options, "on_sigma_rad");
-    const auto on_albedo = get_number(options, "on_albedo");
+    const auto on_sigma = number("on_sigma_rad");
+    const auto on_albedo = number("on_albedo");
     if (on_sigma.has_value() != on_albedo.has_value())
         throw InvalidArgument("give both on_sigma_rad and on_albedo (Oren-Nayar) or neither");
     if (on_sigma) {
         o.oren_nayar = OrenNayarParams{*on_sigma, *on_albedo};
         o.oren_nayar_source = "given";
     }
-    if (const auto fits = get_bool(options, "fits")) o.fits = *fits;
-    if (const auto r = get_string(options, "radiometry")) o.radiometry = parse_radiometry(*r);
-    o.max_overflow_fraction = get_number(options, "max_overflow");
+    if (const auto fits = named.find("fits")) o.fits = fits->boolean();
+    if (const auto r = named.find("radiometry")) o.radiometry = r->named(parse_radiometry);
+    o.max_overflow_fraction = number("max_overflow");
     validate(o);
     return o;
 }

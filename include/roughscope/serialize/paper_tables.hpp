@@ -22,7 +22,8 @@ namespace roughscope::serialize {
 
 // {"table1": {"conditions", "rows"}, "table2": ..., "table3": ...}. Throws DataError
 // "<where>: <place in the document>: <what>" for a missing or malformed key (places as
-// "table1_slightly_rough.rows[0]") or a printed input the estimators refuse.
+// "table1_slightly_rough.rows[0].R_spec", io's JSON reader) or a printed input the estimators
+// refuse.
 Json recompute_paper_tables(const Json& reference, const std::string& where);
 
 // Reads the reference document (docs/input-files.md: UTF-8 BOM, CRLF accepted). Throws DataError
