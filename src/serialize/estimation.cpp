@@ -3,13 +3,18 @@
 
 #include <limits>
 #include <optional>
+#include <sstream>
 #include <string>
+#include <string_view>
+#include <utility>
 #include <vector>
 
 #include "io/json_reader.hpp"
 #include "roughscope/core/errors.hpp"
+#include "roughscope/core/numbers.hpp"
 #include "roughscope/scattering/geometry.hpp"
 #include "roughscope/scattering/validity.hpp"
+#include "roughscope/serialize/text.hpp"
 
 namespace roughscope::serialize {
 namespace {
@@ -49,6 +54,11 @@ bool normal_view(const Geometry& g) { return g.theta_s_rad == 0.0; }
 
 Json ratio_range_json(const RatioRange& r) {
     return Json::array({number(r.lower), number(r.upper)});  // upper = inf → null
+}
+
+// The text reports' precision (the CLI's, docs/cli.md).
+std::string significant(double value, std::string_view name) {
+    return format_significant(value, 10, name);
 }
 
 }  // namespace
@@ -307,6 +317,42 @@ Json fit_estimate_json(const FitOptions& options, std::size_t measurements,
     const Json body = to_json(comparison, with_residuals);
     for (const auto& [k, v] : body.items()) out[k] = v;
     return out;
+}
+
+std::string estimate_text(const Json& record) {
+    std::vector<std::pair<std::string, std::string>> items;
+    for (const auto& [key, value] : record.items()) {
+        std::string v;
+        if (value.is_null()) {
+            v = "unknown";
+        } else if (value.is_boolean()) {
+            v = value.get<bool>() ? "true" : "false";
+        } else if (value.is_string()) {
+            v = value.get<std::string>();
+        } else if (value.is_number()) {
+            v = significant(value.get<double>(), key);
+        } else if (value.is_array() && key.rfind("valid_ratio_range", 0) == 0) {
+            // Open interval; no upper bound is written "> lower" (never "inf").
+            v = value[1].is_null() ? "> " + significant(value[0].get<double>(), key)
+                                   : "(" + significant(value[0].get<double>(), key) + ", " +
+                                         significant(value[1].get<double>(), key) + ")";
+        } else if (value.is_array()) {
+            if (key == "warnings") continue;  // printed below, one per line
+            for (const auto& x : value) {
+                if (!v.empty()) v += ", ";
+                v += x.is_number() ? significant(x.get<double>(), key) : x.dump();
+            }
+            if (v.empty()) v = "(none)";
+        } else {
+            continue;  // nested objects: JSON only
+        }
+        items.emplace_back(key, v);
+    }
+    std::ostringstream os;
+    os << key_value_lines(items);
+    if (record.contains("warnings"))
+        for (const auto& w : record["warnings"]) os << "warning: " << w.get<std::string>() << "\n";
+    return os.str();
 }
 
 }  // namespace roughscope::serialize

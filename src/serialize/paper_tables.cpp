@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <functional>
+#include <sstream>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -15,6 +16,7 @@
 #include "roughscope/estimation/estimation.hpp"
 #include "roughscope/scattering/geometry.hpp"
 #include "roughscope/scattering/validity.hpp"
+#include "roughscope/serialize/text.hpp"
 
 namespace roughscope::serialize {
 namespace {
@@ -175,6 +177,22 @@ Json one_table(Json (*compute)(const JsonNode&), const char* key, const JsonNode
     }
 }
 
+// The text mark of one checked quantity (serialize/paper_tables.hpp).
+std::string mark(const Json& c) {
+    const std::string a = c.at("agreement").get<std::string>();
+    return a == "exact" ? "=" : a == "within_rounding" ? "~" : "DIFFERS";
+}
+
+double value(const Json& j, const char* key) { return j.at(key).get<double>(); }
+
+// "printed  recomputed  mark" cells of one checked quantity.
+void add_cells(std::vector<std::string>& cells, const Json& c, int printed_decimals,
+               int recomputed_decimals) {
+    cells.push_back(format_fixed(value(c, "printed"), printed_decimals));
+    cells.push_back(format_fixed(value(c, "recomputed"), recomputed_decimals));
+    cells.push_back(mark(c));
+}
+
 }  // namespace
 
 Json recompute_paper_tables(const Json& reference, const std::string& where) {
@@ -187,6 +205,76 @@ Json recompute_paper_tables(const Json& reference, const std::string& where) {
 
 Json read_paper_tables_reference(const std::filesystem::path& path) {
     return io::read_json_file(path, "a file");
+}
+
+std::string paper_tables_text(const Json& tables) {
+    std::ostringstream text;
+
+    {
+        const Json& t = tables["table1"];
+        const Json& cond = t["conditions"];
+        std::vector<std::vector<std::string>> cells;
+        for (const Json& row : t["rows"]) {
+            std::vector<std::string> c = {row["surface"].get<std::string>(),
+                                          format_fixed(value(row, "R_spec"), 3)};
+            add_cells(c, row["sigma_um"], 3, 4);
+            c.push_back(format_fixed(value(row, "E1_over_E2"), 3));
+            add_cells(c, row["T_um"], 3, 4);
+            add_cells(c, row["sigma_over_T"], 3, 4);
+            cells.push_back(std::move(c));
+        }
+        text << "Table 1 (slightly rough; sigma from R_spec by Eq. 13 at theta = "
+             << format_fixed(value(cond, "specular_theta_deg"), 0)
+             << " deg, T from the printed sigma and E1/E2 by Eq. 15 at "
+             << format_fixed(value(cond, "theta1_deg"), 0) << "/"
+             << format_fixed(value(cond, "theta2_deg"), 0)
+             << " deg, lambda = " << value(cond, "lambda_um") << " um, R0 = 1, F_VH)\n";
+        text << text_table({"surface", "R_spec", "sigma", "sigma*", "", "E1/E2", "T", "T*", "",
+                            "sigma/T", "sigma/T*", ""},
+                           cells);
+    }
+    {
+        const Json& t = tables["table2"];
+        const Json& cond = t["conditions"];
+        std::vector<std::vector<std::string>> cells;
+        for (const Json& row : t["rows"]) {
+            std::vector<std::string> c = {row["surface"].get<std::string>(),
+                                          format_fixed(value(row, "E1_over_E2"), 3)};
+            add_cells(c, row["sigma_over_T_G"], 4, 4);
+            add_cells(c, row["sigma_over_T_E"], 4, 4);
+            add_cells(c, row["theta_K_deg"], 0, 2);
+            add_cells(c, row["xi_K_percent"], 1, 2);
+            cells.push_back(std::move(c));
+        }
+        text << "\nTable 2 (very rough; sigma/T from E1/E2 by Eq. 17 and 19 at "
+             << format_fixed(value(cond, "theta1_deg"), 0) << "/"
+             << format_fixed(value(cond, "theta2_deg"), 0)
+             << " deg, F_VH; theta_K and xi_K from the printed sigma/T_G)\n";
+        text << text_table({"surface", "E1/E2", "s/T_G", "s/T_G*", "", "s/T_E", "s/T_E*", "",
+                            "theta_K", "theta_K*", "", "xi_K%", "xi_K%*", ""},
+                           cells);
+    }
+    {
+        const Json& t = tables["table3"];
+        const Json& cond = t["conditions"];
+        std::vector<std::vector<std::string>> cells;
+        for (const Json& row : t["rows"]) {
+            std::vector<std::string> c = {row["sample"].get<std::string>(),
+                                          format_fixed(value(row, "E1_over_E2"), 6)};
+            add_cells(c, row["sigma_over_T_G"], 4, 4);
+            add_cells(c, row["sigma_over_T_E"], 4, 4);
+            cells.push_back(std::move(c));
+        }
+        text << "\nTable 3 (CUReT; sigma/T from E1/E2 by Eq. 17 and 19 at "
+             << format_fixed(value(cond, "theta1_deg"), 1) << "/"
+             << format_fixed(value(cond, "theta2_deg"), 1) << " deg, F_VH)\n";
+        text << text_table({"sample", "E1/E2", "s/T_G", "s/T_G*", "", "s/T_E", "s/T_E*", ""},
+                           cells);
+    }
+    text << "\n* recomputed from the printed inputs.  = same at the printed digits;  ~ within the "
+            "rounding of the printed inputs;  DIFFERS otherwise.\n";
+
+    return text.str();
 }
 
 }  // namespace roughscope::serialize

@@ -16,6 +16,7 @@
 #include "roughscope/scattering/factors.hpp"
 #include "roughscope/scattering/validity.hpp"
 #include "roughscope/serialize/model.hpp"
+#include "roughscope/serialize/text.hpp"
 
 namespace roughscope::serialize {
 
@@ -46,11 +47,7 @@ std::string text_of(const Json& value) {
 // Aligned "label  value unit" lines.
 void print_lines(std::ostringstream& out,
                  const std::vector<std::pair<std::string, std::string>>& items) {
-    std::size_t width = 0;
-    for (const auto& [label, value] : items) width = std::max(width, label.size());
-    for (const auto& [label, value] : items) {
-        out << label << std::string(width - label.size() + 2, ' ') << value << '\n';
-    }
+    out << key_value_lines(items);
 }
 
 std::string with_unit(const Json& value, const char* unit) {
@@ -242,20 +239,7 @@ std::string to_text(const surface::SurfacePrediction& p, const ModelOptions& opt
                         text_of(q["phi_s_deg"]), text_of(q["brightness"]),
                         text_of(q["very_rough_brightness"]), text_of(q["g"]),
                         q["roughness_class"].get<std::string>()});
-    std::vector<std::size_t> width(header.size());
-    for (std::size_t c = 0; c < header.size(); ++c) {
-        width[c] = header[c].size();
-        for (const auto& r : rows) width[c] = std::max(width[c], r[c].size());
-    }
-    auto line = [&](const std::vector<std::string>& cells) {
-        for (std::size_t c = 0; c < cells.size(); ++c) {
-            if (c) out << "  ";
-            out << std::string(width[c] - cells[c].size(), ' ') << cells[c];
-        }
-        out << '\n';
-    };
-    line(header);
-    for (const auto& r : rows) line(r);
+    out << text_table(header, rows, TextTableStyle{.first_column_left = false, .rule = false});
     for (const std::string& w : p.warnings) out << "warning: " << w << '\n';
     return out.str();
 }

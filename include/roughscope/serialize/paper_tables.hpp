@@ -31,4 +31,9 @@ Json recompute_paper_tables(const Json& reference, const std::string& where);
 // a text file: NUL byte" or "<path>: line L, column C: not valid JSON: <what>".
 Json read_paper_tables_reference(const std::filesystem::path& path);
 
+// The text report of `roughscope paper tables` (without --json): the three tables of the
+// document recompute_paper_tables returns, each quantity as printed, recomputed (*) and its mark
+// (= exact, ~ within rounding, DIFFERS).
+std::string paper_tables_text(const Json& tables);
+
 }  // namespace roughscope::serialize
