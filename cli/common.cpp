@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "roughscope/core/text.hpp"
+#include "roughscope/serialize/text.hpp"
 
 namespace roughscope::cli {
 
@@ -165,16 +166,7 @@ int run_app(CLI::App& app, int argc, char** argv) {
 // Numbers
 
 std::string format_fixed(double value, int decimals, std::string_view name) {
-    if (!std::isfinite(value)) {
-        throw roughscope::Error("internal error: " + std::string(name) +
-                                " is not a finite number; refusing to print it");
-    }
-    if (decimals < 0 || decimals > 17)
-        throw roughscope::InvalidArgument("decimals = " + std::to_string(decimals) +
-                                          " is outside the valid range [0, 17]");
-    char buf[400];  // %.17f of the largest double needs 309 + 1 + 17 characters
-    std::snprintf(buf, sizeof buf, "%.*f", decimals, value);
-    return buf;
+    return serialize::format_fixed(value, decimals, name);
 }
 
 json finite_number(double value, std::string_view name) {
@@ -303,41 +295,12 @@ CLI::Option* add_factor_option(CLI::App& app, GeometricFactor& factor) {
 
 void print_table(std::ostream& out, const std::vector<std::string>& header,
                  const std::vector<std::vector<std::string>>& rows) {
-    std::size_t ncol = header.size();
-    for (const auto& r : rows) ncol = std::max(ncol, r.size());
-    std::vector<std::size_t> width(ncol, 0);
-    const auto measure = [&](const std::vector<std::string>& r) {
-        for (std::size_t c = 0; c < r.size(); ++c) width[c] = std::max(width[c], r[c].size());
-    };
-    measure(header);
-    for (const auto& r : rows) measure(r);
-    const auto emit = [&](const std::vector<std::string>& r) {
-        std::string line;
-        for (std::size_t c = 0; c < ncol; ++c) {
-            const std::string cell = c < r.size() ? r[c] : "";
-            const std::string pad(width[c] - cell.size(), ' ');
-            if (c) line += "  ";
-            line += c == 0 ? cell + pad : pad + cell;
-        }
-        while (!line.empty() && line.back() == ' ') line.pop_back();
-        out << line << '\n';
-    };
-    if (!header.empty()) {
-        emit(header);
-        std::size_t total = 0;
-        for (std::size_t c = 0; c < ncol; ++c) total += width[c] + (c ? 2 : 0);
-        out << std::string(total, '-') << '\n';
-    }
-    for (const auto& r : rows) emit(r);
+    out << serialize::text_table(header, rows);
 }
 
 void print_key_values(std::ostream& out,
                       const std::vector<std::pair<std::string, std::string>>& items) {
-    std::size_t width = 0;
-    for (const auto& [k, v] : items) width = std::max(width, k.size());
-    for (const auto& [k, v] : items) {
-        out << k << std::string(width - k.size() + 2, ' ') << v << '\n';
-    }
+    out << serialize::key_value_lines(items);
 }
 
 std::vector<Geometry> geometries_from_angle_lists(const std::vector<double>& theta_i_deg,

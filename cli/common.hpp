@@ -95,9 +95,9 @@ inline std::string format_result(double value, std::string_view name = "result")
     return roughscope::format_significant(value, kPrintDigits, name);
 }
 
-// `decimals` digits after the decimal point ("%.*f", as the paper prints its tables). The library
-// has no fixed-decimals formatter; this is the CLI's one. Throws roughscope::Error naming `name`
-// if value is NaN or infinite.
+// `decimals` digits after the decimal point ("%.*f", as the paper prints its tables):
+// serialize::format_fixed (serialize/text.hpp). Throws roughscope::Error naming `name` if value
+// is NaN or infinite.
 std::string format_fixed(double value, int decimals, std::string_view name = "value");
 
 // JSON number rounded to kPrintDigits significant digits; throws roughscope::Error naming `name`
@@ -219,8 +219,8 @@ CLI::Option* add_factor_option(CLI::App& app, GeometricFactor& factor);
 // ---------------------------------------------------------------------------------------------
 // Human-readable output
 
-// Prints rows as an aligned text table: first column left-aligned, the others right-aligned,
-// columns separated by two spaces, a dashed rule under the header.
+// Prints rows as an aligned text table (serialize::text_table): first column left-aligned, the
+// others right-aligned, columns separated by two spaces, a dashed rule under the header.
 void print_table(std::ostream& out, const std::vector<std::string>& header,
                  const std::vector<std::vector<std::string>>& rows);
 

@@ -14,7 +14,6 @@
 #include <limits>
 #include <memory>
 #include <optional>
-#include <sstream>
 #include <string>
 #include <vector>
 
@@ -68,132 +67,6 @@ struct Args {
         *o_on_sigma{}, *o_on_albedo{}, *o_max_overflow{}, *o_data{}, *o_channel{},
         *o_table_channel{}, *o_threads{}, *o_pair{};
 };
-
-// ASCII labels for the aligned text table (print_table counts bytes).
-std::string ascii(std::string_view s) {
-    std::string out;
-    for (std::size_t k = 0; k < s.size(); ++k) {
-        if (k + 2 < s.size() && static_cast<unsigned char>(s[k]) == 0xE2 &&
-            static_cast<unsigned char>(s[k + 1]) == 0x80 &&
-            static_cast<unsigned char>(s[k + 2]) == 0x93) {
-            out += '-';
-            k += 2;
-        } else {
-            out += s[k];
-        }
-    }
-    return out;
-}
-
-// Six significant digits for the text tables (the library's format_significant); throws on
-// NaN/inf (never printed). A -0 read from a data file stays "-0" in the data-issue list.
-std::string short_number(double v, std::string_view name) {
-    if (v == 0.0 && std::signbit(v)) return "-0";
-    return roughscope::format_significant(v, 6, name);
-}
-
-std::string text_report(const Comparison& c) {
-    std::ostringstream out;
-    out << (c.sample ? "CUReT sample " + std::to_string(c.sample) : c.name);
-    if (c.sample && !curet_sample_name(c.sample).empty()) out << " (" << c.name << ")";
-    out << ", channel " << (c.channel.empty() ? "-" : c.channel) << ": " << c.measurement.size()
-        << " of " << c.total_measurements << " measurements used\n\n";
-    const TwoPointEstimate& t = c.two_point;
-    out << "Two-point estimate (Table 3; measurements " << t.measurement1 << " and "
-        << t.measurement2 << ", F_VH, viewer on the normal):\n";
-    if (t.available) {
-        std::vector<std::pair<std::string, std::string>> kv;
-        kv.emplace_back("theta1, theta2 (deg)",
-                        short_number(rad_to_deg(t.theta1_rad), "theta1") + ", " +
-                            short_number(rad_to_deg(t.theta2_rad), "theta2"));
-        kv.emplace_back("E1/E2", format_result(*t.E1_over_E2, "E1/E2"));
-        kv.emplace_back("sigma/T (Gaussian, Eq. 17)",
-                        t.sigma_over_T_gaussian ? format_result(*t.sigma_over_T_gaussian, "sigma/T")
-                                                : "unavailable: " + t.gaussian_reason);
-        kv.emplace_back("sigma/T (exponential, Eq. 19)",
-                        t.sigma_over_T_exponential
-                            ? format_result(*t.sigma_over_T_exponential, "sigma/T")
-                            : "unavailable: " + t.exponential_reason);
-        print_key_values(out, kv);
-    } else {
-        out << "  unavailable: " << t.reason << "\n";
-    }
-    out << "\nErrors (Table 4 = sum of squared differences of max-normalised brightness; RMSE = "
-           "sqrt(Table 4 / N); gain SSE = after the optimal gain):\n";
-    std::vector<std::vector<std::string>> rows;
-    auto skipped = [](const ModelResult& r) {
-        return is_fit(r.model) && r.reason == "fits not requested";
-    };
-    for (const ModelResult& r : c.models) {
-        if (skipped(r)) continue;
-        std::vector<std::string> row{ascii(display_name(r.model))};
-        if (!r.available) {
-            row.insert(row.end(), {"-", "-", "-", "-", "unavailable"});
-            rows.push_back(row);
-            continue;
-        }
-        std::string params;
-        for (const ModelParameter& p : r.parameters) {
-            if (p.name == "gain") continue;
-            if (!p.identified) {  // no number for what the data do not determine
-                params += (params.empty() ? "" : " ") + p.name + "=not-identifiable";
-                continue;
-            }
-            params += (params.empty() ? "" : " ") + p.name + "=" + short_number(p.value, p.name);
-            if (p.standard_error && std::isfinite(*p.standard_error))
-                params += "(+-" + short_number(*p.standard_error, p.name) + ")";
-        }
-        row.push_back(params);
-        row.push_back(short_number(r.errors.paper_sse, "Table-4 error"));
-        row.push_back(short_number(r.errors.rmse, "RMSE"));
-        row.push_back(short_number(r.errors.gain_sse, "gain SSE"));
-        row.push_back(r.fit_status ? std::string(to_string(*r.fit_status)) : "");
-        rows.push_back(row);
-    }
-    print_table(out, {"model", "parameters", "Table 4", "RMSE", "gain SSE", "status"}, rows);
-    out << "\nWinner by gain SSE (fits included): "
-        << (c.winner ? ascii(display_name(*c.winner)) : std::string("-"))
-        << "\nWinner by the Table-4 metric (paper's methods): "
-        << (c.winner_paper_metric ? ascii(display_name(*c.winner_paper_metric)) : std::string("-"))
-        << "\n";
-    for (const ModelResult& r : c.models)
-        if (!r.available && !skipped(r))
-            out << "  " << ascii(display_name(r.model)) << ": " << r.reason << "\n";
-    if (!c.data_issues.empty()) {
-        out << "\nData issues (" << c.data_issues.size() << "):\n";
-        for (const DataIssue& d : c.data_issues)
-            out << "  measurement " << d.measurement << ": f = " << short_number(d.value, "f")
-                << ", " << d.issue << " - " << d.note << "\n";
-    }
-    return out.str();
-}
-
-std::string text_report_all(const std::vector<Comparison>& all) {
-    std::vector<std::vector<std::string>> rows;
-    for (const Comparison& c : all) {
-        std::vector<std::string> row{std::to_string(c.sample)};
-        const TwoPointEstimate& t = c.two_point;
-        row.push_back(t.E1_over_E2 ? short_number(*t.E1_over_E2, "E1/E2") : "-");
-        row.push_back(t.sigma_over_T_gaussian ? short_number(*t.sigma_over_T_gaussian, "s/T")
-                                              : "-");
-        row.push_back(t.sigma_over_T_exponential ? short_number(*t.sigma_over_T_exponential, "s/T")
-                                                 : "-");
-        for (ComparisonModel m : kPaperComparisonModels) {
-            const ModelResult& r = c.result(m);
-            row.push_back(r.available ? short_number(r.errors.paper_sse, "error") : "-");
-        }
-        row.push_back(c.winner ? ascii(display_name(*c.winner)) : "-");
-        row.push_back(std::to_string(c.data_issues.size()));
-        rows.push_back(row);
-    }
-    std::ostringstream out;
-    std::vector<std::string> header{"sample", "E1/E2", "s/T_G", "s/T_E"};
-    for (ComparisonModel m : kPaperComparisonModels) header.push_back(ascii(display_name(m)));
-    header.push_back("best (gain SSE)");
-    header.push_back("issues");
-    print_table(out, header, rows);
-    return out.str();
-}
 
 // A comparison in which no model is determined by the data (e.g. a one-row table, or every row
 // at one geometry) has no result: NoSolution (exit 3) saying why, instead of arbitrary numbers.
@@ -282,7 +155,7 @@ void run(Args& a) {
                 text = serialize::to_markdown(all);
                 break;
             case Format::Text:
-                text = text_report_all(all);
+                text = serialize::to_text(all);
                 break;
         }
         if (!a.plot_path.empty()) plot_document = serialize::to_json(all, false);
@@ -310,7 +183,7 @@ void run(Args& a) {
                 text = serialize::to_markdown({c});
                 break;
             case Format::Text:
-                text = text_report(c);
+                text = serialize::to_text(c);
                 break;
         }
         if (!a.plot_path.empty()) plot_document = serialize::to_json(c, true);

@@ -16,7 +16,6 @@
 #include <limits>
 #include <memory>
 #include <optional>
-#include <sstream>
 #include <string>
 #include <system_error>
 #include <vector>
@@ -148,48 +147,10 @@ CLI::Option* add_pair_radiometry_option(CLI::App& cmd, Radiometry& radiometry) {
 }
 
 void emit(const OutputArgs& o, const json& record) {
-    std::string text;
-    if (o.json_output) {
-        text = serialize::dump(serialize::versioned(record));
-    } else {
-        std::vector<std::pair<std::string, std::string>> items;
-        for (const auto& [key, value] : record.items()) {
-            std::string v;
-            if (value.is_null()) {
-                v = "unknown";
-            } else if (value.is_boolean()) {
-                v = value.get<bool>() ? "true" : "false";
-            } else if (value.is_string()) {
-                v = value.get<std::string>();
-            } else if (value.is_number()) {
-                v = format_result(value.get<double>(), key);
-            } else if (value.is_array() && key.rfind("valid_ratio_range", 0) == 0) {
-                // Open interval; no upper bound is written "> lower" (never "inf").
-                v = value[1].is_null() ? "> " + format_result(value[0].get<double>(), key)
-                                       : "(" + format_result(value[0].get<double>(), key) + ", " +
-                                             format_result(value[1].get<double>(), key) + ")";
-            } else if (value.is_array()) {
-                if (key == "warnings") continue;  // printed below, one per line
-                for (const auto& x : value) {
-                    if (!v.empty()) v += ", ";
-                    v += x.is_number() ? format_result(x.get<double>(), key) : x.dump();
-                }
-                if (v.empty()) v = "(none)";
-            } else {
-                continue;  // nested objects: JSON only
-            }
-            items.emplace_back(key, v);
-        }
-        std::ostringstream os;
-        print_key_values(os, items);
-        if (record.contains("warnings"))
-            for (const auto& w : record["warnings"])
-                os << "warning: " << w.get<std::string>() << "\n";
-        text = os.str();
-    }
     write_output(
         given(o.o_output) ? std::optional<std::filesystem::path>(o.output_path) : std::nullopt,
-        text);
+        o.json_output ? serialize::dump(serialize::versioned(record))
+                      : serialize::estimate_text(record));
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -11,7 +11,6 @@
 #include <limits>
 #include <memory>
 #include <optional>
-#include <sstream>
 #include <string>
 #include <utility>
 #include <vector>
@@ -38,80 +37,6 @@ struct MeasureCommand {
     std::string maps_dir;
     CLI::Option *o_output{}, *o_report{}, *o_maps{};
 };
-
-std::string value_with_error(const serialize::Json& doc, const std::string& key,
-                             const std::string& unit = "") {
-    const auto& v = doc[key];
-    if (v.is_null()) return "-";
-    // The value with the CLI's 10 significant digits, its standard error with 2 (the digits
-    // beyond are noise).
-    std::string text = format_result(v.get<double>(), key);
-    const auto& e = doc[key + "_stderr"];
-    if (!e.is_null() && e.get<double>() > 0.0)
-        text = concat(text, " ± ", roughscope::format_significant(e.get<double>(), 2, key));
-    return unit.empty() ? text : concat(text, " ", unit);
-}
-
-std::string text_report(const serialize::Json& doc) {
-    std::vector<std::pair<std::string, std::string>> items;
-    items.emplace_back("captures", std::to_string(doc["captures"].size()));
-    items.emplace_back("object", doc["object"]["shape"].get<std::string>());
-    if (doc["region"].contains("description"))
-        items.emplace_back(
-            "region",
-            concat(printable_text(doc["region"]["description"].get<std::string>()), " (",
-                   std::to_string(doc["region"]["pixels"].get<std::size_t>()), " pixels)"));
-    items.emplace_back("E1/E2", value_with_error(doc, "E1_over_E2"));
-    items.emplace_back("sigma/T (Gaussian)", value_with_error(doc, "sigma_over_T_gaussian"));
-    items.emplace_back("sigma/T (exponential)", value_with_error(doc, "sigma_over_T_exponential"));
-    items.emplace_back("sigma", value_with_error(doc, "sigma_um", "um"));
-    items.emplace_back("T", value_with_error(doc, "T_um", "um"));
-    items.emplace_back("theta_K", value_with_error(doc, "theta_K_deg", "deg"));
-    items.emplace_back("xi_K", value_with_error(doc, "xi_K"));
-    const auto& cls = doc["roughness_class"];
-    items.emplace_back(
-        "roughness class",
-        cls.is_null() ? std::string("-")
-                      : concat(cls.get<std::string>(), doc["roughness_class_assumed"].get<bool>()
-                                                           ? " (assumed by the estimator)"
-                                                           : ""));
-    if (const auto& cyl = doc["cylinder"]; !cyl.is_null()) {
-        items.emplace_back("profile bins", std::to_string(cyl["profile"].size()));
-        for (const auto& m : cyl["models"]) {
-            const auto& d = m["departure_angle_deg"];
-            items.emplace_back(concat("departure ", m["model"].get<std::string>()),
-                               d.is_null()
-                                   ? std::string("none (follows the data)")
-                                   : concat(format_result(d.get<double>(), "departure"), " deg"));
-        }
-    }
-    if (const auto& sph = doc["sphere"]; !sph.is_null()) {
-        items.emplace_back("sphere table rows", std::to_string(sph["rows"].get<std::size_t>()));
-        const auto& winner = sph["comparison"]["winner"];
-        items.emplace_back("best model",
-                           winner.is_null() ? std::string("-") : winner.get<std::string>());
-    }
-    if (const auto& map = doc["map"]; !map.is_null()) {
-        items.emplace_back("map",
-                           concat(std::to_string(map["width"].get<std::size_t>()), " x ",
-                                  std::to_string(map["height"].get<std::size_t>()), " (window ",
-                                  std::to_string(map["window_px"].get<std::size_t>()), " px), ",
-                                  std::to_string(map["valid"].get<std::size_t>()), " valid"));
-        for (const auto& c : map["classes"])
-            items.emplace_back(concat("map ", c["roughness_class"].get<std::string>()),
-                               concat(format_fixed(100.0 * c["fraction"].get<double>(), 1), " %"));
-        for (const auto& r : map["regions"])
-            items.emplace_back(
-                concat("region ", printable_text(r["name"].get<std::string>())),
-                concat("sigma/T (G) ", value_with_error(r, "sigma_over_T_gaussian")));
-    }
-    std::ostringstream out;
-    print_key_values(out, items);
-    // Names and paths from the capture file: control characters escaped (core/text.hpp).
-    for (const auto& w : doc["warnings"])
-        out << "warning: " << printable_text(w.get<std::string>()) << '\n';
-    return out.str();
-}
 
 // The map's layers as files (docs/measure.md "Map files"): <layer>.tiff (float32) and <layer>.npy
 // for every float layer, <layer>.png (false colour with a colour bar) for σ/T and T, <class
@@ -235,7 +160,7 @@ void run_measure(const MeasureCommand& c) {
                                              serialize::dump(for_report), "measure --report"));
     }
     const std::string text =
-        c.json_output ? serialize::dump(serialize::versioned(doc)) : text_report(doc);
+        c.json_output ? serialize::dump(serialize::versioned(doc)) : serialize::measure_text(doc);
     if (given(c.o_output)) pending.add(c.output_path, text);
     pending.commit();
     if (!given(c.o_output)) write_output(std::nullopt, text);

@@ -348,4 +348,5 @@ PYBIND11_MODULE(_core, m) {
     roughscope::python::bind_capture(m);
     roughscope::python::bind_image(m);
     roughscope::python::bind_report(m);
+    roughscope::python::bind_documents(m);
 }

@@ -12,6 +12,7 @@
 #include "roughscope/core/parallel.hpp"
 #include "roughscope/core/response.hpp"
 #include "roughscope/core/text.hpp"
+#include "roughscope/core/uncertainty.hpp"
 
 // io: the CSV reader, input-file checks, atomic output files, the reference-data locator
 #include "roughscope/io/csv.hpp"
@@ -78,7 +79,7 @@
 // measure: the capture file and the measurement
 #include "roughscope/measure/measure.hpp"
 
-// serialize: every result type to JSON, CSV and Markdown
+// serialize: every result type to JSON, CSV, Markdown and text
 #include "roughscope/serialize/capture.hpp"
 #include "roughscope/serialize/comparison.hpp"
 #include "roughscope/serialize/estimation.hpp"
@@ -88,3 +89,4 @@
 #include "roughscope/serialize/paper_tables.hpp"
 #include "roughscope/serialize/simulation.hpp"
 #include "roughscope/serialize/surface.hpp"
+#include "roughscope/serialize/text.hpp"

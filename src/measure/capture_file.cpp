@@ -4,16 +4,18 @@
 #include <array>
 #include <cmath>
 #include <filesystem>
-#include <fstream>
-#include <sstream>
+#include <initializer_list>
+#include <string>
+#include <string_view>
+#include <utility>
+#include <vector>
 
 #include <Eigen/Core>
-#include <nlohmann/json.hpp>
 
+#include "io/json_reader.hpp"
 #include "roughscope/core/errors.hpp"
 #include "roughscope/core/numbers.hpp"
 #include "roughscope/core/text.hpp"
-#include "roughscope/io/input_file.hpp"
 #include "roughscope/measure/measure.hpp"
 #include "roughscope/scattering/beckmann.hpp"
 #include "roughscope/scattering/factors.hpp"
@@ -22,348 +24,242 @@
 namespace roughscope::image {
 namespace {
 
-using Json = nlohmann::json;
+using io::JsonNode;
 
 // A light or view direction closer to the sample's plane than this cosine is grazing: no
 // brightness to measure (scattering/geometry.hpp's horizon).
 constexpr double kGrazingCos = 1e-12;
 
+// What the capture file adds to the typed reader: paths relative to the file's folder, and the
+// library's ranges of exposures and lengths.
 struct Context {
-    std::string file;
     std::filesystem::path dir;
 
-    [[noreturn]] void fail(const std::string& key, const std::string& reason) const {
-        throw DataError(concat(file, ": ", key, ": ", reason));
-    }
-    double number(const Json& j, const std::string& key) const {
-        if (!j.is_number()) fail(key, concat("must be a number, not ", j.dump()));
-        const double v = j.get<double>();
-        if (!std::isfinite(v)) fail(key, "must be finite");
-        return v;
-    }
-    double positive(const Json& j, const std::string& key) const {
-        const double v = number(j, key);
-        if (!(v > 0.0)) fail(key, concat(check::format_number(v), " must be > 0"));
-        return v;
-    }
-    // A number in [lo, hi] (`unit` follows the limits in the message).
-    double range(const Json& j, const std::string& key, double lo, double hi,
-                 std::string_view unit = "") const {
-        const double v = number(j, key);
-        if (!(v >= lo && v <= hi))
-            fail(key, concat(check::format_number(v), " must be in [", check::format_number(lo),
-                             ", ", check::format_number(hi), "]", unit));
-        return v;
-    }
     // An exposure time (s): kMinExposureS … kMaxExposureS (measure.hpp).
-    double exposure(const Json& j, const std::string& key) const {
-        return range(j, key, kMinExposureS, kMaxExposureS, " s");
+    static double exposure(const JsonNode& j) {
+        return j.number(kMinExposureS, kMaxExposureS, " s");
     }
     // A length (µm) the scattering functions take: kMinLengthUm … kMaxLengthUm.
-    double length(const Json& j, const std::string& key) const {
-        return range(j, key, kMinLengthUm, kMaxLengthUm, " µm");
-    }
-    std::string string(const Json& j, const std::string& key) const {
-        if (!j.is_string()) fail(key, concat("must be a string, not ", j.dump()));
-        return j.get<std::string>();
-    }
-    std::string path(const Json& j, const std::string& key) const {
-        const std::string p = string(j, key);
-        if (p.empty()) fail(key, "must name a file");
+    static double length(const JsonNode& j) { return j.number(kMinLengthUm, kMaxLengthUm, " µm"); }
+    std::string path(const JsonNode& j) const {
+        const std::string p = j.string();
+        if (p.empty()) j.fail("must name a file");
         const std::filesystem::path fp(p);
         return (fp.is_absolute() ? fp : dir / fp).lexically_normal().string();
-    }
-    std::vector<double> numbers(const Json& j, const std::string& key, std::size_t n) const {
-        if (!j.is_array() || j.size() != n)
-            fail(key,
-                 concat("must be an array of ", std::to_string(n), " numbers, not ", j.dump()));
-        std::vector<double> out;
-        for (std::size_t k = 0; k < n; ++k)
-            out.push_back(number(j[k], concat(key, "[", std::to_string(k), "]")));
-        return out;
-    }
-    template <class F>
-    auto named(const Json& j, const std::string& key, F parse) const {
-        const std::string name = string(j, key);
-        try {
-            return parse(name);
-        } catch (const InvalidArgument& e) {
-            fail(key, e.what());
-        }
-    }
-    void only(const Json& object, const std::string& key,
-              std::initializer_list<std::string_view> allowed) const {
-        if (!object.is_object()) fail(key, concat("must be an object, not ", object.dump()));
-        for (const auto& item : object.items()) {
-            bool ok = false;
-            for (const auto a : allowed) ok = ok || item.key() == a;
-            if (!ok) {
-                std::string valid;
-                for (const auto a : allowed) valid = concat(valid, valid.empty() ? "" : ", ", a);
-                fail(concat(key.empty() ? "" : concat(key, "."), item.key()),
-                     concat("unknown key; valid keys: ", valid));
-            }
-        }
     }
 };
 
 // A direction: any non-zero vector, normalised (scaled by its largest component first, so that
 // neither a huge nor a tiny one overflows or underflows).
-Eigen::Vector3d unit_vector(const Context& ctx, const Json& j, const std::string& key) {
-    const auto v = ctx.numbers(j, key, 3);
+Eigen::Vector3d unit_vector(const JsonNode& j) {
+    const auto v = j.numbers(3);
     Eigen::Vector3d d(v[0], v[1], v[2]);
     const double largest = d.cwiseAbs().maxCoeff();
-    if (!(largest > 0.0)) ctx.fail(key, "must be a non-zero vector");
+    if (!(largest > 0.0)) j.fail("must be a non-zero vector");
     d /= largest;
     return d / d.norm();
 }
 
 // [{"image": FILE, "exposure_s": t}, ...]: an exposure bracket (≥ 2 photographs).
-std::vector<BracketShot> parse_bracket(const Context& ctx, const Json& j, const std::string& key) {
+std::vector<BracketShot> parse_bracket(const Context& ctx, const JsonNode& j) {
     if (!j.is_array() || j.size() < 2)
-        ctx.fail(key, concat("must be an array of at least 2 {\"image\": FILE, \"exposure_s\": "
-                             "t} photographs, not ",
-                             j.dump()));
+        j.fail(
+            concat("must be an array of at least 2 {\"image\": FILE, \"exposure_s\": "
+                   "t} photographs, not ",
+                   j.json().dump()));
     std::vector<BracketShot> shots;
-    for (std::size_t k = 0; k < j.size(); ++k) {
-        const std::string name = concat(key, "[", std::to_string(k), "]");
-        ctx.only(j[k], name, {"image", "exposure_s"});
-        if (!j[k].contains("image") || !j[k].contains("exposure_s"))
-            ctx.fail(name, "needs \"image\" and \"exposure_s\"");
-        shots.push_back(BracketShot{ctx.path(j[k]["image"], concat(name, ".image")),
-                                    ctx.exposure(j[k]["exposure_s"], concat(name, ".exposure_s"))});
+    for (const JsonNode& shot : j.array(2)) {
+        shot.only({"image", "exposure_s"});
+        if (!shot.has("image") || !shot.has("exposure_s"))
+            shot.fail("needs \"image\" and \"exposure_s\"");
+        shots.push_back(
+            BracketShot{ctx.path(shot.at("image")), Context::exposure(shot.at("exposure_s"))});
     }
     return shots;
 }
 
-// {"rect": ...} | {"circle": ...} | {"polygon": ...} | {"mask": FILE}, under `key`; `allowed`
-// lists the keys the object may hold (a map region also has its "name").
-Region parse_region(const Context& ctx, const Json& j, const std::string& key,
+// {"rect": ...} | {"circle": ...} | {"polygon": ...} | {"mask": FILE}; `allowed` lists the keys
+// the object may hold (a map region also has its "name").
+Region parse_region(const Context& ctx, const JsonNode& j,
                     std::initializer_list<std::string_view> allowed = {"rect", "circle", "polygon",
                                                                        "mask"}) {
-    ctx.only(j, key, allowed);
-    const int shapes =
-        static_cast<int>(j.contains("rect")) + static_cast<int>(j.contains("circle")) +
-        static_cast<int>(j.contains("polygon")) + static_cast<int>(j.contains("mask"));
-    if (shapes != 1) ctx.fail(key, "must have exactly one of rect, circle, polygon, mask");
-    if (j.contains("rect")) {
-        const auto r = ctx.numbers(j["rect"], concat(key, ".rect"), 4);
+    j.only(allowed);
+    const int shapes = static_cast<int>(j.has("rect")) + static_cast<int>(j.has("circle")) +
+                       static_cast<int>(j.has("polygon")) + static_cast<int>(j.has("mask"));
+    if (shapes != 1) j.fail("must have exactly one of rect, circle, polygon, mask");
+    if (j.has("rect")) {
+        const auto r = j.at("rect").numbers(4);
         return RectangleRegion{r[0], r[1], r[2], r[3]};
     }
-    if (j.contains("circle")) {
-        const auto c = ctx.numbers(j["circle"], concat(key, ".circle"), 3);
+    if (j.has("circle")) {
+        const auto c = j.at("circle").numbers(3);
         return CircleRegion{c[0], c[1], c[2]};
     }
-    if (j.contains("polygon")) {
-        const Json& p = j["polygon"];
-        if (!p.is_array()) ctx.fail(concat(key, ".polygon"), "must be an array of [x, y] points");
+    if (j.has("polygon")) {
+        const JsonNode p = j.at("polygon");
+        if (!p.is_array()) p.fail("must be an array of [x, y] points");
         std::vector<std::array<double, 2>> points;
-        for (std::size_t k = 0; k < p.size(); ++k) {
-            const auto xy = ctx.numbers(p[k], concat(key, ".polygon[", std::to_string(k), "]"), 2);
+        for (const JsonNode& point : p.array()) {
+            const auto xy = point.numbers(2);
             points.push_back({xy[0], xy[1]});
         }
         return PolygonRegion{points};
     }
-    const std::string file = ctx.path(j["mask"], concat(key, ".mask"));
+    const JsonNode mask = j.at("mask");
+    const std::string file = ctx.path(mask);
     try {
         return mask_region_from_image(read_image(file));
     } catch (const Error& e) {  // missing, unreadable, not an image
-        ctx.fail(concat(key, ".mask"), e.what());
+        mask.fail(e.what());
     }
 }
 
 // A whole number in [lo, hi].
-std::size_t whole(const Context& ctx, const Json& j, const std::string& key, double lo, double hi) {
-    const double v = ctx.number(j, key);
-    if (v != std::floor(v) || v < lo || v > hi)
-        ctx.fail(key, concat(check::format_number(v), " must be a whole number in [",
-                             check::format_number(lo), ", ", check::format_number(hi), "]"));
-    return static_cast<std::size_t>(v);
+std::size_t whole(const JsonNode& j, long long lo, long long hi) {
+    return static_cast<std::size_t>(j.integer(lo, hi));
 }
 
-bool boolean(const Context& ctx, const Json& j, const std::string& key) {
-    if (!j.is_boolean()) ctx.fail(key, concat("must be true or false, not ", j.dump()));
-    return j.get<bool>();
-}
-
-// The library's own check of an options struct, its InvalidArgument reported under `key`.
-template <class F>
-void checked(const Context& ctx, const std::string& key, F check) {
-    try {
-        check();
-    } catch (const InvalidArgument& e) {
-        ctx.fail(key, e.what());
-    }
-}
-
-EdgePoint point_px(const Context& ctx, const Json& j, const std::string& key) {
-    const auto xy = ctx.numbers(j, key, 2);
+EdgePoint point_px(const JsonNode& j) {
+    const auto xy = j.numbers(2);
     EdgePoint p;
     p.x_px = xy[0];
     p.y_px = xy[1];
     return p;
 }
 
-void parse_sphere_object(const Context& ctx, const Json& j, SphereOptions& o) {
-    ctx.only(j, "object",
-             {"shape", "circle", "threshold", "limb_fraction", "max_angle_deg", "cell_px",
-              "max_cells", "min_cell_fraction"});
-    if (j.contains("circle")) {
-        const auto c = ctx.numbers(j["circle"], "object.circle", 3);
+void parse_sphere_object(const JsonNode& j, SphereOptions& o) {
+    j.only({"shape", "circle", "threshold", "limb_fraction", "max_angle_deg", "cell_px",
+            "max_cells", "min_cell_fraction"});
+    if (j.has("circle")) {
+        const JsonNode node = j.at("circle");
+        const auto c = node.numbers(3);
         CircleFit circle;
         circle.centre_x_px = c[0];
         circle.centre_y_px = c[1];
         circle.radius_px = c[2];
-        if (!(circle.radius_px > 0.0)) ctx.fail("object.circle", "the radius must be > 0");
+        if (!(circle.radius_px > 0.0)) node.fail("the radius must be > 0");
         o.circle = circle;
     }
-    if (j.contains("threshold"))
-        o.silhouette.threshold = ctx.positive(j["threshold"], "object.threshold");
-    if (j.contains("limb_fraction"))
-        o.limb_fraction = ctx.number(j["limb_fraction"], "object.limb_fraction");
-    if (j.contains("max_angle_deg"))
-        o.max_angle_deg = ctx.number(j["max_angle_deg"], "object.max_angle_deg");
-    if (j.contains("cell_px")) o.cell_px = whole(ctx, j["cell_px"], "object.cell_px", 0, 65535);
-    if (j.contains("max_cells"))
-        o.max_cells = whole(ctx, j["max_cells"], "object.max_cells", 1, 1e7);
-    if (j.contains("min_cell_fraction"))
-        o.min_cell_fraction = ctx.number(j["min_cell_fraction"], "object.min_cell_fraction");
-    checked(ctx, "object", [&] { check_sphere_options(o); });
+    if (j.has("threshold")) o.silhouette.threshold = j.at("threshold").positive();
+    if (j.has("limb_fraction")) o.limb_fraction = j.at("limb_fraction").number();
+    if (j.has("max_angle_deg")) o.max_angle_deg = j.at("max_angle_deg").number();
+    if (j.has("cell_px")) o.cell_px = whole(j.at("cell_px"), 0, 65535);
+    if (j.has("max_cells")) o.max_cells = whole(j.at("max_cells"), 1, 10000000);
+    if (j.has("min_cell_fraction")) o.min_cell_fraction = j.at("min_cell_fraction").number();
+    j.checked([&] { check_sphere_options(o); });
+}
+
+void parse_cylinder_object(const JsonNode& j, CylinderOptions& o) {
+    j.only({"shape", "axis", "edges", "half", "bin_width_deg", "min_pixels_per_bin",
+            "limb_fraction", "sigma_over_T", "fit_max_theta_i_deg", "departure_k", "departure_bins",
+            "threshold"});
+    if (j.has("axis") && j.has("edges")) j.fail("give the cylinder's axis or its edges, not both");
+    if (j.has("axis")) {
+        const JsonNode a = j.at("axis");
+        a.only({"point_px", "direction", "radius_px"});
+        if (!a.has("point_px") || !a.has("direction") || !a.has("radius_px"))
+            a.fail("needs point_px [x, y], direction [dx, dy] and radius_px");
+        const auto p = a.at("point_px").numbers(2);
+        const auto d = a.at("direction").numbers(2);
+        const double r = a.at("radius_px").positive();
+        a.checked([&] { o.axis = cylinder_axis_from_line(p[0], p[1], d[0], d[1], r); });
+    }
+    if (j.has("edges")) {
+        const JsonNode e = j.at("edges");
+        const io::JsonValue& v = e.json();
+        if (!v.is_array() || v.size() != 2 || !v[0].is_array() || v[0].size() != 2 ||
+            !v[1].is_array() || v[1].size() != 2)
+            e.fail("must be two edges of two points each: [[[x, y], [x, y]], [[x, y], [x, y]]]");
+        const EdgePoint a0 = point_px(e.item(0).item(0));
+        const EdgePoint a1 = point_px(e.item(0).item(1));
+        const EdgePoint b0 = point_px(e.item(1).item(0));
+        const EdgePoint b1 = point_px(e.item(1).item(1));
+        e.checked([&] { o.axis = cylinder_axis_from_edges(a0, a1, b0, b1); });
+    }
+    if (j.has("half")) o.half = j.at("half").named(parse_cylinder_half);
+    if (j.has("bin_width_deg")) o.bin_width_deg = j.at("bin_width_deg").number();
+    if (j.has("min_pixels_per_bin"))
+        o.min_pixels_per_bin = whole(j.at("min_pixels_per_bin"), 1, 1000000000);
+    if (j.has("limb_fraction")) o.limb_fraction = j.at("limb_fraction").number();
+    if (j.given("sigma_over_T")) o.sigma_over_T = j.at("sigma_over_T").positive();
+    if (j.has("fit_max_theta_i_deg")) o.fit_max_theta_i_deg = j.at("fit_max_theta_i_deg").number();
+    if (j.has("departure_k")) o.departure_k = j.at("departure_k").number();
+    if (j.has("departure_bins")) o.departure_bins = whole(j.at("departure_bins"), 1, 1000000);
+    if (j.has("threshold")) o.silhouette.threshold = j.at("threshold").positive();
+    j.checked([&] { check_cylinder_options(o); });
 }
 
 // "object": {"shape": ..., shape options} (docs/measure.md "Curved objects and maps").
-ObjectSpec parse_object(const Context& ctx, const Json& j) {
-    if (!j.is_object() || !j.contains("shape"))
-        ctx.fail("object", concat("must be an object with a \"shape\" (plane, cylinder, sphere, "
-                                  "normal_map), not ",
-                                  j.dump()));
+ObjectSpec parse_object(const Context& ctx, const JsonNode& j) {
+    if (!j.is_object() || !j.has("shape"))
+        j.fail(
+            concat("must be an object with a \"shape\" (plane, cylinder, sphere, "
+                   "normal_map), not ",
+                   j.json().dump()));
     ObjectSpec spec;
-    spec.shape = ctx.named(j["shape"], "object.shape", parse_object_shape);
+    spec.shape = j.at("shape").named(parse_object_shape);
     switch (spec.shape) {
         case ObjectShape::Plane:
-            ctx.only(j, "object", {"shape"});
+            j.only({"shape"});
             break;
         case ObjectShape::NormalMap:
-            ctx.only(j, "object", {"shape", "file"});
-            if (!j.contains("file")) ctx.fail("object.file", "missing: the normal-map image");
-            spec.normal_map = ctx.path(j["file"], "object.file");
+            j.only({"shape", "file"});
+            if (!j.has("file")) j.fail_at("file", "missing: the normal-map image");
+            spec.normal_map = ctx.path(j.at("file"));
             break;
-        case ObjectShape::Cylinder: {
-            ctx.only(j, "object",
-                     {"shape", "axis", "edges", "half", "bin_width_deg", "min_pixels_per_bin",
-                      "limb_fraction", "sigma_over_T", "fit_max_theta_i_deg", "departure_k",
-                      "departure_bins", "threshold"});
-            CylinderOptions& o = spec.cylinder;
-            if (j.contains("axis") && j.contains("edges"))
-                ctx.fail("object", "give the cylinder's axis or its edges, not both");
-            if (j.contains("axis")) {
-                const Json& a = j["axis"];
-                ctx.only(a, "object.axis", {"point_px", "direction", "radius_px"});
-                if (!a.contains("point_px") || !a.contains("direction") || !a.contains("radius_px"))
-                    ctx.fail("object.axis",
-                             "needs point_px [x, y], direction [dx, dy] and "
-                             "radius_px");
-                const auto p = ctx.numbers(a["point_px"], "object.axis.point_px", 2);
-                const auto d = ctx.numbers(a["direction"], "object.axis.direction", 2);
-                const double r = ctx.positive(a["radius_px"], "object.axis.radius_px");
-                checked(ctx, "object.axis",
-                        [&] { o.axis = cylinder_axis_from_line(p[0], p[1], d[0], d[1], r); });
-            }
-            if (j.contains("edges")) {
-                const Json& e = j["edges"];
-                if (!e.is_array() || e.size() != 2 || !e[0].is_array() || e[0].size() != 2 ||
-                    !e[1].is_array() || e[1].size() != 2)
-                    ctx.fail("object.edges",
-                             "must be two edges of two points each: [[[x, y], [x, y]], "
-                             "[[x, y], [x, y]]]");
-                const EdgePoint a0 = point_px(ctx, e[0][0], "object.edges[0][0]");
-                const EdgePoint a1 = point_px(ctx, e[0][1], "object.edges[0][1]");
-                const EdgePoint b0 = point_px(ctx, e[1][0], "object.edges[1][0]");
-                const EdgePoint b1 = point_px(ctx, e[1][1], "object.edges[1][1]");
-                checked(ctx, "object.edges",
-                        [&] { o.axis = cylinder_axis_from_edges(a0, a1, b0, b1); });
-            }
-            if (j.contains("half"))
-                o.half = ctx.named(j["half"], "object.half", parse_cylinder_half);
-            if (j.contains("bin_width_deg"))
-                o.bin_width_deg = ctx.number(j["bin_width_deg"], "object.bin_width_deg");
-            if (j.contains("min_pixels_per_bin"))
-                o.min_pixels_per_bin =
-                    whole(ctx, j["min_pixels_per_bin"], "object.min_pixels_per_bin", 1, 1e9);
-            if (j.contains("limb_fraction"))
-                o.limb_fraction = ctx.number(j["limb_fraction"], "object.limb_fraction");
-            if (j.contains("sigma_over_T") && !j["sigma_over_T"].is_null())
-                o.sigma_over_T = ctx.positive(j["sigma_over_T"], "object.sigma_over_T");
-            if (j.contains("fit_max_theta_i_deg"))
-                o.fit_max_theta_i_deg =
-                    ctx.number(j["fit_max_theta_i_deg"], "object.fit_max_theta_i_deg");
-            if (j.contains("departure_k"))
-                o.departure_k = ctx.number(j["departure_k"], "object.departure_k");
-            if (j.contains("departure_bins"))
-                o.departure_bins = whole(ctx, j["departure_bins"], "object.departure_bins", 1, 1e6);
-            if (j.contains("threshold"))
-                o.silhouette.threshold = ctx.positive(j["threshold"], "object.threshold");
-            checked(ctx, "object", [&] { check_cylinder_options(o); });
+        case ObjectShape::Cylinder:
+            parse_cylinder_object(j, spec.cylinder);
             break;
-        }
         case ObjectShape::Sphere:
-            parse_sphere_object(ctx, j, spec.sphere);
+            parse_sphere_object(j, spec.sphere);
             break;
     }
     return spec;
 }
 
 // "maps": {...} (docs/measure.md "Curved objects and maps", docs/maps.md).
-MapRequest parse_maps(const Context& ctx, const Json& j) {
-    ctx.only(j, "maps",
-             {"window_px", "min_used_fraction", "max_shift_px", "allow_misregistration",
-              "slightly_rough_max_sigma_over_T", "very_rough_min_sigma_over_T", "both_correlations",
-              "ratio_layer", "regions"});
+MapRequest parse_maps(const Context& ctx, const JsonNode& j) {
+    j.only({"window_px", "min_used_fraction", "max_shift_px", "allow_misregistration",
+            "slightly_rough_max_sigma_over_T", "very_rough_min_sigma_over_T", "both_correlations",
+            "ratio_layer", "regions"});
     MapRequest maps;
     MapOptions& o = maps.options;
-    if (j.contains("window_px"))
-        o.window_px = whole(ctx, j["window_px"], "maps.window_px", 1, 4096);
-    if (j.contains("min_used_fraction")) {
-        o.min_used_fraction = ctx.number(j["min_used_fraction"], "maps.min_used_fraction");
+    if (j.has("window_px")) o.window_px = whole(j.at("window_px"), 1, 4096);
+    if (j.has("min_used_fraction")) {
+        const JsonNode f = j.at("min_used_fraction");
+        o.min_used_fraction = f.number();
         if (!(o.min_used_fraction > 0.0 && o.min_used_fraction <= 1.0))
-            ctx.fail("maps.min_used_fraction",
-                     concat(check::format_number(o.min_used_fraction), " must be in (0, 1]"));
+            f.fail(concat(check::format_number(o.min_used_fraction), " must be in (0, 1]"));
     }
-    if (j.contains("max_shift_px")) {
-        o.max_shift_px = ctx.number(j["max_shift_px"], "maps.max_shift_px");
-        if (o.max_shift_px < 0.0) ctx.fail("maps.max_shift_px", "must be ≥ 0");
+    if (j.has("max_shift_px")) {
+        const JsonNode m = j.at("max_shift_px");
+        o.max_shift_px = m.number();
+        if (o.max_shift_px < 0.0) m.fail("must be ≥ 0");
     }
-    if (j.contains("allow_misregistration"))
-        o.allow_misregistration =
-            boolean(ctx, j["allow_misregistration"], "maps.allow_misregistration");
-    if (j.contains("both_correlations"))
-        o.both_correlations = boolean(ctx, j["both_correlations"], "maps.both_correlations");
-    if (j.contains("ratio_layer"))
-        o.ratio_layer = boolean(ctx, j["ratio_layer"], "maps.ratio_layer");
-    if (j.contains("slightly_rough_max_sigma_over_T"))
-        o.slightly_rough_max_sigma_over_T = ctx.positive(j["slightly_rough_max_sigma_over_T"],
-                                                         "maps.slightly_rough_max_sigma_over_T");
-    if (j.contains("very_rough_min_sigma_over_T"))
-        o.very_rough_min_sigma_over_T =
-            ctx.positive(j["very_rough_min_sigma_over_T"], "maps.very_rough_min_sigma_over_T");
+    if (j.has("allow_misregistration"))
+        o.allow_misregistration = j.at("allow_misregistration").boolean();
+    if (j.has("both_correlations")) o.both_correlations = j.at("both_correlations").boolean();
+    if (j.has("ratio_layer")) o.ratio_layer = j.at("ratio_layer").boolean();
+    if (j.has("slightly_rough_max_sigma_over_T"))
+        o.slightly_rough_max_sigma_over_T = j.at("slightly_rough_max_sigma_over_T").positive();
+    if (j.has("very_rough_min_sigma_over_T"))
+        o.very_rough_min_sigma_over_T = j.at("very_rough_min_sigma_over_T").positive();
     if (!(o.very_rough_min_sigma_over_T >= o.slightly_rough_max_sigma_over_T))
-        ctx.fail(j.contains("very_rough_min_sigma_over_T") ? "maps.very_rough_min_sigma_over_T"
-                                                           : "maps.slightly_rough_max_sigma_over_T",
-                 concat("very_rough_min_sigma_over_T = ",
-                        check::format_number(o.very_rough_min_sigma_over_T),
-                        " must be at least slightly_rough_max_sigma_over_T = ",
-                        check::format_number(o.slightly_rough_max_sigma_over_T)));
-    if (j.contains("regions")) {
-        const Json& r = j["regions"];
-        if (!r.is_array())
-            ctx.fail("maps.regions", "must be an array of {\"name\": ..., \"rect\": ...} regions");
-        for (std::size_t k = 0; k < r.size(); ++k) {
-            const std::string key = concat("maps.regions[", std::to_string(k), "]");
-            if (!r[k].is_object() || !r[k].contains("name"))
-                ctx.fail(key, "needs a \"name\" and one of rect, circle, polygon, mask");
-            const std::string name = ctx.string(r[k]["name"], concat(key, ".name"));
+        j.fail_at(j.has("very_rough_min_sigma_over_T") ? "very_rough_min_sigma_over_T"
+                                                       : "slightly_rough_max_sigma_over_T",
+                  concat("very_rough_min_sigma_over_T = ",
+                         check::format_number(o.very_rough_min_sigma_over_T),
+                         " must be at least slightly_rough_max_sigma_over_T = ",
+                         check::format_number(o.slightly_rough_max_sigma_over_T)));
+    if (j.has("regions")) {
+        const JsonNode r = j.at("regions");
+        if (!r.is_array()) r.fail("must be an array of {\"name\": ..., \"rect\": ...} regions");
+        for (const JsonNode& region : r.array()) {
+            if (!region.is_object() || !region.has("name"))
+                region.fail("needs a \"name\" and one of rect, circle, polygon, mask");
+            const std::string name = region.at("name").string();
             maps.regions.emplace_back(
-                name, parse_region(ctx, r[k], key, {"name", "rect", "circle", "polygon", "mask"}));
+                name, parse_region(ctx, region, {"name", "rect", "circle", "polygon", "mask"}));
         }
     }
     return maps;
@@ -373,71 +269,64 @@ MapRequest parse_maps(const Context& ctx, const Json& j) {
 // vectors (the sample's normal +z; for a curved object the camera frame, view +z by default, and
 // neither given: L = V = +z, the retro-reflection of §5.2). Returns (θi, θs, φs) in degrees as
 // typed (from vectors: as computed), for messages that echo them.
-std::array<double, 3> parse_capture_geometry(const Context& ctx, const Json& c,
-                                             const std::string& key, bool curved,
-                                             CaptureSpec& spec) {
-    const bool angles =
-        c.contains("theta_i_deg") || c.contains("theta_s_deg") || c.contains("phi_s_deg");
-    const bool vectors = c.contains("light") || c.contains("view");
+std::array<double, 3> parse_capture_geometry(const JsonNode& c, bool curved, CaptureSpec& spec) {
+    const bool angles = c.has("theta_i_deg") || c.has("theta_s_deg") || c.has("phi_s_deg");
+    const bool vectors = c.has("light") || c.has("view");
     if (angles && vectors)
-        ctx.fail(key,
-                 "give either theta_i_deg, theta_s_deg, phi_s_deg or light and view, not both");
+        c.fail("give either theta_i_deg, theta_s_deg, phi_s_deg or light and view, not both");
     auto degrees = [](const Geometry& g) {
         return std::array<double, 3>{rad_to_deg(g.theta_i_rad), rad_to_deg(g.theta_s_rad),
                                      rad_to_deg(g.phi_s_rad)};
     };
     if (curved && !angles) {
-        spec.light = c.contains("light") ? unit_vector(ctx, c["light"], concat(key, ".light"))
-                                         : Eigen::Vector3d::UnitZ();
-        spec.view = c.contains("view") ? unit_vector(ctx, c["view"], concat(key, ".view"))
-                                       : Eigen::Vector3d::UnitZ();
+        spec.light = c.has("light") ? unit_vector(c.at("light")) : Eigen::Vector3d::UnitZ();
+        spec.view = c.has("view") ? unit_vector(c.at("view")) : Eigen::Vector3d::UnitZ();
         for (const auto& [name, v] :
              {std::pair{"light", *spec.light}, std::pair{"view", *spec.view}})
             if (!(v.z() > kGrazingCos))
-                ctx.fail(concat(key, ".", name),
-                         "must point toward the camera side (z > 0; camera frame: x image right, "
-                         "y image up, z toward the camera)");
+                c.fail_at(name,
+                          "must point toward the camera side (z > 0; camera frame: x image right, "
+                          "y image up, z toward the camera)");
         if (const auto g = geometry_from_vectors(Eigen::Vector3d::UnitZ(), *spec.light, *spec.view))
             spec.geometry = *g;
         return degrees(spec.geometry);
     }
     if (vectors) {
-        if (!c.contains("light") || !c.contains("view"))
-            ctx.fail(key, "light and view must both be given");
-        const Eigen::Vector3d L = unit_vector(ctx, c["light"], concat(key, ".light"));
-        const Eigen::Vector3d V = unit_vector(ctx, c["view"], concat(key, ".view"));
+        if (!c.has("light") || !c.has("view")) c.fail("light and view must both be given");
+        const Eigen::Vector3d L = unit_vector(c.at("light"));
+        const Eigen::Vector3d V = unit_vector(c.at("view"));
         for (const auto& [name, v] : {std::pair{"light", L}, std::pair{"view", V}})
             if (!(v.z() > kGrazingCos))
-                ctx.fail(concat(key, ".", name),
-                         "points at or below the sample's plane (z ≤ 0, or grazing); the "
-                         "normal of the sample is +z");
+                c.fail_at(name,
+                          "points at or below the sample's plane (z ≤ 0, or grazing); the "
+                          "normal of the sample is +z");
         const auto g = geometry_from_vectors(Eigen::Vector3d::UnitZ(), L, V);
         if (!g)
-            ctx.fail(key,
-                     "the light or the view is at or below the sample's plane (z ≤ 0); the "
-                     "normal of the sample is +z");
+            c.fail(
+                "the light or the view is at or below the sample's plane (z ≤ 0); the "
+                "normal of the sample is +z");
         spec.geometry = *g;
         spec.light = L;
         spec.view = V;
         return degrees(*g);
     }
-    if (!c.contains("theta_i_deg"))
-        ctx.fail(key, "needs theta_i_deg (and theta_s_deg, phi_s_deg) or light and view");
+    if (!c.has("theta_i_deg"))
+        c.fail("needs theta_i_deg (and theta_s_deg, phi_s_deg) or light and view");
     // Checked in degrees, as typed (a value converted to radians and back may print differently).
     std::array<double, 3> deg{0.0, 0.0, 0.0};
     const std::array<const char*, 3> names{"theta_i_deg", "theta_s_deg", "phi_s_deg"};
     for (std::size_t a = 0; a < 3; ++a) {
-        if (!c.contains(names[a])) continue;
-        const std::string name = concat(key, ".", names[a]);
-        deg[a] = ctx.number(c[names[a]], name);
+        if (!c.has(names[a])) continue;
+        const JsonNode angle = c.at(names[a]);
+        deg[a] = angle.number();
         if (a < 2 && !(deg[a] >= 0.0 && deg[a] < 90.0))
-            ctx.fail(name, concat(check::format_number(deg[a]), " must be in [0, 90)"));
+            angle.fail(concat(check::format_number(deg[a]), " must be in [0, 90)"));
     }
     Geometry g;
     g.theta_i_rad = deg_to_rad(deg[0]);
     g.theta_s_rad = deg_to_rad(deg[1]);
     g.phi_s_rad = deg_to_rad(deg[2]);
-    checked(ctx, key, [&] { check::geometry(g); });
+    c.checked([&] { check::geometry(g); });
     spec.geometry = g;
     if (curved) {
         spec.light = light_direction(g);
@@ -447,51 +336,43 @@ std::array<double, 3> parse_capture_geometry(const Context& ctx, const Json& c,
 }
 
 // A specular capture is taken in the mirror direction of its light (θs = θi, φs = 0; §4.1.1).
-void check_specular_geometry(const Context& ctx, const CaptureSpec& spec, const std::string& key,
+void check_specular_geometry(const JsonNode& c, const CaptureSpec& spec,
                              const std::array<double, 3>& deg) {
     const Geometry& g = spec.geometry;
     if (std::abs(g.theta_i_rad - g.theta_s_rad) <= kSpecularToleranceRad &&
         std::abs(std::remainder(g.phi_s_rad, 2 * kPi)) <= kSpecularToleranceRad)
         return;
-    ctx.fail(concat(key, ".role"),
-             concat("a specular capture must be taken in the specular direction (theta_s = "
-                    "theta_i, phi_s = 0); got theta_i = ",
-                    format_message(deg[0], 15), "°, theta_s = ", format_message(deg[1], 15),
-                    "°, phi_s = ", format_message(deg[2], 15), "°"));
+    c.fail_at("role",
+              concat("a specular capture must be taken in the specular direction (theta_s = "
+                     "theta_i, phi_s = 0); got theta_i = ",
+                     format_message(deg[0], 15), "°, theta_s = ", format_message(deg[1], 15),
+                     "°, phi_s = ", format_message(deg[2], 15), "°"));
 }
 
 // "captures": [...] (and the check of "exposures_equal" against the exposures they give).
-void parse_captures(const Context& ctx, const Json& doc, bool curved, MeasureRequest& request) {
-    if (!doc.contains("captures") || !doc["captures"].is_array() || doc["captures"].empty())
-        ctx.fail("captures", "must be a non-empty array of captures");
-    const Json& captures = doc["captures"];
-    for (std::size_t k = 0; k < captures.size(); ++k) {
-        const std::string key = concat("captures[", std::to_string(k), "]");
-        const Json& c = captures[k];
-        ctx.only(c, key,
-                 {"image", "bracket", "theta_i_deg", "theta_s_deg", "phi_s_deg", "light", "view",
-                  "exposure_s", "role", "description"});
+void parse_captures(const Context& ctx, const JsonNode& doc, bool curved, MeasureRequest& request) {
+    if (!doc.has("captures") || !doc.at("captures").is_array() || doc.at("captures").size() == 0)
+        doc.fail_at("captures", "must be a non-empty array of captures");
+    for (const JsonNode& c : doc.at("captures").array()) {
+        c.only({"image", "bracket", "theta_i_deg", "theta_s_deg", "phi_s_deg", "light", "view",
+                "exposure_s", "role", "description"});
         CaptureSpec spec;
-        if (c.contains("image") == c.contains("bracket"))
-            ctx.fail(key,
-                     "needs \"image\" (a file) or \"bracket\" (an exposure bracket), one of them");
-        if (c.contains("bracket")) {
-            spec.bracket = parse_bracket(ctx, c["bracket"], concat(key, ".bracket"));
+        if (c.has("image") == c.has("bracket"))
+            c.fail("needs \"image\" (a file) or \"bracket\" (an exposure bracket), one of them");
+        if (c.has("bracket")) {
+            spec.bracket = parse_bracket(ctx, c.at("bracket"));
             spec.image = spec.bracket.front().image;
-            if (c.contains("exposure_s"))
-                ctx.fail(concat(key, ".exposure_s"),
-                         "a bracket gives each photograph's exposure_s; a merged bracket is per "
-                         "second");
+            if (c.has("exposure_s"))
+                c.fail_at("exposure_s",
+                          "a bracket gives each photograph's exposure_s; a merged bracket is per "
+                          "second");
         } else {
-            spec.image = ctx.path(c["image"], concat(key, ".image"));
+            spec.image = ctx.path(c.at("image"));
         }
-        const std::array<double, 3> deg = parse_capture_geometry(ctx, c, key, curved, spec);
-        if (c.contains("exposure_s") && !c["exposure_s"].is_null())
-            spec.exposure_s = ctx.exposure(c["exposure_s"], concat(key, ".exposure_s"));
-        if (c.contains("role"))
-            spec.role = ctx.named(c["role"], concat(key, ".role"), parse_capture_role);
-        if (spec.role == CaptureRole::Specular && !curved)
-            check_specular_geometry(ctx, spec, key, deg);
+        const std::array<double, 3> deg = parse_capture_geometry(c, curved, spec);
+        if (const auto e = c.find("exposure_s")) spec.exposure_s = Context::exposure(*e);
+        if (c.has("role")) spec.role = c.at("role").named(parse_capture_role);
+        if (spec.role == CaptureRole::Specular && !curved) check_specular_geometry(c, spec, deg);
         request.captures.push_back(std::move(spec));
     }
     if (!request.exposures_equal) return;
@@ -502,45 +383,68 @@ void parse_captures(const Context& ctx, const Json& doc, bool curved, MeasureReq
         const CaptureSpec& spec = request.captures[k];
         if (!spec.exposure_s || !spec.bracket.empty()) continue;
         if (timed != nullptr && *timed->exposure_s != *spec.exposure_s)
-            ctx.fail("exposures_equal",
-                     concat("true, but captures[", std::to_string(k), "].exposure_s ",
-                            check::format_number(*spec.exposure_s), " s differs from ",
-                            check::format_number(*timed->exposure_s),
-                            " s; give each capture's exposure_s and leave exposures_equal out"));
+            doc.fail_at("exposures_equal",
+                        concat("true, but captures[", std::to_string(k), "].exposure_s ",
+                               check::format_number(*spec.exposure_s), " s differs from ",
+                               check::format_number(*timed->exposure_s),
+                               " s; give each capture's exposure_s and leave exposures_equal out"));
         if (timed == nullptr) timed = &spec;
     }
 }
 
-}  // namespace
-
-namespace {
-
-MeasureRequest parse_checked(std::string_view text, const std::string& path);
-
-}  // namespace
-
-MeasureRequest parse_capture_file(std::string_view text, const std::string& path) {
-    // Every value is type-checked before it is read; should the JSON library still throw, the
-    // file is named as for any other malformed input.
-    try {
-        return parse_checked(text, path);
-    } catch (const Json::exception& e) {
-        throw DataError(concat(path, ": ", e.what()));
+// The "response" key: a name, {"gamma": g} or {"bracket": [...]}.
+void parse_response_key(const Context& ctx, const JsonNode& r, MeasureRequest& request) {
+    if (r.is_object() && r.has("bracket")) {
+        r.only({"bracket"});
+        request.response_bracket = parse_bracket(ctx, r.at("bracket"));
+    } else if (r.is_object()) {
+        r.only({"gamma", "bracket"});
+        if (!r.has("gamma")) r.fail("an object response needs \"gamma\" or \"bracket\"");
+        request.read.response = Response::Gamma;
+        request.read.gamma = r.at("gamma").positive();
+        if (request.read.gamma < 0.1 || request.read.gamma > 10.0)
+            r.fail_at("gamma",
+                      concat(check::format_number(request.read.gamma), " must be in [0.1, 10]"));
+    } else {
+        request.read.response = r.named(parse_response);
+        if (request.read.response == Response::Gamma) r.fail("give the gamma as {\"gamma\": 2.2}");
     }
 }
 
-namespace {
-
-MeasureRequest parse_checked(std::string_view text, const std::string& path) {
-    Context ctx{path, std::filesystem::path(path).parent_path()};
-    Json doc;
-    try {
-        doc = Json::parse(text);
-    } catch (const Json::exception& e) {  // a syntax error or a number out of range
-        throw DataError(concat(path, ": not valid JSON: ", e.what()));
+void parse_highlight(const JsonNode& h, HighlightOptions& o) {
+    h.only({"core_radius_px", "annulus_inner_px", "annulus_outer_px", "smoothing_sigma_px",
+            "centre_px"});
+    if (h.has("core_radius_px")) o.core_radius_px = h.at("core_radius_px").positive();
+    if (h.has("annulus_inner_px")) o.annulus_inner_px = h.at("annulus_inner_px").positive();
+    if (h.has("annulus_outer_px")) o.annulus_outer_px = h.at("annulus_outer_px").positive();
+    if (h.has("smoothing_sigma_px")) o.smoothing_sigma_px = h.at("smoothing_sigma_px").positive();
+    if (h.has("centre_px")) {
+        const auto c = h.at("centre_px").numbers(2);
+        o.centre_px = std::array<double, 2>{c[0], c[1]};
     }
-    ctx.only(doc, "",
-             {"format",
+}
+
+void parse_statistics(const JsonNode& s, RegionStatisticsOptions& o) {
+    s.only({"tile_size_px", "max_excluded_fraction"});
+    if (s.has("tile_size_px")) {
+        const JsonNode t = s.at("tile_size_px");
+        const double tile = t.positive();
+        if (tile != std::floor(tile) || tile > 1e6)
+            t.fail("must be a whole number of pixels ≤ 1e6");
+        o.tile_size_px = static_cast<std::size_t>(tile);
+    }
+    if (s.has("max_excluded_fraction")) {
+        const JsonNode f = s.at("max_excluded_fraction");
+        const double fraction = f.number();
+        if (!(fraction >= 0.0 && fraction <= 1.0)) f.fail("must be in [0, 1]");
+        o.max_excluded_fraction = fraction;
+    }
+}
+
+MeasureRequest parse_document(const io::JsonValue& value, const std::string& path) {
+    const JsonNode doc(value, path);
+    const Context ctx{std::filesystem::path(path).parent_path()};
+    doc.only({"format",
               "version",
               "wavelength_um",
               "channel_wavelengths_um",
@@ -566,142 +470,77 @@ MeasureRequest parse_checked(std::string_view text, const std::string& path) {
               "description"});
     MeasureRequest request;
     request.source = path;
-    if (doc.contains("format") && ctx.string(doc["format"], "format") != "roughscope-measure")
-        ctx.fail("format", "must be \"roughscope-measure\" when given");
-    if (doc.contains("wavelength_um"))
-        request.wavelength_um = ctx.length(doc["wavelength_um"], "wavelength_um");
-    if (doc.contains("channel_wavelengths_um")) {
-        const Json& w = doc["channel_wavelengths_um"];
-        ctx.numbers(w, "channel_wavelengths_um", 3);  // the shape
+    if (doc.has("format") && doc.at("format").string() != "roughscope-measure")
+        doc.fail_at("format", "must be \"roughscope-measure\" when given");
+    if (doc.has("wavelength_um")) request.wavelength_um = Context::length(doc.at("wavelength_um"));
+    if (doc.has("channel_wavelengths_um")) {
+        const JsonNode w = doc.at("channel_wavelengths_um");
+        w.numbers(3);  // the shape
         for (std::size_t k = 0; k < 3; ++k)
-            request.channel_wavelengths_um[k] =
-                ctx.length(w[k], concat("channel_wavelengths_um[", std::to_string(k), "]"));
+            request.channel_wavelengths_um[k] = Context::length(w.item(k));
     }
-    if (doc.contains("exposures_equal"))
-        request.exposures_equal = boolean(ctx, doc["exposures_equal"], "exposures_equal");
-    if (doc.contains("response")) {
-        const Json& r = doc["response"];
-        if (r.is_object() && r.contains("bracket")) {
-            ctx.only(r, "response", {"bracket"});
-            request.response_bracket = parse_bracket(ctx, r["bracket"], "response.bracket");
-        } else if (r.is_object()) {
-            ctx.only(r, "response", {"gamma", "bracket"});
-            if (!r.contains("gamma"))
-                ctx.fail("response", "an object response needs \"gamma\" or \"bracket\"");
-            request.read.response = Response::Gamma;
-            request.read.gamma = ctx.positive(r["gamma"], "response.gamma");
-            if (request.read.gamma < 0.1 || request.read.gamma > 10.0)
-                ctx.fail("response.gamma",
-                         concat(check::format_number(request.read.gamma), " must be in [0.1, 10]"));
-        } else {
-            request.read.response = ctx.named(r, "response", parse_response);
-            if (request.read.response == Response::Gamma)
-                ctx.fail("response", "give the gamma as {\"gamma\": 2.2}");
-        }
-    }
-    if (doc.contains("black_level_dn")) {
+    if (doc.has("exposures_equal")) request.exposures_equal = doc.at("exposures_equal").boolean();
+    if (doc.has("response")) parse_response_key(ctx, doc.at("response"), request);
+    if (doc.has("black_level_dn")) {
         // One value for every channel, or one per channel ([R, G, B]).
-        const Json& b = doc["black_level_dn"];
-        std::vector<double> levels = b.is_array()
-                                         ? ctx.numbers(b, "black_level_dn", b.size() == 3 ? 3 : 1)
-                                         : std::vector<double>{ctx.number(b, "black_level_dn")};
+        const JsonNode b = doc.at("black_level_dn");
+        std::vector<double> levels =
+            b.is_array() ? b.numbers(b.size() == 3 ? 3 : 1) : std::vector<double>{b.number()};
         for (const double level : levels)
-            if (level < 0.0) ctx.fail("black_level_dn", "must be ≥ 0");
+            if (level < 0.0) b.fail("must be ≥ 0");
         request.read.black_level_dn = std::move(levels);
     }
-    if (doc.contains("white_balance")) {
-        if (!doc["white_balance"].is_boolean()) ctx.fail("white_balance", "must be true or false");
-        request.read.white_balance = doc["white_balance"].get<bool>();
+    if (doc.has("white_balance")) {
+        const JsonNode w = doc.at("white_balance");
+        if (!w.json().is_boolean()) w.fail("must be true or false");
+        request.read.white_balance = w.boolean();
     }
-    if (doc.contains("dark_frame") && !doc["dark_frame"].is_null())
-        request.dark_frame = ctx.path(doc["dark_frame"], "dark_frame");
-    if (doc.contains("flat_field") && !doc["flat_field"].is_null())
-        request.flat_field = ctx.path(doc["flat_field"], "flat_field");
-    if (doc.contains("correlation"))
-        request.correlation = ctx.named(doc["correlation"], "correlation", parse_correlation);
-    if (doc.contains("regime")) request.regime = ctx.named(doc["regime"], "regime", parse_regime);
-    if (doc.contains("factor"))
-        request.factor = ctx.named(doc["factor"], "factor", parse_geometric_factor);
-    if (doc.contains("radiometry"))
-        request.radiometry = ctx.named(doc["radiometry"], "radiometry", parse_radiometry);
-    if (doc.contains("sigma_um") && !doc["sigma_um"].is_null())
-        request.sigma_um = ctx.length(doc["sigma_um"], "sigma_um");
-    if (doc.contains("sigma_um_stderr"))
-        request.sigma_um_stderr =
-            ctx.range(doc["sigma_um_stderr"], "sigma_um_stderr", 0.0, kMaxLengthUm, " µm");
-    if (doc.contains("R0")) request.R0 = ctx.positive(doc["R0"], "R0");
-    if (doc.contains("highlight")) {
-        const Json& h = doc["highlight"];
-        ctx.only(h, "highlight",
-                 {"core_radius_px", "annulus_inner_px", "annulus_outer_px", "smoothing_sigma_px",
-                  "centre_px"});
-        if (h.contains("core_radius_px"))
-            request.highlight.core_radius_px =
-                ctx.positive(h["core_radius_px"], "highlight.core_radius_px");
-        if (h.contains("annulus_inner_px"))
-            request.highlight.annulus_inner_px =
-                ctx.positive(h["annulus_inner_px"], "highlight.annulus_inner_px");
-        if (h.contains("annulus_outer_px"))
-            request.highlight.annulus_outer_px =
-                ctx.positive(h["annulus_outer_px"], "highlight.annulus_outer_px");
-        if (h.contains("smoothing_sigma_px"))
-            request.highlight.smoothing_sigma_px =
-                ctx.positive(h["smoothing_sigma_px"], "highlight.smoothing_sigma_px");
-        if (h.contains("centre_px")) {
-            const auto c = ctx.numbers(h["centre_px"], "highlight.centre_px", 2);
-            request.highlight.centre_px = std::array<double, 2>{c[0], c[1]};
-        }
-    }
-    if (doc.contains("statistics")) {
-        const Json& s = doc["statistics"];
-        ctx.only(s, "statistics", {"tile_size_px", "max_excluded_fraction"});
-        if (s.contains("tile_size_px")) {
-            const double t = ctx.positive(s["tile_size_px"], "statistics.tile_size_px");
-            if (t != std::floor(t) || t > 1e6)
-                ctx.fail("statistics.tile_size_px", "must be a whole number of pixels ≤ 1e6");
-            request.statistics.tile_size_px = static_cast<std::size_t>(t);
-        }
-        if (s.contains("max_excluded_fraction")) {
-            const double f =
-                ctx.number(s["max_excluded_fraction"], "statistics.max_excluded_fraction");
-            if (!(f >= 0.0 && f <= 1.0))
-                ctx.fail("statistics.max_excluded_fraction", "must be in [0, 1]");
-            request.statistics.max_excluded_fraction = f;
-        }
-    }
-    if (doc.contains("object")) request.object = parse_object(ctx, doc["object"]);
-    if (doc.contains("maps")) request.maps = parse_maps(ctx, doc["maps"]);
+    if (const auto d = doc.find("dark_frame")) request.dark_frame = ctx.path(*d);
+    if (const auto f = doc.find("flat_field")) request.flat_field = ctx.path(*f);
+    if (doc.has("correlation"))
+        request.correlation = doc.at("correlation").named(parse_correlation);
+    if (doc.has("regime")) request.regime = doc.at("regime").named(parse_regime);
+    if (doc.has("factor")) request.factor = doc.at("factor").named(parse_geometric_factor);
+    if (doc.has("radiometry")) request.radiometry = doc.at("radiometry").named(parse_radiometry);
+    if (const auto sigma = doc.find("sigma_um")) request.sigma_um = Context::length(*sigma);
+    if (doc.has("sigma_um_stderr"))
+        request.sigma_um_stderr = doc.at("sigma_um_stderr").number(0.0, kMaxLengthUm, " µm");
+    if (doc.has("R0")) request.R0 = doc.at("R0").positive();
+    if (doc.has("highlight")) parse_highlight(doc.at("highlight"), request.highlight);
+    if (doc.has("statistics")) parse_statistics(doc.at("statistics"), request.statistics);
+    if (doc.has("object")) request.object = parse_object(ctx, doc.at("object"));
+    if (doc.has("maps")) request.maps = parse_maps(ctx, doc.at("maps"));
     const bool curved = request.object.shape != ObjectShape::Plane;
-    if (doc.contains("roi"))
-        request.roi = parse_region(ctx, doc["roi"], "roi");
+    if (doc.has("roi"))
+        request.roi = parse_region(ctx, doc.at("roi"));
     else if (!curved && !request.maps)
-        ctx.fail("roi",
-                 "missing: the region to measure is required (for a flat sample without "
-                 "\"maps\")");
+        doc.fail_at("roi",
+                    "missing: the region to measure is required (for a flat sample without "
+                    "\"maps\")");
     parse_captures(ctx, doc, curved, request);
     return request;
 }
 
 }  // namespace
 
+MeasureRequest parse_capture_file(std::string_view text, const std::string& path) {
+    const io::JsonValue doc = io::parse_json_text(text, path);
+    // Every value is type-checked before it is read; should the JSON library still throw, the
+    // file is named as for any other malformed input.
+    try {
+        return parse_document(doc, path);
+    } catch (const io::JsonValue::exception& e) {
+        throw DataError(concat(path, ": ", e.what()));
+    }
+}
+
 MeasureRequest read_capture_file(const std::string& path) {
-    std::error_code ec;
-    if (std::filesystem::is_directory(path, ec))
-        throw DataError(concat(path, ": is a directory, not a capture file"));
-    io::check_input_file(path, path);
-    constexpr std::size_t kMaxCaptureFileBytes = std::size_t{16} << 20;
-    const auto too_large = [&] {
-        return DataError(concat(path, ": larger than 16 MiB: not a capture file"));
-    };
-    std::error_code size_ec;
-    if (std::filesystem::file_size(path, size_ec) > kMaxCaptureFileBytes && !size_ec)
-        throw too_large();
-    std::ifstream in(path, std::ios::binary);
-    if (!in) throw DataError(concat(path, ": cannot open the capture file"));
-    std::ostringstream text;
-    text << in.rdbuf();
-    if (text.str().size() > kMaxCaptureFileBytes) throw too_large();
-    return parse_capture_file(text.str(), path);
+    const io::JsonValue doc = io::read_json_file(path, "a capture file");
+    try {
+        return parse_document(doc, path);
+    } catch (const io::JsonValue::exception& e) {
+        throw DataError(concat(path, ": ", e.what()));
+    }
 }
 
 }  // namespace roughscope::image

@@ -8,12 +8,17 @@
 #include <optional>
 #include <sstream>
 #include <string>
+#include <string_view>
 #include <vector>
 
-#include "options.hpp"
+#include "io/json_reader.hpp"
+#include "roughscope/brdf/curet.hpp"
 #include "roughscope/core/errors.hpp"
+#include "roughscope/core/numbers.hpp"
+#include "roughscope/core/uncertainty.hpp"
 #include "roughscope/scattering/geometry.hpp"
 #include "roughscope/scattering/validity.hpp"
+#include "roughscope/serialize/text.hpp"
 
 namespace roughscope::serialize {
 namespace {
@@ -186,41 +191,69 @@ std::string md_escape(const std::string& s) {
     return out;
 }
 
+// Significant digits of the text report's headline numbers (the CLI's precision, docs/cli.md).
+constexpr int kTextDigits = 10;
+
+// ASCII labels for the aligned text table (an en dash as "-").
+std::string ascii(std::string_view s) {
+    std::string out;
+    for (std::size_t k = 0; k < s.size(); ++k) {
+        if (k + 2 < s.size() && static_cast<unsigned char>(s[k]) == 0xE2 &&
+            static_cast<unsigned char>(s[k + 1]) == 0x80 &&
+            static_cast<unsigned char>(s[k + 2]) == 0x93) {
+            out += '-';
+            k += 2;
+        } else {
+            out += s[k];
+        }
+    }
+    return out;
+}
+
+// Six significant digits for the text tables (the library's format_significant); throws on
+// NaN/inf (never printed). A -0 read from a data file stays "-0" in the data-issue list.
+std::string short_number(double v, std::string_view name) {
+    if (v == 0.0 && std::signbit(v)) return "-0";
+    return format_significant(v, 6, name);
+}
+
 }  // namespace
 
 ComparisonOptions comparison_options_from(const Json& options) {
-    using namespace detail;
-    check_keys(options, "comparison option",
-               {"theta1_deg", "theta2_deg", "pair", "on_sigma_rad", "on_albedo", "fits",
-                "radiometry", "max_overflow"});
+    const io::JsonNode named(options, "comparison options", io::JsonSource::Arguments);
+    if (!options.is_null())
+        named.only({"theta1_deg", "theta2_deg", "pair", "on_sigma_rad", "on_albedo", "fits",
+                    "radiometry", "max_overflow"});
+    const auto number = [&](const char* key) -> std::optional<double> {
+        if (const auto v = named.find(key)) return v->number();
+        return std::nullopt;
+    };
     ComparisonOptions o;
-    const auto theta1 = get_number(options, "theta1_deg");
-    const auto theta2 = get_number(options, "theta2_deg");
+    const auto theta1 = number("theta1_deg");
+    const auto theta2 = number("theta2_deg");
     if (theta1.has_value() != theta2.has_value())
         throw InvalidArgument("give both theta1_deg and theta2_deg (degrees) or neither");
     if (theta1) {
         o.theta1_rad = deg_to_rad(*theta1);
         o.theta2_rad = deg_to_rad(*theta2);
     }
-    if (const auto pair = get_int_pair(options, "pair")) {
-        if (pair->first < 1 || pair->second < 1)
-            throw InvalidArgument("pair = [" + std::to_string(pair->first) + ", " +
-                                  std::to_string(pair->second) +
-                                  "]: expected two measurement numbers >= 1");
-        o.measurement1 = pair->first;
-        o.measurement2 = pair->second;
+    if (const auto pair = named.find("pair")) {
+        // Two measurement numbers >= 1 (CUReT numbers them from 1).
+        const auto items = pair->array(2, 2, "measurement numbers");
+        o.measurement1 = static_cast<int>(items[0].integer(1, std::numeric_limits<int>::max()));
+        o.measurement2 = static_cast<int>(items[1].integer(1, std::numeric_limits<int>::max()));
     }
-    const auto on_sigma = get_number(options, "on_sigma_rad");
-    const auto on_albedo = get_number(options, "on_albedo");
+    const auto on_sigma = number("on_sigma_rad");
+    const auto on_albedo = number("on_albedo");
     if (on_sigma.has_value() != on_albedo.has_value())
         throw InvalidArgument("give both on_sigma_rad and on_albedo (Oren-Nayar) or neither");
     if (on_sigma) {
         o.oren_nayar = OrenNayarParams{*on_sigma, *on_albedo};
         o.oren_nayar_source = "given";
     }
-    if (const auto fits = get_bool(options, "fits")) o.fits = *fits;
-    if (const auto r = get_string(options, "radiometry")) o.radiometry = parse_radiometry(*r);
-    o.max_overflow_fraction = get_number(options, "max_overflow");
+    if (const auto fits = named.find("fits")) o.fits = fits->boolean();
+    if (const auto r = named.find("radiometry")) o.radiometry = r->named(parse_radiometry);
+    o.max_overflow_fraction = number("max_overflow");
     validate(o);
     return o;
 }
@@ -315,4 +348,110 @@ std::string to_markdown(const std::vector<Comparison>& comparisons) {
     }
     return out.str();
 }
+std::string to_text(const Comparison& c) {
+    std::ostringstream out;
+    out << (c.sample ? "CUReT sample " + std::to_string(c.sample) : c.name);
+    if (c.sample && !curet_sample_name(c.sample).empty()) out << " (" << c.name << ")";
+    out << ", channel " << (c.channel.empty() ? "-" : c.channel) << ": " << c.measurement.size()
+        << " of " << c.total_measurements << " measurements used\n\n";
+    const TwoPointEstimate& t = c.two_point;
+    out << "Two-point estimate (Table 3; measurements " << t.measurement1 << " and "
+        << t.measurement2 << ", F_VH, viewer on the normal):\n";
+    if (t.available) {
+        std::vector<std::pair<std::string, std::string>> kv;
+        kv.emplace_back("theta1, theta2 (deg)",
+                        short_number(rad_to_deg(t.theta1_rad), "theta1") + ", " +
+                            short_number(rad_to_deg(t.theta2_rad), "theta2"));
+        kv.emplace_back("E1/E2", format_significant(*t.E1_over_E2, kTextDigits, "E1/E2"));
+        kv.emplace_back("sigma/T (Gaussian, Eq. 17)",
+                        t.sigma_over_T_gaussian
+                            ? format_significant(*t.sigma_over_T_gaussian, kTextDigits, "sigma/T")
+                            : "unavailable: " + t.gaussian_reason);
+        kv.emplace_back("sigma/T (exponential, Eq. 19)",
+                        t.sigma_over_T_exponential ? format_significant(*t.sigma_over_T_exponential,
+                                                                        kTextDigits, "sigma/T")
+                                                   : "unavailable: " + t.exponential_reason);
+        out << key_value_lines(kv);
+    } else {
+        out << "  unavailable: " << t.reason << "\n";
+    }
+    out << "\nErrors (Table 4 = sum of squared differences of max-normalised brightness; RMSE = "
+           "sqrt(Table 4 / N); gain SSE = after the optimal gain):\n";
+    std::vector<std::vector<std::string>> rows;
+    auto skipped = [](const ModelResult& r) {
+        return is_fit(r.model) && r.reason == "fits not requested";
+    };
+    for (const ModelResult& r : c.models) {
+        if (skipped(r)) continue;
+        std::vector<std::string> row{ascii(display_name(r.model))};
+        if (!r.available) {
+            row.insert(row.end(), {"-", "-", "-", "-", "unavailable"});
+            rows.push_back(row);
+            continue;
+        }
+        std::string params;
+        for (const ModelParameter& p : r.parameters) {
+            if (p.name == "gain") continue;
+            if (!p.identified) {  // no number for what the data do not determine
+                params += (params.empty() ? "" : ", ") + p.name + "=not-identifiable";
+                continue;
+            }
+            // "name=value ± error" (core/uncertainty.hpp), the value alone with 6 digits.
+            const std::string value = p.value == 0.0 && std::signbit(p.value)
+                                          ? short_number(p.value, p.name)
+                                          : format_uncertain(p.value, p.standard_error, 6, p.name);
+            params += (params.empty() ? "" : ", ") + p.name + "=" + value;
+        }
+        row.push_back(params);
+        row.push_back(short_number(r.errors.paper_sse, "Table-4 error"));
+        row.push_back(short_number(r.errors.rmse, "RMSE"));
+        row.push_back(short_number(r.errors.gain_sse, "gain SSE"));
+        row.push_back(r.fit_status ? std::string(to_string(*r.fit_status)) : "");
+        rows.push_back(row);
+    }
+    out << text_table({"model", "parameters", "Table 4", "RMSE", "gain SSE", "status"}, rows);
+    out << "\nWinner by gain SSE (fits included): "
+        << (c.winner ? ascii(display_name(*c.winner)) : std::string("-"))
+        << "\nWinner by the Table-4 metric (paper's methods): "
+        << (c.winner_paper_metric ? ascii(display_name(*c.winner_paper_metric)) : std::string("-"))
+        << "\n";
+    for (const ModelResult& r : c.models)
+        if (!r.available && !skipped(r))
+            out << "  " << ascii(display_name(r.model)) << ": " << r.reason << "\n";
+    if (!c.data_issues.empty()) {
+        out << "\nData issues (" << c.data_issues.size() << "):\n";
+        for (const DataIssue& d : c.data_issues)
+            out << "  measurement " << d.measurement << ": f = " << short_number(d.value, "f")
+                << ", " << d.issue << " - " << d.note << "\n";
+    }
+    return out.str();
+}
+
+std::string to_text(const std::vector<Comparison>& all) {
+    std::vector<std::vector<std::string>> rows;
+    for (const Comparison& c : all) {
+        std::vector<std::string> row{std::to_string(c.sample)};
+        const TwoPointEstimate& t = c.two_point;
+        row.push_back(t.E1_over_E2 ? short_number(*t.E1_over_E2, "E1/E2") : "-");
+        row.push_back(t.sigma_over_T_gaussian ? short_number(*t.sigma_over_T_gaussian, "s/T")
+                                              : "-");
+        row.push_back(t.sigma_over_T_exponential ? short_number(*t.sigma_over_T_exponential, "s/T")
+                                                 : "-");
+        for (ComparisonModel m : kPaperComparisonModels) {
+            const ModelResult& r = c.result(m);
+            row.push_back(r.available ? short_number(r.errors.paper_sse, "error") : "-");
+        }
+        row.push_back(c.winner ? ascii(display_name(*c.winner)) : "-");
+        row.push_back(std::to_string(c.data_issues.size()));
+        rows.push_back(row);
+    }
+    std::ostringstream out;
+    std::vector<std::string> header{"sample", "E1/E2", "s/T_G", "s/T_E"};
+    for (ComparisonModel m : kPaperComparisonModels) header.push_back(ascii(display_name(m)));
+    header.push_back("best (gain SSE)");
+    header.push_back("issues");
+    out << text_table(header, rows);
+    return out.str();
+}
+
 }  // namespace roughscope::serialize

@@ -1,13 +1,20 @@
 // JSON schemas of the §4 estimates and the fits (serialize/estimation.hpp).
 #include "roughscope/serialize/estimation.hpp"
 
+#include <limits>
+#include <optional>
+#include <sstream>
 #include <string>
+#include <string_view>
+#include <utility>
 #include <vector>
 
-#include "options.hpp"
+#include "io/json_reader.hpp"
 #include "roughscope/core/errors.hpp"
+#include "roughscope/core/numbers.hpp"
 #include "roughscope/scattering/geometry.hpp"
 #include "roughscope/scattering/validity.hpp"
+#include "roughscope/serialize/text.hpp"
 
 namespace roughscope::serialize {
 namespace {
@@ -49,37 +56,53 @@ Json ratio_range_json(const RatioRange& r) {
     return Json::array({number(r.lower), number(r.upper)});  // upper = inf → null
 }
 
+// The text reports' precision (the CLI's, docs/cli.md).
+std::string significant(double value, std::string_view name) {
+    return format_significant(value, 10, name);
+}
+
 }  // namespace
 
 // ---------------------------------------------------------------------------------------------
 
 FitOptions fit_options_from(const Json& options) {
-    using namespace detail;
-    check_keys(options, "fit option",
-               {"model", "correlation", "factor", "radiometry", "regime", "wavelength_um",
-                "residual", "loss", "loss_scale", "initial_sigma_over_T", "initial_sigma_um",
-                "initial_T_um", "sigma_over_T_bounds", "sigma_bounds_um", "T_bounds_um",
-                "max_iterations", "scale_covariance"});
+    const io::JsonNode named(options, "fit options", io::JsonSource::Arguments);
+    if (!options.is_null())
+        named.only({"model", "correlation", "factor", "radiometry", "regime", "wavelength_um",
+                    "residual", "loss", "loss_scale", "initial_sigma_over_T", "initial_sigma_um",
+                    "initial_T_um", "sigma_over_T_bounds", "sigma_bounds_um", "T_bounds_um",
+                    "max_iterations", "scale_covariance"});
+    const auto number = [&](const char* key) -> std::optional<double> {
+        if (const auto v = named.find(key)) return v->number();
+        return std::nullopt;
+    };
+    const auto bounds = [&](const char* key, double& lower, double& upper) {
+        if (const auto v = named.find(key)) {
+            const auto pair = v->numbers(2);
+            lower = pair[0];
+            upper = pair[1];
+        }
+    };
     FitOptions o;
-    if (auto v = get_string(options, "model")) o.model = parse_fit_model(*v);
-    if (auto v = get_string(options, "correlation")) o.correlation = parse_correlation(*v);
-    if (auto v = get_string(options, "factor")) o.factor = parse_geometric_factor(*v);
-    if (auto v = get_string(options, "radiometry")) o.radiometry = parse_radiometry(*v);
-    if (auto v = get_string(options, "regime")) o.regime = parse_regime(*v);
-    if (auto v = get_number(options, "wavelength_um")) o.wavelength_um = *v;
-    if (auto v = get_string(options, "residual")) o.residual = parse_residual_type(*v);
-    if (auto v = get_string(options, "loss")) o.loss = parse_loss_type(*v);
-    if (auto v = get_number(options, "loss_scale")) o.loss_scale = *v;
-    o.initial_sigma_over_T = get_number(options, "initial_sigma_over_T");
-    o.initial_sigma_um = get_number(options, "initial_sigma_um");
-    o.initial_T_um = get_number(options, "initial_T_um");
-    if (auto v = get_number_pair(options, "sigma_over_T_bounds"))
-        std::tie(o.sigma_over_T_min, o.sigma_over_T_max) = *v;
-    if (auto v = get_number_pair(options, "sigma_bounds_um"))
-        std::tie(o.sigma_min_um, o.sigma_max_um) = *v;
-    if (auto v = get_number_pair(options, "T_bounds_um")) std::tie(o.T_min_um, o.T_max_um) = *v;
-    if (auto v = get_int(options, "max_iterations")) o.max_iterations = *v;
-    if (auto v = get_bool(options, "scale_covariance")) o.scale_covariance = *v;
+    if (const auto v = named.find("model")) o.model = v->named(parse_fit_model);
+    if (const auto v = named.find("correlation")) o.correlation = v->named(parse_correlation);
+    if (const auto v = named.find("factor")) o.factor = v->named(parse_geometric_factor);
+    if (const auto v = named.find("radiometry")) o.radiometry = v->named(parse_radiometry);
+    if (const auto v = named.find("regime")) o.regime = v->named(parse_regime);
+    if (const auto v = number("wavelength_um")) o.wavelength_um = *v;
+    if (const auto v = named.find("residual")) o.residual = v->named(parse_residual_type);
+    if (const auto v = named.find("loss")) o.loss = v->named(parse_loss_type);
+    if (const auto v = number("loss_scale")) o.loss_scale = *v;
+    o.initial_sigma_over_T = number("initial_sigma_over_T");
+    o.initial_sigma_um = number("initial_sigma_um");
+    o.initial_T_um = number("initial_T_um");
+    bounds("sigma_over_T_bounds", o.sigma_over_T_min, o.sigma_over_T_max);
+    bounds("sigma_bounds_um", o.sigma_min_um, o.sigma_max_um);
+    bounds("T_bounds_um", o.T_min_um, o.T_max_um);
+    if (const auto v = named.find("max_iterations"))
+        o.max_iterations = static_cast<int>(
+            v->integer(std::numeric_limits<int>::min(), std::numeric_limits<int>::max()));
+    if (const auto v = named.find("scale_covariance")) o.scale_covariance = v->boolean();
     return o;
 }
 
@@ -294,6 +317,42 @@ Json fit_estimate_json(const FitOptions& options, std::size_t measurements,
     const Json body = to_json(comparison, with_residuals);
     for (const auto& [k, v] : body.items()) out[k] = v;
     return out;
+}
+
+std::string estimate_text(const Json& record) {
+    std::vector<std::pair<std::string, std::string>> items;
+    for (const auto& [key, value] : record.items()) {
+        std::string v;
+        if (value.is_null()) {
+            v = "unknown";
+        } else if (value.is_boolean()) {
+            v = value.get<bool>() ? "true" : "false";
+        } else if (value.is_string()) {
+            v = value.get<std::string>();
+        } else if (value.is_number()) {
+            v = significant(value.get<double>(), key);
+        } else if (value.is_array() && key.rfind("valid_ratio_range", 0) == 0) {
+            // Open interval; no upper bound is written "> lower" (never "inf").
+            v = value[1].is_null() ? "> " + significant(value[0].get<double>(), key)
+                                   : "(" + significant(value[0].get<double>(), key) + ", " +
+                                         significant(value[1].get<double>(), key) + ")";
+        } else if (value.is_array()) {
+            if (key == "warnings") continue;  // printed below, one per line
+            for (const auto& x : value) {
+                if (!v.empty()) v += ", ";
+                v += x.is_number() ? significant(x.get<double>(), key) : x.dump();
+            }
+            if (v.empty()) v = "(none)";
+        } else {
+            continue;  // nested objects: JSON only
+        }
+        items.emplace_back(key, v);
+    }
+    std::ostringstream os;
+    os << key_value_lines(items);
+    if (record.contains("warnings"))
+        for (const auto& w : record["warnings"]) os << "warning: " << w.get<std::string>() << "\n";
+    return os.str();
 }
 
 }  // namespace roughscope::serialize

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <utility>
@@ -11,9 +12,11 @@
 #include "roughscope/core/errors.hpp"
 #include "roughscope/core/numbers.hpp"
 #include "roughscope/core/text.hpp"
+#include "roughscope/core/uncertainty.hpp"
 #include "roughscope/scattering/factors.hpp"
 #include "roughscope/scattering/validity.hpp"
 #include "roughscope/serialize/model.hpp"
+#include "roughscope/serialize/text.hpp"
 
 namespace roughscope::serialize {
 
@@ -44,17 +47,22 @@ std::string text_of(const Json& value) {
 // Aligned "label  value unit" lines.
 void print_lines(std::ostringstream& out,
                  const std::vector<std::pair<std::string, std::string>>& items) {
-    std::size_t width = 0;
-    for (const auto& [label, value] : items) width = std::max(width, label.size());
-    for (const auto& [label, value] : items) {
-        out << label << std::string(width - label.size() + 2, ' ') << value << '\n';
-    }
+    out << key_value_lines(items);
 }
 
 std::string with_unit(const Json& value, const char* unit) {
     std::string s = text_of(value);
     if (!value.is_null()) s.append(" ").append(unit);
     return s;
+}
+
+// "value ± error unit" (core/uncertainty.hpp; the value alone with 6 digits without an error),
+// or "-" for an unknown value.
+std::string uncertain_with_unit(const Json& value, const Json& error, const char* unit) {
+    if (value.is_null()) return "-";
+    const std::optional<double> e =
+        error.is_number() ? std::optional<double>(error.get<double>()) : std::nullopt;
+    return concat(format_uncertain(value.get<double>(), e, 6), " ", unit);
 }
 
 }  // namespace
@@ -138,11 +146,8 @@ std::string to_text(const StatisticsInput& input, const surface::SurfaceStatisti
     if (!j["cutoff_um"].is_null())
         out << ", Gaussian filter cutoff " << text_of(j["cutoff_um"]) << " um";
     out << "; " << j["acf_estimator"].get<std::string>() << " ACF\n";
-    std::string sigma = with_unit(j["sigma_um"], "um");
-    if (!j["sigma_stderr_um"].is_null())
-        sigma.append(" +- ").append(with_unit(j["sigma_stderr_um"], "um"));
-    std::string T = with_unit(j["T_um"], "um");
-    if (!j["T_stderr_um"].is_null()) T.append(" +- ").append(with_unit(j["T_stderr_um"], "um"));
+    const std::string sigma = uncertain_with_unit(j["sigma_um"], j["sigma_stderr_um"], "um");
+    const std::string T = uncertain_with_unit(j["T_um"], j["T_stderr_um"], "um");
     std::string Str = text_of(j["Str"]);
     if (!j["Str_note"].is_null())
         Str.append(" (").append(j["Str_note"].get<std::string>()).append(")");
@@ -234,20 +239,7 @@ std::string to_text(const surface::SurfacePrediction& p, const ModelOptions& opt
                         text_of(q["phi_s_deg"]), text_of(q["brightness"]),
                         text_of(q["very_rough_brightness"]), text_of(q["g"]),
                         q["roughness_class"].get<std::string>()});
-    std::vector<std::size_t> width(header.size());
-    for (std::size_t c = 0; c < header.size(); ++c) {
-        width[c] = header[c].size();
-        for (const auto& r : rows) width[c] = std::max(width[c], r[c].size());
-    }
-    auto line = [&](const std::vector<std::string>& cells) {
-        for (std::size_t c = 0; c < cells.size(); ++c) {
-            if (c) out << "  ";
-            out << std::string(width[c] - cells[c].size(), ' ') << cells[c];
-        }
-        out << '\n';
-    };
-    line(header);
-    for (const auto& r : rows) line(r);
+    out << text_table(header, rows, TextTableStyle{.first_column_left = false, .rule = false});
     for (const std::string& w : p.warnings) out << "warning: " << w << '\n';
     return out.str();
 }

@@ -73,6 +73,7 @@ GOOD_CALLS = {
                               dict(weight=np.ones(4), wavelength_um=0.555, loss_scale=0.05))],
     "comparison_error_measures": [(([1.0, 0.5, 0.2], [1.0, 0.6, 0.1]),
                                    dict(weights=[1.0, 1.0, 2.0]))],
+    "format_uncertain": [((0.29991, 0.00025), dict(digits=4))],
     "correlation_length_from_ratio": [((1.5, 0.05, 10.0, 40.0), dict(wavelength_um=0.555))],
     "correlation_length_two_geometries": [((1.5, 0.05, 10.0, 0.0, 0.0, 40.0, 0.0, 0.0),
                                            dict(wavelength_um=0.555))],

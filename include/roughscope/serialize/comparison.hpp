@@ -1,6 +1,6 @@
 // Output of the model comparison with measured BRDFs (paper §5.3, Tables 3–4, Fig. 10): one JSON
-// schema (keys in docs/curet.md), CSV rows and a Markdown table. Unknown values are null in JSON
-// and empty in CSV, never NaN. Used by `roughscope curet` and roughscope.curet.
+// schema (keys in docs/curet.md), CSV rows, a Markdown table and the text report. Unknown values
+// are null in JSON and empty in CSV, never NaN. Used by `roughscope curet` and roughscope.curet.
 #pragma once
 
 #include <string>
@@ -33,5 +33,11 @@ std::string to_csv(const std::vector<Comparison>& comparisons);  // header + row
 
 // A Markdown table of the paper's Table 3–4 quantities plus the best fit and the exclusions.
 std::string to_markdown(const std::vector<Comparison>& comparisons);
+
+// The text report of `roughscope curet` (--format text): the two-point estimate, the table of
+// models (parameters as "name=value ± error", core/uncertainty.hpp), the winners and the data
+// issues of one comparison; for several, one aligned row per sample.
+std::string to_text(const Comparison& comparison);
+std::string to_text(const std::vector<Comparison>& comparisons);
 
 }  // namespace roughscope::serialize

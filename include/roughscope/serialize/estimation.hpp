@@ -67,4 +67,10 @@ Json fit_estimate_json(const FitOptions& options, std::size_t measurements, cons
 Json fit_estimate_json(const FitOptions& options, std::size_t measurements,
                        const CorrelationComparison& comparison, bool with_residuals);
 
+// The text report of an `estimate` document (any of the above, without --json): "key  value"
+// lines in the document's order, numbers with 10 significant digits, null as "unknown", a valid
+// ratio range as "(lower, upper)" or "> lower", nested objects left out (JSON only), then
+// "warning: ..." lines.
+std::string estimate_text(const Json& record);
+
 }  // namespace roughscope::serialize

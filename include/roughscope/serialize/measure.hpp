@@ -20,6 +20,13 @@ namespace roughscope::serialize {
 // and warnings.
 Json to_json(const image::MeasureResult& result, const image::MeasureRequest& request);
 
+// The text report of `roughscope measure` (without --json): "key  value" lines of the headline
+// values (each "value ± error", core/uncertainty.hpp), the object's, sphere's and map's
+// summaries, then "warning: ..." lines; names from the capture file with their control
+// characters escaped. measure_text takes the document to_json returns.
+std::string to_text(const image::MeasureResult& result, const image::MeasureRequest& request);
+std::string measure_text(const Json& document);
+
 // A cylinder's profile (§5.2, image/cylinder.hpp): axis, profile rows (theta_deg, brightness,
 // stderr, ...), the fitted sigma_over_T_gaussian / _exponential with _stderr, the models with
 // their predictions and departure_angle_deg, theta_K_deg.

@@ -22,12 +22,18 @@ namespace roughscope::serialize {
 
 // {"table1": {"conditions", "rows"}, "table2": ..., "table3": ...}. Throws DataError
 // "<where>: <place in the document>: <what>" for a missing or malformed key (places as
-// "table1_slightly_rough.rows[0]") or a printed input the estimators refuse.
+// "table1_slightly_rough.rows[0].R_spec", io's JSON reader) or a printed input the estimators
+// refuse.
 Json recompute_paper_tables(const Json& reference, const std::string& where);
 
 // Reads the reference document (docs/input-files.md: UTF-8 BOM, CRLF accepted). Throws DataError
 // "<path>: does not exist", "<path>: is a directory, not a file", "<path>: line L, column C: not
 // a text file: NUL byte" or "<path>: line L, column C: not valid JSON: <what>".
 Json read_paper_tables_reference(const std::filesystem::path& path);
+
+// The text report of `roughscope paper tables` (without --json): the three tables of the
+// document recompute_paper_tables returns, each quantity as printed, recomputed (*) and its mark
+// (= exact, ~ within rounding, DIFFERS).
+std::string paper_tables_text(const Json& tables);
 
 }  // namespace roughscope::serialize

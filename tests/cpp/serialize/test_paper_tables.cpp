@@ -197,7 +197,8 @@ TEST(PaperTablesFile, WrongTypesAndRefusedInputsNameThePlace) {
         FAIL() << "expected DataError";
     } catch (const rs::DataError& e) {
         EXPECT_STREQ(e.what(),
-                     "tables.json: table1_slightly_rough.rows[0]: key 'R_spec' is not a number");
+                     "tables.json: table1_slightly_rough.rows[0].R_spec: must be a number, not "
+                     "\"0.014\"");
     }
     Json negative = reference(0.3957);
     negative["table1_slightly_rough"]["conditions"]["lambda_um"] = -1;
