@@ -40,7 +40,6 @@ void bind_simulation(pybind11::module_& m);  // python/bind_simulation.cpp: Kirc
 void bind_capture(pybind11::module_& m);     // python/bind_capture.cpp: synthetic captures
 void bind_image(pybind11::module_& m);       // python/bind_image.cpp: photographs to roughness
 void bind_report(pybind11::module_& m);      // python/bind_report.cpp: what the report draws
-
 void bind_documents(pybind11::module_& m);   // python/bind_documents.cpp: text and documents
 
 // Results cross into Python as real objects, built from the library's serializer
