@@ -45,7 +45,6 @@ KNOWN_OVER = {
     "src/objects/cylinder.cpp",
     "src/objects/cylinder.cpp:measure_cylinder_profile",
     "src/objects/sphere.cpp:measure_sphere_table",
-    "src/photo/decode_raw.cpp:decode_raw",
     "src/surface/format_x3p.cpp",
     "cli/model.cpp",
     "python/bind_core.cpp",
