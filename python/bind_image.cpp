@@ -27,29 +27,6 @@ namespace py = pybind11;
 namespace roughscope::python {
 namespace {
 
-serialize::Json info_json(const image::ImageInfo& info) {
-    serialize::Json out;
-    out["source"] = info.source;
-    out["format"] = info.format;
-    out["raw_format"] = serialize::text_or_null(info.raw_format);
-    out["bits_per_sample"] = info.bits_per_sample;
-    out["is_float"] = info.is_float;
-    out["white_level_dn"] = serialize::number(info.white_level_dn);
-    out["black_level_dn"] = serialize::numbers(info.black_level_dn);
-    out["response"] = std::string(to_string(info.response));
-    out["gamma"] =
-        info.response == Response::Gamma ? serialize::number(info.gamma) : serialize::Json();
-    out["file_response"] = info.file_response
-                               ? serialize::Json(std::string(to_string(*info.file_response)))
-                               : serialize::Json();
-    out["file_response_evidence"] = serialize::text_or_null(info.file_response_evidence);
-    out["exposure_s"] = serialize::number(info.exposure_s);
-    out["f_number"] = serialize::number(info.f_number);
-    out["iso"] = serialize::number(info.iso);
-    out["warnings"] = info.warnings;
-    return out;
-}
-
 py::dict image_dict(const image::LinearImage& image) {
     py::array_t<float> values({image.channels, image.height, image.width});
     std::memcpy(values.mutable_data(), image.values.data(), image.values.size() * sizeof(float));
@@ -58,7 +35,7 @@ py::dict image_dict(const image::LinearImage& image) {
     py::dict out;
     out["values"] = values;
     out["flags"] = flags;
-    out["info"] = to_python(info_json(image.info));
+    out["info"] = to_python(serialize::to_json(image.info));  // the CLI's `info` of a capture
     return out;
 }
 

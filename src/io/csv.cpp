@@ -8,6 +8,7 @@
 #include <istream>
 #include <set>
 #include <system_error>
+#include <utility>
 
 #include "roughscope/core/errors.hpp"
 #include "roughscope/core/numbers.hpp"
@@ -21,24 +22,35 @@ bool is_space(char c) {
     return c == ' ' || c == '\t' || c == '\r' || c == '\n' || c == '\v' || c == '\f';
 }
 
+// One line as every text reader takes it (csv.hpp): DataError for a NUL byte, the UTF-8
+// byte-order mark skipped on line 1, one trailing CR removed.
+std::string_view text_line(std::string_view line, std::size_t number, const std::string& source) {
+    if (const auto nul = line.find('\0'); nul != std::string_view::npos)
+        throw DataError(source + ":" + std::to_string(number) +
+                        ": not a text file: NUL byte at column " + std::to_string(nul + 1));
+    if (number == 1 && line.starts_with("\xEF\xBB\xBF")) line.remove_prefix(3);  // UTF-8 BOM
+    if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
+    return line;
+}
+
 }  // namespace
 
-std::vector<std::string_view> split_fields(std::string_view line, char separator) {
-    std::vector<std::string_view> out;
+void split_fields(std::string_view line, char separator, std::vector<std::string_view>& out) {
+    out.clear();
     std::size_t start = 0;
     while (true) {
         const auto pos = line.find(separator, start);
         if (pos == std::string_view::npos) {
             out.push_back(line.substr(start));
-            return out;
+            return;
         }
         out.push_back(line.substr(start, pos - start));
         start = pos + 1;
     }
 }
 
-std::vector<std::string_view> split_whitespace(std::string_view line) {
-    std::vector<std::string_view> out;
+void split_whitespace(std::string_view line, std::vector<std::string_view>& out) {
+    out.clear();
     std::size_t k = 0;
     while (k < line.size()) {
         while (k < line.size() && is_space(line[k])) ++k;
@@ -46,7 +58,39 @@ std::vector<std::string_view> split_whitespace(std::string_view line) {
         while (k < line.size() && !is_space(line[k])) ++k;
         if (k > start) out.push_back(line.substr(start, k - start));
     }
+}
+
+std::vector<std::string_view> split_fields(std::string_view line, char separator) {
+    std::vector<std::string_view> out;
+    split_fields(line, separator, out);
     return out;
+}
+
+std::vector<std::string_view> split_whitespace(std::string_view line) {
+    std::vector<std::string_view> out;
+    split_whitespace(line, out);
+    return out;
+}
+
+// ---------------------------------------------------------------------------------------------
+// TextLines
+
+TextLines::TextLines(std::string_view text, std::string source)
+    : rest_(text), source_(std::move(source)) {}
+
+bool TextLines::next(std::string_view& line) {
+    if (done_) return false;
+    const std::size_t end = rest_.find('\n');
+    std::string_view raw = rest_.substr(0, end);
+    if (end == std::string_view::npos) {
+        done_ = true;
+        if (raw.empty()) return false;  // the text ended with a line end (or is empty)
+    } else {
+        rest_.remove_prefix(end + 1);
+    }
+    ++line_;
+    line = text_line(raw, line_, source_);
+    return true;
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -76,12 +120,7 @@ bool LineReader::next(std::string_view& line) {
         return false;
     }
     ++line_;
-    if (const auto nul = buffer_.find('\0'); nul != std::string::npos)
-        throw DataError(where() + "not a text file: NUL byte at column " + std::to_string(nul + 1));
-    std::string_view view = buffer_;
-    if (line_ == 1 && view.starts_with("\xEF\xBB\xBF")) view.remove_prefix(3);  // UTF-8 BOM
-    if (!view.empty() && view.back() == '\r') view.remove_suffix(1);
-    line = view;
+    line = text_line(buffer_, line_, source_);
     return true;
 }
 
@@ -184,16 +223,7 @@ bool CsvReader::next(CsvRow& row) {
     while (lines_.next(raw)) {
         const std::string_view line = trim(raw);
         if (line.empty() || line.front() == '#') continue;
-        fields_.clear();
-        for (std::size_t start = 0;;) {
-            const auto comma = line.find(',', start);
-            if (comma == std::string_view::npos) {
-                fields_.push_back(line.substr(start));
-                break;
-            }
-            fields_.push_back(line.substr(start, comma - start));
-            start = comma + 1;
-        }
+        split_fields(line, ',', fields_);
         if (fields_.size() != header_.size())
             throw DataError(lines_.where() + "expected " + std::to_string(header_.size()) +
                             " fields (" + join(header_, ",") + "), found " +

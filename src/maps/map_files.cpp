@@ -1,13 +1,10 @@
-// Files of a roughness map (image/map_files.hpp, docs/maps.md "Files"): TIFF through libtiff and
-// PNG through libpng, encoded in memory; colour maps and text through OpenCV imgproc.
-// libpng reports errors by longjmp: every object with a destructor is created before setjmp.
-// libtiff's messages go to a per-file handler, never to stderr.
+// Files of a roughness map (maps/map_files.hpp, docs/maps.md "Files"): float TIFF and PNG
+// encoded in memory by io's codecs (src/io/tiff_codec.hpp, png_codec.hpp); colour maps and text
+// through OpenCV imgproc.
 #include "roughscope/maps/map_files.hpp"
 
 #include <algorithm>
 #include <cmath>
-#include <csetjmp>
-#include <cstdarg>
 #include <cstdio>
 #include <cstring>
 #include <limits>
@@ -16,10 +13,9 @@
 
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
-#include <png.h>
-#include <tiffio.h>
 
-#include "io/memory_image_writers.hpp"
+#include "io/png_codec.hpp"
+#include "io/tiff_codec.hpp"
 #include "roughscope/core/errors.hpp"
 #include "roughscope/core/text.hpp"
 #include "roughscope/maps/maps.hpp"
@@ -42,26 +38,16 @@ void check_layer(std::size_t size, std::size_t width, std::size_t height, std::s
 constexpr std::size_t kMaxTiffSide = std::size_t{1} << 31;
 constexpr std::size_t kMaxPngSide = 65535;
 
-// ---- PNG ------------------------------------------------------------------------------------
-
-using io::detail::PngMemoryWriter;
-using io::detail::TiffMemoryWriter;
+namespace codec = io::codec;
 
 // An 8-bit RGB cv::Mat (CV_8UC3, R G B order) as PNG.
 std::string encode_rgb_png(const cv::Mat& rgb) {
-    std::vector<png_bytep> rows(static_cast<std::size_t>(rgb.rows));
-    for (int r = 0; r < rgb.rows; ++r)
-        rows[static_cast<std::size_t>(r)] = const_cast<png_bytep>(rgb.ptr<png_byte>(r));
-    std::string out;
-    PngMemoryWriter w(out);
-    if (setjmp(png_jmpbuf(w.png())) != 0) throw Error(w.message());
-    png_set_IHDR(w.png(), w.info(), static_cast<png_uint_32>(rgb.cols),
-                 static_cast<png_uint_32>(rgb.rows), 8, PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE,
-                 PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
-    png_write_info(w.png(), w.info());
-    png_write_image(w.png(), rows.data());
-    png_write_end(w.png(), nullptr);
-    return out;
+    return codec::encode_png({rgb.data,
+                              static_cast<std::size_t>(rgb.cols),
+                              static_cast<std::size_t>(rgb.rows),
+                              3,
+                              {8, false},
+                              rgb.step[0]});
 }
 
 // ---- colours --------------------------------------------------------------------------------
@@ -135,25 +121,11 @@ std::array<std::uint8_t, 3> map_colour(float value, ColourRange range) {
 std::string encode_map_tiff_float(std::span<const float> layer, std::size_t width,
                                   std::size_t height) {
     check_layer(layer.size(), width, height, kMaxTiffSide - 1, "map tiff");
-    std::string out;
-    TiffMemoryWriter writer(out, "wl", "map tiff");
-    TIFF* tif = writer.get();
-    TIFFSetField(tif, TIFFTAG_IMAGEWIDTH, static_cast<std::uint32_t>(width));
-    TIFFSetField(tif, TIFFTAG_IMAGELENGTH, static_cast<std::uint32_t>(height));
-    TIFFSetField(tif, TIFFTAG_BITSPERSAMPLE, 32);
-    TIFFSetField(tif, TIFFTAG_SAMPLESPERPIXEL, 1);
-    TIFFSetField(tif, TIFFTAG_SAMPLEFORMAT, SAMPLEFORMAT_IEEEFP);
-    TIFFSetField(tif, TIFFTAG_PHOTOMETRIC, PHOTOMETRIC_MINISBLACK);
-    TIFFSetField(tif, TIFFTAG_PLANARCONFIG, PLANARCONFIG_CONTIG);
-    TIFFSetField(tif, TIFFTAG_COMPRESSION, COMPRESSION_NONE);
-    TIFFSetField(tif, TIFFTAG_ORIENTATION, ORIENTATION_TOPLEFT);
-    TIFFSetField(tif, TIFFTAG_ROWSPERSTRIP, TIFFDefaultStripSize(tif, 0));
-    TIFFSetField(tif, TIFFTAG_SOFTWARE, "roughscope map");
-    // The layer's rows as scanlines (libtiff does not modify an uncompressed buffer).
-    writer.write_rows(reinterpret_cast<const unsigned char*>(layer.data()), width * sizeof(float),
-                      height);
-    writer.finish();
-    return out;
+    codec::TiffEncodeOptions options;
+    options.mode = "wl";
+    options.orientation = true;
+    options.software = "roughscope map";
+    return codec::encode_tiff({layer.data(), width, height, 1, {32, true}, 0}, options, "map tiff");
 }
 
 std::string encode_npy(std::span<const float> layer, std::size_t width, std::size_t height) {

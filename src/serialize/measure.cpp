@@ -46,15 +46,16 @@ Json capture_json(const image::CaptureMeasurement& c) {
     out["phi_s_deg"] = degrees(c.spec.geometry.phi_s_rad);
     out["exposure_scale"] = number(c.exposure_scale);
     out["exposure_source"] = c.exposure_source;
-    out["format"] = c.info.format;
-    out["bits_per_sample"] = c.info.bits_per_sample;
-    out["response"] = std::string(to_string(c.info.response));
-    out["file_response"] =
-        c.info.file_response ? Json(std::string(to_string(*c.info.file_response))) : Json();
-    out["file_response_evidence"] = text_or_null(c.info.file_response_evidence);
-    out["exposure_s_metadata"] = number(c.info.exposure_s);
-    out["iso_metadata"] = number(c.info.iso);
-    out["f_number_metadata"] = number(c.info.f_number);
+    // The photograph's metadata: a few keys of its ImageInfo beside the capture (the metadata's
+    // exposure, ISO and f-number named apart from the capture file's), all of it under `info`.
+    const Json info = to_json(c.info);
+    for (const char* key :
+         {"format", "bits_per_sample", "response", "file_response", "file_response_evidence"})
+        out[key] = info[key];
+    out["exposure_s_metadata"] = info["exposure_s"];
+    out["iso_metadata"] = info["iso"];
+    out["f_number_metadata"] = info["f_number"];
+    out["info"] = info;
     if (c.spec.role == image::CaptureRole::Diffuse) {
         out["brightness"] = number(c.brightness);
         // 0: the region gives no noise (one pixel, no spread): unknown (image/measure.hpp).
@@ -110,6 +111,27 @@ Json profile_fit_json(const image::ProfileFit& f) {
 }
 
 }  // namespace
+
+Json to_json(const image::ImageInfo& info) {
+    Json out;
+    out["source"] = info.source;
+    out["format"] = info.format;
+    out["raw_format"] = text_or_null(info.raw_format);
+    out["bits_per_sample"] = info.bits_per_sample;
+    out["is_float"] = info.is_float;
+    out["white_level_dn"] = number(info.white_level_dn);
+    out["black_level_dn"] = numbers(info.black_level_dn);
+    out["response"] = std::string(to_string(info.response));
+    out["gamma"] = info.response == Response::Gamma ? number(info.gamma) : Json();
+    out["file_response"] =
+        info.file_response ? Json(std::string(to_string(*info.file_response))) : Json();
+    out["file_response_evidence"] = text_or_null(info.file_response_evidence);
+    out["exposure_s"] = number(info.exposure_s);
+    out["f_number"] = number(info.f_number);
+    out["iso"] = number(info.iso);
+    out["warnings"] = info.warnings;
+    return out;
+}
 
 Json to_json(const image::CylinderProfile& p) {
     Json out;

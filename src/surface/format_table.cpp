@@ -5,8 +5,9 @@
 // unit (m, mm, um, nm: the unit of the numbers in the file), title; and Gwyddion's "ASCII data
 // matrix" export header: `# Channel: <title>`, `# Width: <length> <unit>`, `# Height: <length>
 // <unit>`, `# Value units: <unit>`. What the file says wins over HeightReadOptions (the options
-// describe files that do not say it). Numbers go through the library's strict parser
-// (core/numbers.hpp); an empty cell or "NaN" is a missing point.
+// describe files that do not say it). Lines and cells come from io's text reader
+// (roughscope/io/csv.hpp), numbers from the library's strict parser (core/numbers.hpp); an empty
+// cell or "NaN" is a missing point.
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
@@ -20,6 +21,7 @@
 #include "roughscope/core/errors.hpp"
 #include "roughscope/core/numbers.hpp"
 #include "roughscope/core/text.hpp"
+#include "roughscope/io/csv.hpp"
 #include "roughscope/surface/formats.hpp"
 #include "tab_common.hpp"
 
@@ -46,23 +48,6 @@ struct Line {
     std::string_view text;
     std::size_t number = 0;  // 1-based
 };
-
-// Splits into lines (LF or CRLF), keeping 1-based numbers.
-std::vector<Line> split_lines(std::string_view bytes) {
-    std::vector<Line> lines;
-    std::size_t start = 0;
-    std::size_t number = 1;
-    while (start <= bytes.size()) {
-        std::size_t end = bytes.find('\n', start);
-        if (end == std::string_view::npos) end = bytes.size();
-        std::string_view text = bytes.substr(start, end - start);
-        if (!text.empty() && text.back() == '\r') text.remove_suffix(1);
-        lines.push_back({text, number});
-        ++number;
-        start = end + 1;
-    }
-    return lines;
-}
 
 std::size_t column_of(std::string_view line, std::string_view part) {
     return static_cast<std::size_t>(part.data() - line.data()) + 1;
@@ -136,31 +121,6 @@ void read_header_line(const std::string& name, const Line& line, std::string_vie
     }
 }
 
-// The cells of a data line: by `sep` (',' or ';'; cells may be empty) or, for sep == 0, by runs
-// of spaces and tabs.
-void split_cells(std::string_view text, char sep, std::vector<std::string_view>& cells) {
-    cells.clear();
-    if (sep != 0) {
-        std::size_t start = 0;
-        while (true) {
-            const std::size_t end = text.find(sep, start);
-            if (end == std::string_view::npos) {
-                cells.push_back(text.substr(start));
-                return;
-            }
-            cells.push_back(text.substr(start, end - start));
-            start = end + 1;
-        }
-    }
-    std::size_t i = 0;
-    while (i < text.size()) {
-        while (i < text.size() && (text[i] == ' ' || text[i] == '\t')) ++i;
-        const std::size_t start = i;
-        while (i < text.size() && text[i] != ' ' && text[i] != '\t') ++i;
-        if (i > start) cells.push_back(text.substr(start, i - start));
-    }
-}
-
 // A cell's value: a strict number, or NaN for an empty cell or "NaN" (only when allow_missing).
 double cell_value(const std::string& name, const Line& line, std::string_view cell,
                   bool allow_missing, std::string_view what) {
@@ -174,14 +134,18 @@ double cell_value(const std::string& name, const Line& line, std::string_view ce
     throw tab::error_at(name, line.number, column, message);
 }
 
-// Walks the lines: header comments into `header`, data lines (split into cells) to `on_row`.
+// Walks the lines (io::TextLines: the byte-order mark, line ends and NUL bytes as every text
+// reader takes them): header comments into `header`, data lines split into cells to `on_row` —
+// by `,` or `;` (cells may be empty) or by runs of white space, as the first data line shows.
 template <class OnRow>
 void walk(std::string_view bytes, const std::string& name, Header& header, OnRow&& on_row) {
-    bytes = tab::skip_utf8_bom(bytes);
+    io::TextLines lines(bytes, name);
     std::vector<std::string_view> cells;
     bool have_sep = false;
     char sep = 0;
-    for (const Line& line : split_lines(bytes)) {
+    std::string_view text;
+    while (lines.next(text)) {
+        const Line line{text, lines.line_number()};
         const std::string_view t = trim_space(line.text);
         if (t.empty()) continue;
         if (t.front() == '#') {
@@ -196,7 +160,10 @@ void walk(std::string_view bytes, const std::string& name, Header& header, OnRow
                 sep = ';';
             }
         }
-        split_cells(line.text, sep, cells);
+        if (sep != 0)
+            io::split_fields(line.text, sep, cells);
+        else
+            io::split_whitespace(line.text, cells);
         on_row(line, cells);
     }
 }

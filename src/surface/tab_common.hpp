@@ -52,13 +52,6 @@ inline HeightMap finish(HeightMap map, const std::string& name) {
     return map;
 }
 
-// The text after a UTF-8 byte-order mark at the start of a text file (docs/input-files.md: the
-// mark is skipped); the bytes unchanged when there is none.
-inline std::string_view skip_utf8_bom(std::string_view bytes) {
-    if (bytes.starts_with("\xEF\xBB\xBF")) bytes.remove_prefix(3);
-    return bytes;
-}
-
 // Throws DataError unless nx, ny >= 1 and nx·ny <= kMaxHeightMapPoints (checked before any
 // allocation, so a corrupt header cannot ask for terabytes).
 inline void check_grid_size(const std::string& name, std::size_t nx, std::size_t ny,

@@ -40,7 +40,6 @@ KNOWN_OVER = {
     "src/objects/cylinder.cpp",
     "src/objects/cylinder.cpp:measure_cylinder_profile",
     "src/objects/sphere.cpp:measure_sphere_table",
-    "src/photo/decode_raw.cpp:decode_raw",
 }
 
 INCLUDE_RE = re.compile(r'^\s*#\s*include\s*[<"](?:roughscope/)?([a-z_]+)/[a-z_0-9]+\.hpp[>"]', re.M)

@@ -12,6 +12,7 @@ ROUGHSCOPE_REQUIRE_SHARED_DATA=1.
 
 import json
 import math
+import pathlib
 import subprocess
 
 import numpy as np
@@ -203,3 +204,29 @@ def test_paper_tables_bad_reference_fails_in_both(paper_tables, tmp_path):
     assert proc.returncode == 4 and "missing key 'table2_very_rough'" in proc.stderr
     with pytest.raises(rs.DataError, match="missing key 'table2_very_rough'"):
         rs.recompute_paper_tables(broken)
+
+
+@pytest.mark.parametrize("index", [0, 1, 2], ids=["srgb8-png", "linear16-tiff", "dng"])
+def test_image_info_is_one_schema(tmp_path, index):
+    """A photograph's ImageInfo has one conversion (serialize/measure.hpp): the `info` of each
+    capture of `measure --json` and the `info` of Python's read_image are the same document for
+    the same image and options, and the capture's metadata keys repeat its values."""
+    from roughscope import _core, report_measure
+
+    spec = report_measure.DEMO_SAMPLES[index]
+    capture_file = report_measure.write_demo_sample(spec, tmp_path)
+    doc = json.loads(pathlib.Path(capture_file).read_text(encoding="utf-8"))
+    result = cli_json("measure", capture_file)
+    for spec_capture, capture in zip(doc["captures"], result["captures"]):
+        path = tmp_path / spec_capture["image"]
+        py = _core.read_image(str(path), response=doc["response"],
+                              black_level_dn=doc.get("black_level_dn"))["info"]
+        cli = dict(capture["info"])
+        assert set(cli) == set(py)
+        assert pathlib.Path(cli.pop("source")).name == pathlib.Path(py.pop("source")).name
+        assert_same(cli, py)
+        for key in ("format", "bits_per_sample", "response", "file_response",
+                    "file_response_evidence"):
+            assert capture[key] == py[key], key
+        for key in ("exposure_s", "iso", "f_number"):
+            assert capture[f"{key}_metadata"] == py[key], key

@@ -44,6 +44,31 @@ std::vector<std::string_view> split_fields(std::string_view line, char separator
 // The whitespace-separated words of `line` (empty for a blank line).
 std::vector<std::string_view> split_whitespace(std::string_view line);
 
+// The same into `out` (cleared first; its capacity is reused, for readers of many lines).
+void split_fields(std::string_view line, char separator, std::vector<std::string_view>& out);
+void split_whitespace(std::string_view line, std::vector<std::string_view>& out);
+
+// The lines of a text held in memory (a file's bytes), by LineReader's rules: a UTF-8
+// byte-order mark at the start is skipped, one trailing CR removed from each line, a NUL byte is
+// a DataError "<source>:<line>: not a text file: NUL byte at column C". The lines are views into
+// `text`, which must outlive the reader.
+class TextLines {
+  public:
+    TextLines(std::string_view text, std::string source);
+
+    // The next line (without its end); false at the end of the text.
+    bool next(std::string_view& line);
+
+    std::size_t line_number() const { return line_; }  // of the last line returned
+    const std::string& source() const { return source_; }
+
+  private:
+    std::string_view rest_;
+    bool done_ = false;
+    std::string source_;
+    std::size_t line_ = 0;
+};
+
 // Reads a text stream line by line: skips a UTF-8 byte-order mark at the start and removes one
 // trailing CR from each line. Counts lines from 1 for error messages.
 class LineReader {

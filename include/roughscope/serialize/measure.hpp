@@ -16,8 +16,8 @@ namespace roughscope::serialize {
 // `_stderr`; null where the captures do not give them), rms_slope, theta_K_deg, xi_K,
 // roughness_class, roughness_class_assumed —, then specular (per channel σ and the χ² of their
 // agreement), slope_gaussian, slope_exponential, correlation_length, fit (the estimates in full),
-// region, captures (per capture: file, geometry, exposure, response, region statistics, highlight)
-// and warnings.
+// region, captures (per capture: file, geometry, exposure, response, region statistics, highlight,
+// and the photograph's ImageInfo as `info`) and warnings.
 Json to_json(const image::MeasureResult& result, const image::MeasureRequest& request);
 
 // The text report of `roughscope measure` (without --json): "key  value" lines of the headline
@@ -26,6 +26,13 @@ Json to_json(const image::MeasureResult& result, const image::MeasureRequest& re
 // characters escaped. measure_text takes the document to_json returns.
 std::string to_text(const image::MeasureResult& result, const image::MeasureRequest& request);
 std::string measure_text(const Json& document);
+
+// A photograph's ImageInfo (photo/image.hpp; keys as its fields, docs/image.md "Metadata"):
+// source, format, raw_format, bits_per_sample, is_float, white_level_dn, black_level_dn,
+// response, gamma (null unless the response is gamma), file_response, file_response_evidence,
+// exposure_s, f_number, iso (null where the file does not record them) and warnings. The one
+// conversion: `info` of each capture in the measurement and of Python's read_image.
+Json to_json(const image::ImageInfo& info);
 
 // A cylinder's profile (§5.2, image/cylinder.hpp): axis, profile rows (theta_deg, brightness,
 // stderr, ...), the fitted sigma_over_T_gaussian / _exponential with _stderr, the models with

@@ -101,6 +101,16 @@ TEST(FormatCsv, ErrorsNameFileLineAndColumn) {
     expect_data_error([] { csv("# Width: 4.0\n1\n"); }, {"m.csv:1:", "<length> <unit>"});
     expect_data_error([] { csv("nan,NaN\n"); }, {"every point is missing"});
     expect_data_error([] { csv("1,inf\n"); }, {"m.csv:1:3", "'inf'"});
+    // A NUL byte: a binary file, as for every text reader (docs/input-files.md).
+    expect_data_error(
+        [] {
+            csv(
+                std::string("1,2\n3,\0"
+                            "4\n",
+                            9));
+        },
+        {"m.csv:2: not a text file: NUL byte at column 3"});
+    expect_data_error([] { xyz(std::string("0 0 1\n\0", 7)); }, {"p.xyz:2: not a text file"});
     HeightReadOptions bad;
     bad.length_unit = "inch";
     EXPECT_THROW(csv("1\n", bad), InvalidArgument);
