@@ -116,5 +116,4 @@ TEST(CylinderDeparture, TheFirstOfConsecutiveBinsBeyondKStandardErrors) {
     EXPECT_EQ(departure_bin(bins, prediction, 3.0, 3), 9U);
 }
 
-
 }  // namespace

@@ -54,7 +54,6 @@ Expected sums_by_definition(const LinearImage& img, const std::uint8_t* region,
     return e;
 }
 
-
 TEST(CylinderScan, SumsDoNotDependOnTheNumberOfThreads) {
     const CylinderAxis axis = cylinder_axis_from_line(250.0, 300.0, 0.2, 1.0, 150.0);
     const LinearImage img =
@@ -73,7 +72,6 @@ TEST(CylinderScan, SumsDoNotDependOnTheNumberOfThreads) {
         EXPECT_EQ(many.slice_sum, one.slice_sum);
     }
 }
-
 
 TEST(CylinderBins, StandardErrorOfAPixelIsTheNoiseOverTheRootOfItsCount) {
     const double R = 150.0, noise = 0.02;

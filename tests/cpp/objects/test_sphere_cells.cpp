@@ -102,5 +102,4 @@ TEST(SphereCells, ThePassUsesTheLitAndSeenPixelsOfTheDisc) {
         }
 }
 
-
 }  // namespace
