@@ -258,8 +258,8 @@ TEST(RatioInverseTable, LookUpsInAnyOrderFindTheirInterval) {
             // Beyond double's range, or within the last step of the nodes before it (the nodes
             // are where the model ratio is a finite double, NodesAreTheEstimationTopicsRatio).
             const RatioRange range = table.ratio_range();
-            if (!(ratio > 0.0) || !std::isfinite(ratio) ||
-                (ratio > range.upper && ratio > 1e300) || (ratio < range.lower && ratio < 1e-300))
+            if (!(ratio > 0.0) || !std::isfinite(ratio) || (ratio > range.upper && ratio > 1e300) ||
+                (ratio < range.lower && ratio < 1e-300))
                 continue;
             const auto v = table.lookup(std::log(ratio), hint);
             ASSERT_TRUE(v.has_value()) << s;
