@@ -112,6 +112,10 @@ std::size_t sample_step(std::size_t n) { return std::max<std::size_t>(1, n >> 18
 // (silhouette.hpp); sets s.otsu_threshold.
 double automatic_level(const LinearImage& image, std::vector<float> sample,
                        const SilhouetteOptions& options, Silhouette& s) {
+    // A non-finite value is refused, naming its sample, by the silhouette's pass over every
+    // value; here it is left out (its cast to 8 bits would be undefined).
+    std::erase_if(sample, [](float v) { return !std::isfinite(v); });
+    if (sample.empty()) return 0.0;
     const auto [lo_it, hi_it] = std::minmax_element(sample.begin(), sample.end());
     const double lo = *lo_it, hi = *hi_it;
     if (!(hi > lo))

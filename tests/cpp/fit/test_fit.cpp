@@ -25,7 +25,11 @@ constexpr double kLambda = 0.555;
 std::vector<rs::Geometry> random_geometries(int n, std::mt19937_64& rng) {
     std::uniform_real_distribution<double> th(0.0, deg_to_rad(70.0)), ph(0.0, 2.0 * rs::kPi);
     std::vector<rs::Geometry> g;
-    for (int i = 0; i < n; ++i) g.push_back(rs::make_geometry(th(rng), th(rng), ph(rng)));
+    for (int i = 0; i < n; ++i) {
+        // Drawn in a fixed order (the order of a call's arguments is the compiler's choice).
+        const double phi_s = ph(rng), theta_s = th(rng), theta_i = th(rng);
+        g.push_back(rs::make_geometry(theta_i, theta_s, phi_s));
+    }
     return g;
 }
 
