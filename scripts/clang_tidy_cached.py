@@ -21,7 +21,7 @@ the unchecked units are ordered — first those whose source, or header of the s
 in the last ROUGHSCOPE_TIDY_RECENT_COMMITS commits (default 30), then the rest in an order that
 rotates from day to day — and no unit is started once the budget is spent. The units left for a
 later run are listed; they stay unchecked (not cached), so the next run takes them up, and every
-unit is checked within a few runs. A warm cache leaves only what changed, well within budget.
+unit is checked within a few runs. A warm cache leaves only what changed, within budget.
 """
 import concurrent.futures
 import datetime
@@ -119,16 +119,15 @@ def priority_order(units: list[str], changed: set[str]) -> list[str]:
     return sorted(units, key=lambda u: (not touched(u, changed), rotation(u)))
 
 
-def run_with_budget(pool, build: str, todo: list[str], seconds: float | None, changed: set[str]):
-    """clang-tidy on the units in order; once `seconds` are spent (None: no budget) only the
-    recently changed units are still started."""
+def run_with_budget(pool, build: str, todo: list[str], seconds: float | None):
+    """clang-tidy on the units in order; none is started once `seconds` are spent (None: no
+    budget)."""
     start = time.monotonic()
     lock = threading.Lock()
     skipped: list[str] = []
 
     def job(unit: str):
-        if (seconds is not None and time.monotonic() - start > seconds
-                and not touched(unit, changed)):
+        if seconds is not None and time.monotonic() - start > seconds:
             with lock:
                 skipped.append(unit)
             return None
@@ -169,12 +168,11 @@ def main() -> int:
         print(f"lint: clang-tidy on {len(todo)} of {len(units)} translation units "
               f"({len(units) - len(todo)} unchanged since found clean"
               + (f"; time budget {seconds:.0f} s" if seconds is not None else "") + ")", flush=True)
-        results, deferred = run_with_budget(pool, build, todo, seconds, changed)
+        results, deferred = run_with_budget(pool, build, todo, seconds)
         todo = [u for u in todo if u in results]
         if deferred:
             root = str(Path.cwd()) + "/"
-            print(f"lint: time budget spent; {len(deferred)} units not changed by the recent commits "
-                  "left for a later run: " + " ".join(u.replace(root, "") for u in deferred), flush=True)
+            print(f"lint: time budget spent; {len(deferred)} units left for a later run: " + " ".join(u.replace(root, "") for u in deferred), flush=True)
 
     failed = []
     with open(log_path, "w", encoding="utf-8") as log:
