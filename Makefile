@@ -3,8 +3,11 @@
 # (scripts/install-deps; a quick no-op once they are there).
 
 BUILD      ?= build
+# One clang build with AddressSanitizer + UBSan and libFuzzer's coverage instrumentation serves
+# both `make sanitize` (the C++ and CLI tests) and `make fuzz` (the fuzz targets): the library is
+# compiled once for both.
 ASAN_BUILD ?= build-asan
-FUZZ_BUILD ?= build-fuzz
+FUZZ_BUILD ?= $(ASAN_BUILD)
 FUZZ_SECONDS ?= 30
 JOBS       ?= 2
 PYTHON     ?= /usr/bin/python3
@@ -35,27 +38,24 @@ CONFIGURE_FLAGS = -G Ninja $(LAUNCHER_FLAGS) \
 	-DROUGHSCOPE_WERROR=$(ROUGHSCOPE_WERROR) \
 	-DPython3_EXECUTABLE=$(PYTHON)
 
+# The sanitizer build (clang): every object instrumented with ASan + UBSan and libFuzzer's
+# coverage (-fsanitize=fuzzer-no-link: ROUGHSCOPE_BUILD_FUZZERS), asserts on; the tests, the CLI
+# and the libFuzzer executables of fuzz/ link the same library objects. -ffp-contract=off: clang
+# would otherwise fuse multiply-adds that GCC (ISO mode) does not, and the tests that compare a
+# vectorised path with its scalar definition bit for bit must see the same arithmetic. Warnings
+# are not errors here (clang-only warnings in code built with GCC and -Werror elsewhere).
 ASAN_CONFIGURE_FLAGS = -G Ninja $(LAUNCHER_FLAGS) \
+	-DCMAKE_CXX_COMPILER=clang++ \
 	-DCMAKE_BUILD_TYPE=RelWithDebInfo \
+	"-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -gline-tables-only" \
+	-DCMAKE_CXX_FLAGS=-ffp-contract=off \
+	-DROUGHSCOPE_BUILD_FUZZERS=ON \
 	-DROUGHSCOPE_BUILD_TESTS=ON \
 	-DROUGHSCOPE_BUILD_PYTHON=OFF \
 	-DROUGHSCOPE_BUILD_BENCH=OFF \
 	-DROUGHSCOPE_BUILD_CLI=ON \
-	-DROUGHSCOPE_SANITIZE=ON \
 	-DROUGHSCOPE_WERROR=OFF
-
-# libFuzzer build (clang): every object instrumented for coverage + ASan + UBSan, asserts on.
-# Warnings are not errors here (clang-only warnings in code built with GCC elsewhere).
-FUZZ_CONFIGURE_FLAGS = -G Ninja $(LAUNCHER_FLAGS) \
-	-DCMAKE_CXX_COMPILER=clang++ \
-	-DCMAKE_BUILD_TYPE=RelWithDebInfo \
-	"-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -gline-tables-only" \
-	-DROUGHSCOPE_BUILD_FUZZERS=ON \
-	-DROUGHSCOPE_BUILD_TESTS=OFF \
-	-DROUGHSCOPE_BUILD_PYTHON=OFF \
-	-DROUGHSCOPE_BUILD_BENCH=OFF \
-	-DROUGHSCOPE_BUILD_CLI=OFF \
-	-DROUGHSCOPE_WERROR=OFF
+FUZZ_CONFIGURE_FLAGS = $(ASAN_CONFIGURE_FLAGS)
 
 # Any sanitizer report ends the process with exit code 86, which no roughscope command uses.
 # For the CLI tests, ASan and LeakSanitizer reports also go to files, and tests/python/conftest.py
@@ -93,12 +93,11 @@ demo: configure
 		$(PYTHON) -m roughscope.report --out $(REPORT_DIR)
 	@echo "Report: $(REPORT_DIR)/index.html"
 
-# Under AddressSanitizer + UBSan: the C++ tests (ctest labels "cpp" and "fuzz": the fuzz
-# targets' corpus and regressions), then the CLI tests (pytest marker "cli", see DEVELOPERS.md)
-# against the instrumented executable, with the Python module of the release build $(BUILD)
-# (built here if missing) and ROUGHSCOPE_SANITIZED=1 (memory-measuring tests skip). Warnings are
-# not errors here: GCC's flow warnings give false positives under -fsanitize (the Release build
-# has -Werror).
+# Under AddressSanitizer + UBSan (the clang build $(ASAN_BUILD) above): the C++ tests (ctest
+# labels "cpp" and "fuzz": the libFuzzer executables replay their corpus and regressions), then
+# the CLI tests (pytest marker "cli", see DEVELOPERS.md) against the instrumented executable,
+# with the Python module of the release build $(BUILD) (built here if missing) and
+# ROUGHSCOPE_SANITIZED=1 (memory-measuring tests skip).
 sanitize: configure
 	$(CMAKE) --build $(BUILD) -j $(JOBS) --target _core roughscope_python_package
 	$(CMAKE) -S . -B $(ASAN_BUILD) $(ASAN_CONFIGURE_FLAGS)
@@ -110,11 +109,12 @@ sanitize: configure
 		ROUGHSCOPE_CLI=$(CURDIR)/$(ASAN_BUILD)/bin/roughscope PYTHONDONTWRITEBYTECODE=1 MPLBACKEND=Agg \
 		$(PYTHON) -m pytest -q -m cli -o cache_dir=$(CURDIR)/$(ASAN_BUILD)/.pytest_cache tests/python
 
-# libFuzzer: builds $(FUZZ_BUILD) with clang and runs every target of fuzz/ for FUZZ_SECONDS
-# each (fuzz/run: fixed seed, a copy of the seed corpus, fails on any crash or report).
+# libFuzzer: builds $(FUZZ_BUILD) (the sanitizer build: nothing to compile after `make sanitize`)
+# and runs every target of fuzz/ for FUZZ_SECONDS each (fuzz/run: fixed seed, a copy of the seed
+# corpus, fails on any crash or report).
 fuzz: deps
 	$(CMAKE) -S . -B $(FUZZ_BUILD) $(FUZZ_CONFIGURE_FLAGS)
-	$(CMAKE) --build $(FUZZ_BUILD) -j $(JOBS)
+	$(CMAKE) --build $(FUZZ_BUILD) -j $(JOBS) --target roughscope_fuzzers
 	FUZZ_SECONDS=$(FUZZ_SECONDS) fuzz/run $(FUZZ_BUILD)
 
 # clang-format check + clang-tidy (.clang-format, .clang-tidy) on the project's sources.
@@ -134,4 +134,4 @@ bench: build
 	fi
 
 clean:
-	rm -rf $(BUILD) $(ASAN_BUILD) $(FUZZ_BUILD) out
+	rm -rf $(BUILD) $(ASAN_BUILD) $(FUZZ_BUILD) build-fuzz out

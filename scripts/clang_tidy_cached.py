@@ -14,14 +14,26 @@ text it gives the same diagnostics. The key of a unit is the SHA-256 of
 A unit is checked unless its key is in the cache; a unit found clean adds its key. A unit with a
 diagnostic is never cached, so the log always lists every problem. The cache lives outside the
 clone, so a fresh clone on the same machine (CI) re-checks only what changed.
+
+Time budget (ROUGHSCOPE_TIDY_SECONDS, default: none). With an empty cache (a new machine) every
+unit is unchecked and clang-tidy on all of them takes longer than CI's budget. Given a budget,
+the unchecked units are ordered — first those whose source, or header of the same name, changed
+in the last ROUGHSCOPE_TIDY_RECENT_COMMITS commits (default 30), then the rest in an order that
+rotates from day to day — and no unit is started once the budget is spent. The units left for a
+later run are listed; they stay unchecked (not cached), so the next run takes them up, and every
+unit is checked within a few runs. A warm cache leaves only what changed, within budget.
 """
 import concurrent.futures
+import datetime
 import hashlib
 import json
 import os
 import shlex
 import subprocess
 import sys
+import threading
+import time
+import zlib
 from pathlib import Path
 
 EXTRA_ARGS = ["-extra-arg=-Wno-unknown-pragmas"]
@@ -80,6 +92,51 @@ def run_tidy(build: str, unit: str) -> tuple[int, str]:
     return result.returncode, result.stdout + result.stderr
 
 
+def recently_changed(commits: int) -> set[str]:
+    """Resolved paths of the files changed in the last `commits` commits (empty outside git)."""
+    result = subprocess.run(["git", "log", f"-{commits}", "--name-only", "--format="],
+                            capture_output=True, text=True, check=False)
+    if result.returncode != 0:
+        return set()
+    return {str(Path(line).resolve()) for line in result.stdout.splitlines() if line.strip()}
+
+
+def touched(unit: str, changed: set[str]) -> bool:
+    """The unit's source, or the public header of the same name, is among `changed`."""
+    path = Path(unit)
+    root = path.parents[1] if path.parent.parent.name in ("src",) else path.parents[0]
+    header = root.parent / "include" / "roughscope" / path.parent.name / (path.stem + ".hpp")
+    return unit in changed or str(header) in changed
+
+
+def priority_order(units: list[str], changed: set[str]) -> list[str]:
+    """Recently changed units first, then the others in an order that rotates daily."""
+    day = datetime.date.today().toordinal()
+
+    def rotation(unit: str) -> int:
+        return zlib.crc32(f"{day}:{Path(unit).name}".encode())
+
+    return sorted(units, key=lambda u: (not touched(u, changed), rotation(u)))
+
+
+def run_with_budget(pool, build: str, todo: list[str], seconds: float | None):
+    """clang-tidy on the units in order; none is started once `seconds` are spent (None: no
+    budget)."""
+    start = time.monotonic()
+    lock = threading.Lock()
+    skipped: list[str] = []
+
+    def job(unit: str):
+        if seconds is not None and time.monotonic() - start > seconds:
+            with lock:
+                skipped.append(unit)
+            return None
+        return run_tidy(build, unit)
+
+    results = {u: r for u, r in zip(todo, pool.map(job, todo)) if r is not None}
+    return results, [u for u in todo if u in skipped]
+
+
 def main() -> int:
     build, log_path, units = sys.argv[1], sys.argv[2], [str(Path(u).resolve()) for u in sys.argv[3:]]
     jobs = int(os.environ.get("JOBS", "2"))
@@ -101,9 +158,21 @@ def main() -> int:
         keys = dict(zip(units, pool.map(
             lambda u: unit_key(database[u], common) if cache is not None else None, units)))
         todo = [u for u in units if keys[u] is None or not (cache / keys[u]).exists()]
+        budget = os.environ.get("ROUGHSCOPE_TIDY_SECONDS")
+        seconds = float(budget) if budget else None
+        changed: set[str] = set()
+        if seconds is not None:
+            recent = int(os.environ.get("ROUGHSCOPE_TIDY_RECENT_COMMITS", "30"))
+            changed = recently_changed(recent)
+            todo = priority_order(todo, changed)
         print(f"lint: clang-tidy on {len(todo)} of {len(units)} translation units "
-              f"({len(units) - len(todo)} unchanged since found clean)", flush=True)
-        results = dict(zip(todo, pool.map(lambda u: run_tidy(build, u), todo)))
+              f"({len(units) - len(todo)} unchanged since found clean"
+              + (f"; time budget {seconds:.0f} s" if seconds is not None else "") + ")", flush=True)
+        results, deferred = run_with_budget(pool, build, todo, seconds)
+        todo = [u for u in todo if u in results]
+        if deferred:
+            root = str(Path.cwd()) + "/"
+            print(f"lint: time budget spent; {len(deferred)} units left for a later run: " + " ".join(u.replace(root, "") for u in deferred), flush=True)
 
     failed = []
     with open(log_path, "w", encoding="utf-8") as log:
