@@ -572,17 +572,13 @@ TwoPointEstimate two_point_estimate(const BrdfTable& table, const std::vector<bo
     }
     t.available = true;
     t.E1_over_E2 = *t.E1 / *t.E2;
-    try {
-        t.sigma_over_T_gaussian = sigma_over_T_gaussian_from_ratio(
-            *t.E1_over_E2, t.theta1_rad, t.theta2_rad, GeometricFactor::VernoldHarvey);
-    } catch (const Error& e) {
-        t.gaussian_reason = e.what();
-    }
-    try {
-        t.sigma_over_T_exponential = sigma_over_T_exponential_from_ratio(
-            *t.E1_over_E2, t.theta1_rad, t.theta2_rad, GeometricFactor::VernoldHarvey);
-    } catch (const Error& e) {
-        t.exponential_reason = e.what();
+    for (const Correlation c : kCorrelations) {
+        try {  // Eq. 17 / Eq. 19
+            t.sigma_over_T(c) = sigma_over_T_from_ratio(
+                c, *t.E1_over_E2, t.theta1_rad, t.theta2_rad, GeometricFactor::VernoldHarvey);
+        } catch (const Error& e) {
+            t.correlation_reason(c) = e.what();
+        }
     }
     return t;
 }
@@ -951,21 +947,19 @@ Comparison compare(const BrdfTable& table, const ComparisonOptions& o, BrdfTable
     };
     auto two_point_model = [&](const VeryRoughVariant& v) {
         ModelResult& r = result(v.model);
-        const bool gaussian = v.correlation == Correlation::Gaussian;
-        const std::optional<double> sigma_over_T =
-            gaussian ? c.two_point.sigma_over_T_gaussian : c.two_point.sigma_over_T_exponential;
+        const CorrelationInfo& ci = info(v.correlation);
+        const std::optional<double> sigma_over_T = c.two_point.sigma_over_T(v.correlation);
         if (!sigma_over_T) {
             r.reason = "two-point estimate unavailable: " +
                        (!c.two_point.available ? c.two_point.reason
-                                               : (gaussian ? c.two_point.gaussian_reason
-                                                           : c.two_point.exponential_reason));
+                                               : c.two_point.correlation_reason(v.correlation));
             return;
         }
         r.available = true;
         r.method = std::string("two-point estimate of sigma/T (") +
-                   (gaussian ? "Eq. 17" : "Eq. 19") + ", F_VH, measurements " +
+                   std::string(ci.inverse_equation) + ", F_VH, measurements " +
                    std::to_string(o.measurement1) + " and " + std::to_string(o.measurement2) +
-                   "); " + (gaussian ? "Eq. 4" : "Eq. 5") + " with " +
+                   "); " + std::string(ci.very_rough_equation) + " with " +
                    (v.factor == GeometricFactor::Beckmann ? "F_Beck" : "F_VH") + ", " +
                    std::string(to_string(o.radiometry));
         r.parameters = {{"sigma_over_T", *sigma_over_T, std::nullopt, true}};
@@ -984,7 +978,7 @@ Comparison compare(const BrdfTable& table, const ComparisonOptions& o, BrdfTable
             if (v.factor != factor) continue;
             ModelResult& r = result(v.fit);
             r.method = std::string("least squares over sigma/T and the gain; ") +
-                       (v.correlation == Correlation::Gaussian ? "Eq. 4" : "Eq. 5") + " with " +
+                       std::string(info(v.correlation).very_rough_equation) + " with " +
                        (v.factor == GeometricFactor::Beckmann ? "F_Beck" : "F_VH") + ", " +
                        std::string(to_string(o.radiometry));
             fit_very_rough(p, r, v.factor, v.correlation, o.fit_sigma_over_T_min,

@@ -271,6 +271,8 @@ template <Correlation C, GeometricFactor F, Radiometry R, AngleUnit U, VectorIsa
     constexpr double kRound = 0x1.8p52;  // (x + kRound) − kRound = nearest integer, |x| < 2^51
     // km = 1/(4 m²) (Gaussian) or 1/m² (exponential), m = σ/T.
     constexpr double kM = C == Correlation::Gaussian ? 0.25 : 1.0;
+    static_assert(C == Correlation::Gaussian || C == Correlation::Exponential,
+                  "a new correlation function needs its vector form (pref, arg, MathFn) here");
     alignas(64) double km[kBlock], pref[kBlock], arg[kBlock], aux[kBlock];
     alignas(64) double scalar_ti[kBlock], scalar_ts[kBlock], scalar_p[kBlock], wide_p[kBlock];
     // Operands repeated over the result (step 0) are read from a block filled once.
@@ -426,11 +428,16 @@ template <AngleUnit U>
 Kernel pick_model(const BrightnessBatchModel& m, VectorIsa isa) {
     using enum Correlation;
     using enum Radiometry;
-    if (m.correlation == Gaussian)
-        return m.radiometry == Radiance ? pick_factor<Gaussian, Radiance, U>(m.factor, isa)
-                                        : pick_factor<Gaussian, Intensity, U>(m.factor, isa);
-    return m.radiometry == Radiance ? pick_factor<Exponential, Radiance, U>(m.factor, isa)
-                                    : pick_factor<Exponential, Intensity, U>(m.factor, isa);
+    // One kernel per correlation function (each has its own vector form above).
+    switch (m.correlation) {
+        case Gaussian:
+            return m.radiometry == Radiance ? pick_factor<Gaussian, Radiance, U>(m.factor, isa)
+                                            : pick_factor<Gaussian, Intensity, U>(m.factor, isa);
+        case Exponential:
+            return m.radiometry == Radiance ? pick_factor<Exponential, Radiance, U>(m.factor, isa)
+                                            : pick_factor<Exponential, Intensity, U>(m.factor, isa);
+    }
+    return nullptr;
 }
 
 Kernel pick_kernel(const BrightnessBatchModel& m, AngleUnit unit, VectorIsa isa) {
@@ -484,6 +491,10 @@ void very_rough_brightness_batch(const BrightnessBatchInput& in, std::span<doubl
                         in.phi_s.data(),        step_of(in.phi_s, n, "phi_s"),
                         in.sigma_over_T.data(), step_of(in.sigma_over_T, n, "sigma_over_T")};
     const Kernel kernel = pick_kernel(model, in.unit, active_vector_isa());
+    if (kernel == nullptr)
+        throw InvalidArgument("very_rough_brightness_batch: correlation " +
+                              std::to_string(static_cast<int>(model.correlation)) +
+                              " or geometric factor is not defined");
     Index bad_at = static_cast<Index>(begin);
     try {
         kernel(inputs, static_cast<Index>(begin), static_cast<Index>(end), out.data(), bad_at);

@@ -99,8 +99,8 @@ Json to_json(const StatisticsInput& input, const surface::SurfaceStatistics& s, 
     j["T_um"] = number(s.T_um);
     j["T_y_um"] = number(s.T_y_um);
     j["T_stderr_um"] = number(s.T_stderr_um);
-    j["T_fit_gaussian_um"] = number(s.T_fit_gaussian_um);
-    j["T_fit_exponential_um"] = number(s.T_fit_exponential_um);
+    for (const Correlation c : kCorrelations)
+        j["T_fit_" + std::string(info(c).name) + "_um"] = number(s.T_fit_um(c));
     j["correlation"] = s.correlation ? Json(std::string(to_string(*s.correlation))) : Json(nullptr);
     j["T_extrapolated_um"] = number(s.T_extrapolated_um);
     j["period_um"] = number(s.period_um);
