@@ -1,11 +1,13 @@
 // JSON schemas of the §4 estimates and the fits (serialize/estimation.hpp).
 #include "roughscope/serialize/estimation.hpp"
 
+#include <algorithm>
 #include <string>
 #include <vector>
 
 #include "options.hpp"
 #include "roughscope/core/errors.hpp"
+#include "roughscope/scattering/correlation.hpp"
 #include "roughscope/scattering/geometry.hpp"
 #include "roughscope/scattering/validity.hpp"
 
@@ -253,7 +255,10 @@ Json to_json(const CorrelationComparison& c, bool with_residuals) {
     PerCorrelation<Json> fits;
     for (const Correlation k : kCorrelations) fits[k] = to_json(c[k], with_residuals);
     const Json& jb = fits[c.preferred];
-    const Json& jg = fits[Correlation::Gaussian];
+    // Caron's θK, ξK, m come from the first correlation they are derived for (Gaussian, §3.5).
+    const Correlation caron = *std::find_if(kCorrelations.begin(), kCorrelations.end(),
+                                            [](Correlation k) { return info(k).caron_formulas; });
+    const Json& jg = fits[caron];
     Json out;
     out["preferred_correlation"] = std::string(to_string(c.preferred));
     out["delta_aic"] = number(c.delta_aic);
@@ -264,7 +269,6 @@ Json to_json(const CorrelationComparison& c, bool with_residuals) {
     }
     if (c[c.preferred].options.model == FitModel::SlightlyRough)
         for (const char* k : {"sigma_um", "sigma_um_stderr", "T_um", "T_um_stderr"}) out[k] = jb[k];
-    // Caron's θK, ξK, m from the Gaussian fit (they are Gaussian-correlation quantities, §3.5).
     for (const char* k : {"theta_K_deg", "theta_K_deg_stderr", "xi_K", "xi_K_stderr", "rms_slope",
                           "rms_slope_stderr", "roughness_class", "roughness_class_assumed", "g"})
         out[k] = jg[k];
