@@ -5,7 +5,7 @@
 //   build*/bin/roughscope_bench --benchmark_filter='very_rough|lambert'
 //
 // Names: series/<kind>/g=<g>            careful sum, one evaluation per iteration
-//        naive/<kind>/g=<g>             the same sum by gaussian_series_sum_naive with
+//        naive/<kind>/g=<g>             the same sum by diffuse_series_sum_naive with
 //                                       g + 10√g + 20 terms; only for g ≤ 700 (beyond, Σ gⁿ/n!
 //                                       overflows and e^{−g} underflows: the series benchmark is
 //                                       labelled "naive overflows" there)
@@ -50,8 +50,8 @@ void BM_series(benchmark::State& state, bool gaussian, double g) {
     std::size_t i = 0;
     for (auto _ : state) {
         const double x = Xs[i++ & 1];
-        benchmark::DoNotOptimize(gaussian ? gaussian_series_sum(g, x)
-                                          : exponential_series_sum(g, x));
+        benchmark::DoNotOptimize(
+            diffuse_series_sum(gaussian ? Correlation::Gaussian : Correlation::Exponential, g, x));
     }
     state.SetItemsProcessed(state.iterations());
     if (g > kNaiveMaxG) state.SetLabel("naive overflows");
@@ -64,8 +64,8 @@ void BM_naive(benchmark::State& state, bool gaussian, double g) {
     std::size_t i = 0;
     for (auto _ : state) {
         const double x = Xs[i++ & 1];
-        benchmark::DoNotOptimize(gaussian ? gaussian_series_sum_naive(g, x, terms)
-                                          : exponential_series_sum_naive(g, x, terms));
+        benchmark::DoNotOptimize(diffuse_series_sum_naive(
+            gaussian ? Correlation::Gaussian : Correlation::Exponential, g, x, terms));
     }
     state.SetItemsProcessed(state.iterations());
     state.counters["terms"] = terms;
@@ -144,8 +144,8 @@ void BM_very_rough_shape(benchmark::State& state) {
         for (const Geometry& g : geoms) {
             const ScatteringDirection q = scattering_direction(g);
             const double F2 = geometric_factor_squared(GeometricFactor::VernoldHarvey, g);
-            sum += kGaussian ? very_rough_shape_gaussian(F2, q, kSigmaOverT)
-                             : very_rough_shape_exponential(F2, q, kSigmaOverT);
+            sum += very_rough_shape(kGaussian ? Correlation::Gaussian : Correlation::Exponential,
+                                    F2, q, kSigmaOverT);
         }
         benchmark::DoNotOptimize(sum);
     }

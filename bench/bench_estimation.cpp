@@ -37,7 +37,8 @@ void BM_Eq17_GaussianClosedForm(benchmark::State& state) {
     const auto r = ratios();
     std::size_t i = 0;
     for (auto _ : state) {
-        benchmark::DoNotOptimize(rs::sigma_over_T_gaussian_from_ratio(r[i++ & 63], kT1, kT2));
+        benchmark::DoNotOptimize(
+            rs::sigma_over_T_from_ratio(rs::Correlation::Gaussian, r[i++ & 63], kT1, kT2));
     }
 }
 BENCHMARK(BM_Eq17_GaussianClosedForm);
@@ -46,7 +47,8 @@ void BM_Eq19_ExponentialClosedForm(benchmark::State& state) {
     const auto r = ratios();
     std::size_t i = 0;
     for (auto _ : state) {
-        benchmark::DoNotOptimize(rs::sigma_over_T_exponential_from_ratio(r[i++ & 63], kT1, kT2));
+        benchmark::DoNotOptimize(
+            rs::sigma_over_T_from_ratio(rs::Correlation::Exponential, r[i++ & 63], kT1, kT2));
     }
 }
 BENCHMARK(BM_Eq19_ExponentialClosedForm);

@@ -824,21 +824,19 @@ constexpr VeryRoughVariant kVeryRoughVariants[] = {
 void very_rough_at_two_point(const Prepared& p, Comparison& c, const ComparisonOptions& o,
                              const VeryRoughVariant& v) {
     ModelResult& r = result_of(c, v.model);
-    const bool gaussian = v.correlation == Correlation::Gaussian;
-    const std::optional<double> sigma_over_T =
-        gaussian ? c.two_point.sigma_over_T_gaussian : c.two_point.sigma_over_T_exponential;
+    const CorrelationInfo& ci = info(v.correlation);
+    const std::optional<double> sigma_over_T = c.two_point.sigma_over_T(v.correlation);
     if (!sigma_over_T) {
         r.reason = "two-point estimate unavailable: " +
                    (!c.two_point.available ? c.two_point.reason
-                                           : (gaussian ? c.two_point.gaussian_reason
-                                                       : c.two_point.exponential_reason));
+                                           : c.two_point.correlation_reason(v.correlation));
         return;
     }
     r.available = true;
-    r.method = std::string("two-point estimate of sigma/T (") + (gaussian ? "Eq. 17" : "Eq. 19") +
+    r.method = std::string("two-point estimate of sigma/T (") + std::string(ci.inverse_equation) +
                ", F_VH, measurements " + std::to_string(o.measurement1) + " and " +
-               std::to_string(o.measurement2) + "); " + (gaussian ? "Eq. 4" : "Eq. 5") + " with " +
-               (v.factor == GeometricFactor::Beckmann ? "F_Beck" : "F_VH") + ", " +
+               std::to_string(o.measurement2) + "); " + std::string(ci.very_rough_equation) +
+               " with " + (v.factor == GeometricFactor::Beckmann ? "F_Beck" : "F_VH") + ", " +
                std::string(to_string(o.radiometry));
     r.parameters = {{"sigma_over_T", *sigma_over_T, std::nullopt, true}};
     r.evaluations = 1;
@@ -858,7 +856,7 @@ void compare_very_rough(Prepared& p, Comparison& c, const ComparisonOptions& o) 
             if (v.factor != factor) continue;
             ModelResult& r = result_of(c, v.fit);
             r.method = std::string("least squares over sigma/T and the gain; ") +
-                       (v.correlation == Correlation::Gaussian ? "Eq. 4" : "Eq. 5") + " with " +
+                       std::string(info(v.correlation).very_rough_equation) + " with " +
                        (v.factor == GeometricFactor::Beckmann ? "F_Beck" : "F_VH") + ", " +
                        std::string(to_string(o.radiometry));
             fit_very_rough(p, r, v.factor, v.correlation, o.fit_sigma_over_T_min,

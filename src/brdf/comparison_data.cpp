@@ -124,17 +124,13 @@ TwoPointEstimate two_point_estimate(const BrdfTable& table, const std::vector<bo
     }
     t.available = true;
     t.E1_over_E2 = *t.E1 / *t.E2;
-    try {
-        t.sigma_over_T_gaussian = sigma_over_T_gaussian_from_ratio(
-            *t.E1_over_E2, t.theta1_rad, t.theta2_rad, GeometricFactor::VernoldHarvey);
-    } catch (const Error& e) {
-        t.gaussian_reason = e.what();
-    }
-    try {
-        t.sigma_over_T_exponential = sigma_over_T_exponential_from_ratio(
-            *t.E1_over_E2, t.theta1_rad, t.theta2_rad, GeometricFactor::VernoldHarvey);
-    } catch (const Error& e) {
-        t.exponential_reason = e.what();
+    for (const Correlation c : kCorrelations) {
+        try {  // Eq. 17 / Eq. 19
+            t.sigma_over_T(c) = sigma_over_T_from_ratio(
+                c, *t.E1_over_E2, t.theta1_rad, t.theta2_rad, GeometricFactor::VernoldHarvey);
+        } catch (const Error& e) {
+            t.correlation_reason(c) = e.what();
+        }
     }
     return t;
 }

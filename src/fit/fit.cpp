@@ -7,6 +7,7 @@
 #include <cmath>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <span>
 #include <string>
 
@@ -262,9 +263,7 @@ LeastSquaresOptions engine_options(const FitOptions& o) {
     return e;
 }
 
-std::string correlation_label(Correlation c) {
-    return c == Correlation::Gaussian ? "Gaussian" : "exponential";
-}
+std::string correlation_label(Correlation c) { return std::string(info(c).adjective); }
 
 }  // namespace
 
@@ -399,23 +398,30 @@ CorrelationComparison compare_correlations(const std::vector<Measurement>& measu
                                            const FitOptions& options) {
     CorrelationComparison c;
     FitOptions o = options;
-    o.correlation = Correlation::Gaussian;
-    c.gaussian = fit_roughness(measurements, o);
-    o.correlation = Correlation::Exponential;
-    c.exponential = fit_roughness(measurements, o);
-    // AIC ranks fits that determine their parameters; an unidentifiable fit never wins, and the
-    // difference is unknown (NaN) unless both are identifiable.
-    const bool g_ok = c.gaussian.status != SolverStatus::NotIdentifiable;
-    const bool e_ok = c.exponential.status != SolverStatus::NotIdentifiable;
-    if (g_ok != e_ok) {
-        c.preferred = g_ok ? Correlation::Gaussian : Correlation::Exponential;
-        c.delta_aic = std::numeric_limits<double>::quiet_NaN();
-        return c;
+    for (const Correlation k : kCorrelations) {
+        o.correlation = k;
+        c[k] = fit_roughness(measurements, o);
     }
-    c.preferred =
-        c.gaussian.aic <= c.exponential.aic ? Correlation::Gaussian : Correlation::Exponential;
-    c.delta_aic = g_ok ? std::abs(c.gaussian.aic - c.exponential.aic)
-                       : std::numeric_limits<double>::quiet_NaN();
+    // AIC ranks fits that determine their parameters; an unidentifiable fit never wins, and the
+    // difference is unknown (NaN) unless all are identifiable.
+    const auto identifiable = [&](Correlation k) {
+        return c[k].status != SolverStatus::NotIdentifiable;
+    };
+    const bool any_ok = std::any_of(kCorrelations.begin(), kCorrelations.end(), identifiable);
+    const bool all_ok = std::all_of(kCorrelations.begin(), kCorrelations.end(), identifiable);
+    std::optional<Correlation> best;
+    for (const Correlation k : kCorrelations) {
+        if (any_ok && !identifiable(k)) continue;
+        if (!best || !(c[*best].aic <= c[k].aic)) best = k;
+    }
+    c.preferred = *best;
+    c.delta_aic = std::numeric_limits<double>::quiet_NaN();
+    if (all_ok) {
+        c.delta_aic = std::numeric_limits<double>::infinity();
+        for (const Correlation k : kCorrelations)
+            if (k != c.preferred)
+                c.delta_aic = std::min(c.delta_aic, std::abs(c[k].aic - c[c.preferred].aic));
+    }
     return c;
 }
 

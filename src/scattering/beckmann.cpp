@@ -14,10 +14,15 @@
 namespace roughscope {
 namespace {
 
-constexpr std::array<NameEntry<Correlation>, 2> kCorrelationNames{{
-    {"gaussian", Correlation::Gaussian},
-    {"exponential", Correlation::Exponential},
-}};
+// The names of the correlation descriptor (correlation.hpp), in the table scheme of names.hpp.
+constexpr std::array<NameEntry<Correlation>, kCorrelationCount> correlation_names() {
+    std::array<NameEntry<Correlation>, kCorrelationCount> names{};
+    for (std::size_t k = 0; k < kCorrelationCount; ++k)
+        names[k] = {kCorrelationInfo[k].name, kCorrelationInfo[k].correlation};
+    return names;
+}
+constexpr std::array<NameEntry<Correlation>, kCorrelationCount> kCorrelationNames =
+    correlation_names();
 
 constexpr std::array<NameEntry<Regime>, 5> kRegimeNames{{
     {"auto", Regime::Auto},
@@ -26,12 +31,6 @@ constexpr std::array<NameEntry<Regime>, 5> kRegimeNames{{
     {"very_rough", Regime::VeryRough},
     {"very_rough_series_limit", Regime::VeryRoughSeriesLimit},
 }};
-
-// Relative size of the second series term against the first (bounds all omitted terms).
-double second_term_ratio(Correlation c, double g, double T2_vxy2) {
-    if (c == Correlation::Gaussian) return g / 4.0 * std::exp(T2_vxy2 / 8.0);  // (g/4) e^{a/2}
-    return g * std::pow((1.0 + T2_vxy2) / (4.0 + T2_vxy2), 1.5);
-}
 
 }  // namespace
 
@@ -98,27 +97,23 @@ ScatteredPower mean_scattered_power(const Geometry& geom, const Surface& surface
     }
 
     double D = 0.0;
-    const bool gaussian = surface.correlation == Correlation::Gaussian;
+    const Correlation c = surface.correlation;
     switch (regime) {
         case Regime::Series: {
-            const SeriesResult sum =
-                gaussian ? gaussian_series(g, T * T * vxy2) : exponential_series(g, T * T * vxy2);
-            D = (gaussian ? kPi : 2.0 * kPi) * T * T / area * F2 * sum.value;
+            const SeriesResult sum = diffuse_series(c, g, T * T * vxy2);
+            D = info(c).diffuse_prefactor * T * T / area * F2 * sum.value;
             out.method = sum.method;
             out.relative_error_bound = sum.relative_error_bound;
             break;
         }
         case Regime::SlightlyRough:
-            D = gaussian ? diffuse_power_slightly_rough_gaussian(F2, T, area, g, vxy2)
-                         : diffuse_power_slightly_rough_exponential(F2, T, area, g, vxy2);
+            D = diffuse_power_slightly_rough(c, F2, T, area, g, vxy2);
             break;
         case Regime::VeryRough:
-            D = gaussian ? diffuse_power_very_rough_gaussian(F2, sigma, T, area, vz2, vxy2)
-                         : diffuse_power_very_rough_exponential(F2, sigma, T, area, vz2, vxy2);
+            D = diffuse_power_very_rough(c, F2, sigma, T, area, vz2, vxy2);
             break;
         case Regime::VeryRoughSeriesLimit:
-            D = gaussian ? diffuse_power_very_rough_gaussian(F2, sigma, T, area, vz2, vxy2)
-                         : diffuse_power_very_rough_exponential_series_limit(F2, T, area, g, vxy2);
+            D = diffuse_power_very_rough_series_limit(c, F2, sigma, T, area, g, vz2, vxy2);
             break;
         case Regime::Auto:
             break;  // resolved above
@@ -160,9 +155,7 @@ double very_rough_brightness(const Geometry& geom, double sigma_over_T, Correlat
     check::positive("sigma_over_T", sigma_over_T);
     const ScatteringDirection q = scattering_direction(geom);
     const double F2 = geometric_factor_squared(factor, geom);
-    const double shape = correlation == Correlation::Gaussian
-                             ? very_rough_shape_gaussian(F2, q, sigma_over_T)
-                             : very_rough_shape_exponential(F2, q, sigma_over_T);
+    const double shape = very_rough_shape(correlation, F2, q, sigma_over_T);
     return shape * radiometric_factor(radiometry, geom);
 }
 
@@ -193,8 +186,7 @@ double diffuse_power_quadrature(Correlation correlation, double F2, double T_um,
                               " um^2) is outside the domain of diffuse_power_quadrature: it "
                               "must be a finite number");
     if (g == 0.0 || scale == 0.0) return 0.0;
-    const bool gaussian = correlation == Correlation::Gaussian;
-    auto C = [gaussian](double u) { return gaussian ? std::exp(-u * u) : std::exp(-u); };
+    auto C = [correlation](double u) { return acf(correlation, u); };
     // log of the envelope e^{−g}(exp(g C(u)) − 1), without overflow or 0·inf for any g.
     auto log_envelope = [g](double c) {
         const double x = g * c;
@@ -218,7 +210,7 @@ double diffuse_power_quadrature(Correlation correlation, double F2, double T_um,
     }
     std::vector<double> cuts{0.0};
     // Geometric breakpoints resolve the peak of width ~1/g (exp.) or 1/√g (Gauss.) at u = 0.
-    const double width = gaussian ? 1.0 / std::sqrt(std::max(g, 1.0)) : 1.0 / std::max(g, 1.0);
+    const double width = diffuse_kernel_width_over_T(correlation, g);
     for (double u = width / 8.0; u < u_max; u *= 2.0) cuts.push_back(u);
     // Half-periods of J0 (at most kQuadratureMaxTvxy · u_max / π of them).
     if (w > 0.0)

@@ -277,6 +277,8 @@ template <Correlation C, GeometricFactor F, Radiometry R, AngleUnit U>
     constexpr double kRound = 0x1.8p52;  // (x + kRound) − kRound = nearest integer, |x| < 2^51
     // km = 1/(4 m²) (Gaussian) or 1/m² (exponential), m = σ/T.
     constexpr double kM = C == Correlation::Gaussian ? 0.25 : 1.0;
+    static_assert(C == Correlation::Gaussian || C == Correlation::Exponential,
+                  "a new correlation function needs its vector form (pref, arg, MathFn) here");
     alignas(64) double km[kBlock], pref[kBlock], arg[kBlock], aux[kBlock];
     alignas(64) double scalar_ti[kBlock], scalar_ts[kBlock], scalar_p[kBlock], wide_p[kBlock];
     // Operands repeated over the result (step 0) are read from a block filled once.
@@ -406,14 +408,18 @@ template <AngleUnit U>
                                              VectorIsa math) {
     using enum Correlation;
     using enum Radiometry;
-    if (m.correlation == Gaussian) {
-        if (m.radiometry == Radiance)
-            return run_factor<Gaussian, Radiance, U>(m.factor, in, begin, end, out, at, math);
-        return run_factor<Gaussian, Intensity, U>(m.factor, in, begin, end, out, at, math);
+    // One kernel per correlation function (each has its own vector form above).
+    switch (m.correlation) {
+        case Gaussian:
+            if (m.radiometry == Radiance)
+                return run_factor<Gaussian, Radiance, U>(m.factor, in, begin, end, out, at, math);
+            return run_factor<Gaussian, Intensity, U>(m.factor, in, begin, end, out, at, math);
+        case Exponential:
+            if (m.radiometry == Radiance)
+                return run_factor<Exponential, Radiance, U>(m.factor, in, begin, end, out, at,
+                                                            math);
+            return run_factor<Exponential, Intensity, U>(m.factor, in, begin, end, out, at, math);
     }
-    if (m.radiometry == Radiance)
-        return run_factor<Exponential, Radiance, U>(m.factor, in, begin, end, out, at, math);
-    return run_factor<Exponential, Intensity, U>(m.factor, in, begin, end, out, at, math);
 }
 
 [[gnu::always_inline]] inline void run_kernel(const BrightnessBatchModel& m, AngleUnit unit,

@@ -35,16 +35,8 @@ void VeryRoughTerms::brightness(double sigma_over_T, Correlation correlation,
     check::positive("sigma_over_T", sigma_over_T);
     assert(out.size() == size());
     const double m2 = sigma_over_T * sigma_over_T;
-    const std::size_t n = size();
-    if (correlation == Correlation::Gaussian) {
-        const double c = 1.0 / (4.0 * m2);
-        for (std::size_t k = 0; k < n; ++k) out[k] = a_[k] * std::exp(-b_[k] * c);  // Eq. 4
-    } else {
-        for (std::size_t k = 0; k < n; ++k) {
-            const double w = 1.0 + b_[k] / m2;
-            out[k] = a_[k] / (w * std::sqrt(w));  // Eq. 5
-        }
-    }
+    for (std::size_t k = 0; k < size(); ++k)
+        out[k] = a_[k] * very_rough_profile(correlation, b_[k] / m2);  // Eq. 4 / Eq. 5
 }
 
 void VeryRoughTerms::brightness_and_log_derivative(
@@ -54,9 +46,8 @@ void VeryRoughTerms::brightness_and_log_derivative(
     assert(d_out_d_ln_sigma_over_T.size() == size());
     const double m2 = sigma_over_T * sigma_over_T;
     for (std::size_t k = 0; k < size(); ++k) {
-        const double x = b_[k] / m2;
         d_out_d_ln_sigma_over_T[k] =
-            correlation == Correlation::Gaussian ? out[k] * 0.5 * x : out[k] * 3.0 * x / (1.0 + x);
+            out[k] * d_log_very_rough_profile_d_log_slope(correlation, b_[k] / m2);
     }
 }
 

@@ -1,6 +1,7 @@
 #include "roughscope/scattering/retro.hpp"
 
 #include <cmath>
+#include <string>
 
 #include "roughscope/core/errors.hpp"
 #include "roughscope/scattering/beckmann.hpp"
@@ -22,30 +23,23 @@ double slope_term(double theta_rad, double sigma_over_T) {
 
 }  // namespace
 
-// Eq. 7
-double retro_beckmann_gaussian_very_rough(double theta_rad, double sigma_over_T) {
+// Eq. 7–10
+double retro_very_rough(Correlation correlation, GeometricFactor factor, double theta_rad,
+                        double sigma_over_T) {
     check_retro(theta_rad, sigma_over_T);
-    const double c = std::cos(theta_rad);
-    return std::exp(-slope_term(theta_rad, sigma_over_T) / 4.0) / std::pow(c, 6);
-}
-
-// Eq. 8
-double retro_beckmann_exponential_very_rough(double theta_rad, double sigma_over_T) {
-    check_retro(theta_rad, sigma_over_T);
-    const double c = std::cos(theta_rad);
-    return 1.0 / (std::pow(c, 6) * std::pow(1.0 + slope_term(theta_rad, sigma_over_T), 1.5));
-}
-
-// Eq. 9
-double retro_vh_gaussian_very_rough(double theta_rad, double sigma_over_T) {
-    check_retro(theta_rad, sigma_over_T);
-    return std::exp(-slope_term(theta_rad, sigma_over_T) / 4.0) / std::cos(theta_rad);
-}
-
-// Eq. 10
-double retro_vh_exponential_very_rough(double theta_rad, double sigma_over_T) {
-    check_retro(theta_rad, sigma_over_T);
-    return 1.0 / (std::cos(theta_rad) * std::pow(1.0 + slope_term(theta_rad, sigma_over_T), 1.5));
+    const double profile = very_rough_profile(correlation, slope_term(theta_rad, sigma_over_T));
+    switch (factor) {
+        case GeometricFactor::Beckmann:  // Eq. 7, 8
+            return profile / std::pow(std::cos(theta_rad), 6);
+        case GeometricFactor::VernoldHarvey:  // Eq. 9, 10
+            return profile / std::cos(theta_rad);
+        case GeometricFactor::Ogilvy:
+        case GeometricFactor::Kirchhoff:
+            break;
+    }
+    throw InvalidArgument(std::string("retro_very_rough: the geometric factor ") +
+                          std::string(to_string(factor)) +
+                          " has no retro-reflection form in the paper (Eq. 7-10: beckmann, vh)");
 }
 
 // Eq. 11

@@ -21,6 +21,7 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <string>
 
 #include "roughscope/core/errors.hpp"
 #include "roughscope/scattering/beckmann.hpp"
@@ -261,43 +262,30 @@ SeriesResult evaluate_series(const Expansion& e, double g, Summation&& summation
 
 }  // namespace
 
-SeriesResult gaussian_series(double g, double T2_vxy2) {
+SeriesResult diffuse_series(Correlation correlation, double g, double T2_vxy2) {
     check_series_args(g, T2_vxy2);
     if (g == 0.0) return {0.0, DiffuseMethod::Summation, 0.0};
-    const double a = T2_vxy2 / 4.0;
-    return evaluate_series(gaussian_expansion(g, a), g, [&] {
-        return poisson_series(GaussianTerm{g, a}, g);
-    });
+    switch (correlation) {
+        case Correlation::Gaussian: {
+            const double a = T2_vxy2 / 4.0;
+            return evaluate_series(gaussian_expansion(g, a), g, [&] {
+                return poisson_series(GaussianTerm{g, a}, g);
+            });
+        }
+        case Correlation::Exponential:
+            return evaluate_series(exponential_expansion(g, T2_vxy2), g, [&] {
+                return poisson_series(ExponentialTerm{g, T2_vxy2}, g);
+            });
+    }
+    throw InvalidArgument("diffuse_series: correlation " +
+                          std::to_string(static_cast<int>(correlation)) + " is not defined");
 }
 
-SeriesResult exponential_series(double g, double T2_vxy2) {
-    check_series_args(g, T2_vxy2);
-    if (g == 0.0) return {0.0, DiffuseMethod::Summation, 0.0};
-    return evaluate_series(exponential_expansion(g, T2_vxy2), g, [&] {
-        return poisson_series(ExponentialTerm{g, T2_vxy2}, g);
-    });
-}
-
-double gaussian_series_sum(double g, double T2_vxy2) { return gaussian_series(g, T2_vxy2).value; }
-
-double exponential_series_sum(double g, double T2_vxy2) {
-    return exponential_series(g, T2_vxy2).value;
-}
-
-double gaussian_series_sum_naive(double g, double T2_vxy2, int max_terms) {
+double diffuse_series_sum_naive(Correlation correlation, double g, double T2_vxy2, int max_terms) {
     double sum = 0.0, power = 1.0;  // gⁿ/n!
     for (int n = 1; n <= max_terms; ++n) {
         power *= g / n;
-        sum += power / n * std::exp(-T2_vxy2 / (4.0 * n));
-    }
-    return std::exp(-g) * sum;
-}
-
-double exponential_series_sum_naive(double g, double T2_vxy2, int max_terms) {
-    double sum = 0.0, power = 1.0;
-    for (int n = 1; n <= max_terms; ++n) {
-        power *= g / n;
-        sum += power * n / std::pow(static_cast<double>(n) * n + T2_vxy2, 1.5);
+        sum += power * series_term_weight(correlation, n, T2_vxy2);
     }
     return std::exp(-g) * sum;
 }

@@ -51,8 +51,8 @@ Json comparison_json(const Comparison& c, bool series) {
     j["used"] = c.measurement.size();
     const TwoPointEstimate& t = c.two_point;
     j["E1_over_E2"] = number(t.E1_over_E2);
-    j["sigma_over_T_gaussian"] = number(t.sigma_over_T_gaussian);
-    j["sigma_over_T_exponential"] = number(t.sigma_over_T_exponential);
+    for (const Correlation k : kCorrelations)
+        j[correlation_key("sigma_over_T", k)] = number(t.sigma_over_T(k));
     Json tp;
     tp["available"] = t.available;
     tp["reason"] = text_or_null(t.reason);
@@ -63,13 +63,15 @@ Json comparison_json(const Comparison& c, bool series) {
     tp["E1"] = number(t.E1);
     tp["E2"] = number(t.E2);
     tp["factor"] = "vh";
-    tp["gaussian_reason"] = text_or_null(t.gaussian_reason);
-    tp["exponential_reason"] = text_or_null(t.exponential_reason);
-    if (t.sigma_over_T_gaussian) {
-        tp["theta_K_deg_gaussian"] =
-            number(rad_to_deg(caron_theta_K_rad(*t.sigma_over_T_gaussian)));
-        tp["rms_slope_gaussian"] = number(rms_slope(*t.sigma_over_T_gaussian));
-    }
+    for (const Correlation k : kCorrelations)
+        tp[std::string(info(k).name) + "_reason"] = text_or_null(t.correlation_reason(k));
+    // Caron's θK and the RMS slope (§3.5) where they are derived for the correlation function.
+    for (const Correlation k : kCorrelations)
+        if (info(k).caron_formulas && t.sigma_over_T(k)) {
+            tp[correlation_key("theta_K_deg", k)] =
+                number(rad_to_deg(caron_theta_K_rad(*t.sigma_over_T(k))));
+            tp[correlation_key("rms_slope", k)] = number(rms_slope(*t.sigma_over_T(k)));
+        }
     j["two_point"] = tp;
     Json sse, rmse, gsse;
     for (const ModelResult& r : c.models) {
@@ -270,7 +272,8 @@ Json to_json(const std::vector<Comparison>& comparisons, bool series) {
 
 std::string csv_header() {
     std::ostringstream out;
-    out << "sample,name,channel,used,E1_over_E2,sigma_over_T_gaussian,sigma_over_T_exponential";
+    out << "sample,name,channel,used,E1_over_E2";
+    for (const Correlation k : kCorrelations) out << "," << correlation_key("sigma_over_T", k);
     for (const char* measure : {"sse", "rmse", "sse_gain"})
         for (ComparisonModel m : kComparisonModels) out << "," << measure << "_" << to_string(m);
     out << ",lafortune_n,winner,winner_paper_metric,two_point_reason,nonpositive_count,"
@@ -282,9 +285,8 @@ std::string csv_row(const Comparison& c) {
     std::ostringstream out;
     out << (c.sample > 0 ? std::to_string(c.sample) : "") << "," << csv_text(c.name) << ","
         << csv_text(c.channel) << "," << c.measurement.size() << ","
-        << csv_number(c.two_point.E1_over_E2) << ","
-        << csv_number(c.two_point.sigma_over_T_gaussian) << ","
-        << csv_number(c.two_point.sigma_over_T_exponential);
+        << csv_number(c.two_point.E1_over_E2);
+    for (const Correlation k : kCorrelations) out << "," << csv_number(c.two_point.sigma_over_T(k));
     for (int measure = 0; measure < 3; ++measure)
         for (const ModelResult& r : c.models) {
             out << ",";
@@ -311,10 +313,12 @@ std::string to_csv(const std::vector<Comparison>& comparisons) {
 
 std::string to_markdown(const std::vector<Comparison>& comparisons) {
     std::ostringstream out;
-    out << "| sample | name | E1/E2 | σ/T_G | σ/T_E";
+    out << "| sample | name | E1/E2";
+    for (const Correlation k : kCorrelations) out << " | σ/T_" << info(k).letter;
     for (ComparisonModel m : kPaperComparisonModels) out << " | " << display_name(m);
     out << " | n_d | best fit (gain SSE) | winner, Table-4 metric | notes |\n";
-    out << "|---:|---|---:|---:|---:";
+    out << "|---:|---|---:";
+    for (std::size_t k = 0; k < kCorrelationCount; ++k) out << "|---:";
     for (std::size_t k = 0; k < kPaperComparisonModels.size(); ++k) out << "|---:";
     out << "|---:|---|---|---|\n";
     auto cell = [](const std::optional<double>& v, const char* spec) {
@@ -322,9 +326,9 @@ std::string to_markdown(const std::vector<Comparison>& comparisons) {
     };
     for (const Comparison& c : comparisons) {
         out << "| " << (c.sample > 0 ? std::to_string(c.sample) : "") << " | " << md_escape(c.name)
-            << " | " << cell(c.two_point.E1_over_E2, "%.6f") << " | "
-            << cell(c.two_point.sigma_over_T_gaussian, "%.4f") << " | "
-            << cell(c.two_point.sigma_over_T_exponential, "%.4f");
+            << " | " << cell(c.two_point.E1_over_E2, "%.6f");
+        for (const Correlation k : kCorrelations)
+            out << " | " << cell(c.two_point.sigma_over_T(k), "%.4f");
         for (ComparisonModel m : kPaperComparisonModels) {
             const ModelResult& r = c.result(m);
             out << " | " << (r.available ? cell(r.errors.paper_sse, "%.3f") : std::string("—"));

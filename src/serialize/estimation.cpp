@@ -1,6 +1,7 @@
 // JSON schemas of the §4 estimates and the fits (serialize/estimation.hpp).
 #include "roughscope/serialize/estimation.hpp"
 
+#include <algorithm>
 #include <limits>
 #include <optional>
 #include <sstream>
@@ -12,6 +13,7 @@
 #include "io/json_reader.hpp"
 #include "roughscope/core/errors.hpp"
 #include "roughscope/core/numbers.hpp"
+#include "roughscope/scattering/correlation.hpp"
 #include "roughscope/scattering/geometry.hpp"
 #include "roughscope/scattering/validity.hpp"
 #include "roughscope/serialize/text.hpp"
@@ -136,7 +138,7 @@ Json correlation_length_estimate_json(const CorrelationLengthInput& in, const Ro
                                       bool with_stderr) {
     // CorrelationLengthInput: Eq. 15 at normal view for Gaussian correlation and Eq. 3.
     const bool closed = normal_view(in.geom1) && normal_view(in.geom2) &&
-                        in.correlation == Correlation::Gaussian &&
+                        info(in.correlation).slightly_rough_inverse &&
                         in.options.regime == Regime::SlightlyRough;
     Json out;
     out["estimator"] = closed ? "correlation length (Eq. 14-15)"
@@ -156,47 +158,56 @@ Json correlation_length_estimate_json(const CorrelationLengthInput& in, const Ro
     return out;
 }
 
-Json slope_estimate_json(const SlopeInput& in, const std::optional<RoughnessEstimate>& eg,
-                         const std::optional<RoughnessEstimate>& ee, bool with_stderr) {
-    if (!eg && !ee)
-        throw InvalidArgument("slope_estimate_json: give the Gaussian or the exponential estimate");
-    // θK, ξK, m as in Table 2: from the Gaussian estimate when there is one.
-    const RoughnessEstimate& primary = eg ? *eg : *ee;
+Json slope_estimate_json(const SlopeInput& in,
+                         const PerCorrelation<std::optional<RoughnessEstimate>>& estimates,
+                         bool with_stderr) {
+    std::vector<Correlation> given;  // the correlations with an estimate, in kCorrelations order
+    for (const Correlation c : kCorrelations)
+        if (estimates[c]) given.push_back(c);
+    if (given.empty())
+        throw InvalidArgument(
+            "slope_estimate_json: give the estimate of at least one "
+            "correlation function (" +
+            correlation_names_text() + ")");
+    // θK, ξK, m as in Table 2: from the Gaussian estimate when there is one (the first given).
+    const RoughnessEstimate& primary = *estimates[given.front()];
     const bool closed = normal_view(in.geom1) && normal_view(in.geom2);  // Eq. 17 / 19
     Json out;
     out["estimator"] =
         closed ? "slope ratio (Eq. 16-19)" : "slope ratio (two-geometry solver, TOMS 748)";
     put(out, "sigma_over_T", primary.sigma_over_T, with_stderr);
-    put(out, "sigma_over_T_gaussian", eg ? eg->sigma_over_T : std::nullopt, with_stderr);
-    put(out, "sigma_over_T_exponential", ee ? ee->sigma_over_T : std::nullopt, with_stderr);
+    for (const Correlation c : kCorrelations)
+        put(out, correlation_key("sigma_over_T", c),
+            estimates[c] ? estimates[c]->sigma_over_T : std::nullopt, with_stderr);
     put(out, "sigma_um", primary.sigma_um, false);  // given, not estimated
     put(out, "T_um", primary.T_um, with_stderr);
-    if (eg && ee && in.sigma_um) {
-        put(out, "T_um_gaussian", eg->T_um, with_stderr);
-        put(out, "T_um_exponential", ee->T_um, with_stderr);
-    }
+    if (given.size() == kCorrelationCount && in.sigma_um)
+        for (const Correlation c : kCorrelations)
+            put(out, correlation_key("T_um", c), estimates[c]->T_um, with_stderr);
     put_derived(out, primary, with_stderr);
     out["E1_over_E2"] = number(in.E1_over_E2);
     const double t1 = in.geom1.theta_i_rad, t2 = in.geom2.theta_i_rad;
-    if (eg)
-        out["valid_ratio_range_gaussian"] =
-            closed ? ratio_range_json(ratio_range_gaussian(t1, t2, in.options.factor))
-                   : Json(nullptr);
-    if (ee)
-        out["valid_ratio_range_exponential"] =
-            closed ? ratio_range_json(ratio_range_exponential(t1, t2, in.options.factor))
-                   : Json(nullptr);
+    for (const Correlation c : given)
+        out[correlation_key("valid_ratio_range", c)] =
+            closed ? ratio_range_json(ratio_range(c, t1, t2, in.options.factor)) : Json(nullptr);
     out["geometry1"] = geometry_json(in.geom1);
     out["geometry2"] = geometry_json(in.geom2);
     out["factor"] = std::string(to_string(in.options.factor));
     out["radiometry"] = std::string(to_string(in.options.radiometry));
     std::vector<std::string> ws;
-    if (eg)
-        for (const auto& w : eg->warnings) ws.push_back((ee ? "gaussian: " : "") + w);
-    if (ee)
-        for (const auto& w : ee->warnings) ws.push_back((eg ? "exponential: " : "") + w);
+    for (const Correlation c : given)
+        for (const auto& w : estimates[c]->warnings)
+            ws.push_back((given.size() > 1 ? std::string(info(c).name) + ": " : std::string()) + w);
     out["warnings"] = strings(ws);
     return out;
+}
+
+Json slope_estimate_json(const SlopeInput& in, const std::optional<RoughnessEstimate>& eg,
+                         const std::optional<RoughnessEstimate>& ee, bool with_stderr) {
+    PerCorrelation<std::optional<RoughnessEstimate>> estimates;
+    estimates[Correlation::Gaussian] = eg;
+    estimates[Correlation::Exponential] = ee;
+    return slope_estimate_json(in, estimates, with_stderr);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -264,28 +275,31 @@ Json to_json(const FitResult& r, bool with_residuals) {
 }
 
 Json to_json(const CorrelationComparison& c, bool with_residuals) {
-    const Json jg = to_json(c.gaussian, with_residuals);
-    const Json je = to_json(c.exponential, with_residuals);
-    const Json& jb = c.preferred == Correlation::Gaussian ? jg : je;
+    PerCorrelation<Json> fits;
+    for (const Correlation k : kCorrelations) fits[k] = to_json(c[k], with_residuals);
+    const Json& jb = fits[c.preferred];
+    // Caron's θK, ξK, m come from the first correlation they are derived for (Gaussian, §3.5).
+    const Correlation caron = *std::find_if(kCorrelations.begin(), kCorrelations.end(),
+                                            [](Correlation k) { return info(k).caron_formulas; });
+    const Json& jg = fits[caron];
     Json out;
     out["preferred_correlation"] = std::string(to_string(c.preferred));
     out["delta_aic"] = number(c.delta_aic);
     for (const char* k : {"sigma_over_T", "sigma_over_T_stderr"}) out[k] = jb[k];
-    out["sigma_over_T_gaussian"] = jg["sigma_over_T"];
-    out["sigma_over_T_gaussian_stderr"] = jg["sigma_over_T_stderr"];
-    out["sigma_over_T_exponential"] = je["sigma_over_T"];
-    out["sigma_over_T_exponential_stderr"] = je["sigma_over_T_stderr"];
-    if (c.gaussian.options.model == FitModel::SlightlyRough)
+    for (const Correlation k : kCorrelations) {
+        out[correlation_key("sigma_over_T", k)] = fits[k]["sigma_over_T"];
+        out[correlation_key("sigma_over_T", k) + "_stderr"] = fits[k]["sigma_over_T_stderr"];
+    }
+    if (c[c.preferred].options.model == FitModel::SlightlyRough)
         for (const char* k : {"sigma_um", "sigma_um_stderr", "T_um", "T_um_stderr"}) out[k] = jb[k];
-    // Caron's θK, ξK, m from the Gaussian fit (they are Gaussian-correlation quantities, §3.5).
     for (const char* k : {"theta_K_deg", "theta_K_deg_stderr", "xi_K", "xi_K_stderr", "rms_slope",
                           "rms_slope_stderr", "roughness_class", "roughness_class_assumed", "g"})
         out[k] = jg[k];
-    out["gaussian"] = jg;
-    out["exponential"] = je;
+    for (const Correlation k : kCorrelations) out[std::string(info(k).name)] = fits[k];
     std::vector<std::string> ws;
-    for (const auto& w : c.gaussian.estimate.warnings) ws.push_back("gaussian: " + w);
-    for (const auto& w : c.exponential.estimate.warnings) ws.push_back("exponential: " + w);
+    for (const Correlation k : kCorrelations)
+        for (const auto& w : c[k].estimate.warnings)
+            ws.push_back(std::string(info(k).name) + ": " + w);
     out["warnings"] = strings(ws);
     return out;
 }

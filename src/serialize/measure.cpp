@@ -327,9 +327,10 @@ Json to_json(const image::MeasureResult& r, const image::MeasureRequest& request
     if (r.cylinder) {
         // A cylinder: σ/T fitted on its profile (§5.2).
         const Json profile = to_json(*r.cylinder);
-        for (const char* key : {"sigma_over_T_gaussian", "sigma_over_T_exponential"}) {
+        for (const Correlation c : kCorrelations) {
+            const std::string key = correlation_key("sigma_over_T", c);
             out[key] = profile[key];
-            out[std::string(key) + "_stderr"] = profile[std::string(key) + "_stderr"];
+            out[key + "_stderr"] = profile[key + "_stderr"];
         }
         out["sigma_over_T_source"] = "cylinder_profile";
     } else {

@@ -14,6 +14,7 @@
 #include "io/json_reader.hpp"
 #include "roughscope/core/errors.hpp"
 #include "roughscope/estimation/estimation.hpp"
+#include "roughscope/scattering/correlation.hpp"
 #include "roughscope/scattering/geometry.hpp"
 #include "roughscope/scattering/validity.hpp"
 #include "roughscope/serialize/text.hpp"
@@ -71,14 +72,12 @@ std::vector<JsonNode> rows_of(const JsonNode& table) {
 // σ/T by Eq. 17 and Eq. 19 from the printed E1/E2 (given to ratio_decimals decimals).
 void add_slope_checks(Json& out, const JsonNode& row, double ratio, int ratio_decimals,
                       double theta1_rad, double theta2_rad) {
-    out["sigma_over_T_G"] =
-        check(num_at(row, "sigma_over_T_G"), 4, {ratio}, {ratio_decimals}, [&](const Inputs& x) {
-            return sigma_over_T_gaussian_from_ratio(x[0], theta1_rad, theta2_rad);
+    for (const Correlation c : kCorrelations) {
+        const std::string key = "sigma_over_T_" + std::string(info(c).letter);  // the paper's σ/T_G
+        out[key] = check(num_at(row, key), 4, {ratio}, {ratio_decimals}, [&](const Inputs& x) {
+            return sigma_over_T_from_ratio(c, x[0], theta1_rad, theta2_rad);
         });
-    out["sigma_over_T_E"] =
-        check(num_at(row, "sigma_over_T_E"), 4, {ratio}, {ratio_decimals}, [&](const Inputs& x) {
-            return sigma_over_T_exponential_from_ratio(x[0], theta1_rad, theta2_rad);
-        });
+    }
 }
 
 // What every printed table has: its conditions and the incidence angles θ1, θ2 of its ratio.

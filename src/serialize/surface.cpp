@@ -107,8 +107,8 @@ Json to_json(const StatisticsInput& input, const surface::SurfaceStatistics& s, 
     j["T_um"] = number(s.T_um);
     j["T_y_um"] = number(s.T_y_um);
     j["T_stderr_um"] = number(s.T_stderr_um);
-    j["T_fit_gaussian_um"] = number(s.T_fit_gaussian_um);
-    j["T_fit_exponential_um"] = number(s.T_fit_exponential_um);
+    for (const Correlation c : kCorrelations)
+        j["T_fit_" + std::string(info(c).name) + "_um"] = number(s.T_fit_um(c));
     j["correlation"] = s.correlation ? Json(std::string(to_string(*s.correlation))) : Json(nullptr);
     j["T_extrapolated_um"] = number(s.T_extrapolated_um);
     j["period_um"] = number(s.period_um);
@@ -151,30 +151,34 @@ std::string to_text(const StatisticsInput& input, const surface::SurfaceStatisti
     std::string Str = text_of(j["Str"]);
     if (!j["Str_note"].is_null())
         Str.append(" (").append(j["Str_note"].get<std::string>()).append(")");
-    print_lines(out, {
-                         {"points", text_of(j["points"])},
-                         {"sigma (Sq)", sigma},
-                         {"Sa", with_unit(j["Sa_um"], "um")},
-                         {"Ssk", text_of(j["Ssk"])},
-                         {"Sku", text_of(j["Sku"])},
-                         {"Sp", with_unit(j["Sp_um"], "um")},
-                         {"Sv", with_unit(j["Sv_um"], "um")},
-                         {"Sz", with_unit(j["Sz_um"], "um")},
-                         {"T (1/e, x)", T},
-                         {"T (1/e, y)", with_unit(j["T_y_um"], "um")},
-                         {"T (Gaussian fit)", with_unit(j["T_fit_gaussian_um"], "um")},
-                         {"T (exponential fit)", with_unit(j["T_fit_exponential_um"], "um")},
-                         {"correlation (AIC)", text_of(j["correlation"])},
-                         {"T (extrapolated)", with_unit(j["T_extrapolated_um"], "um")},
-                         {"period (ACF, x)", with_unit(j["period_um"], "um")},
-                         {"period (ACF, y)", with_unit(j["period_y_um"], "um")},
-                         {"Sal (s = 0.2)", with_unit(j["Sal_um"], "um")},
-                         {"Str", Str},
-                         {"RMS slope along x (Rdq)", text_of(j["rms_slope"])},
-                         {"RMS slope along y (Rdq)", text_of(j["rms_slope_y"])},
-                         {"RMS gradient (Sdq)", text_of(j["Sdq"])},
-                         {"m = sigma*sqrt(2)/T", text_of(j["m_from_T"])},
-                     });
+    std::vector<std::pair<std::string, std::string>> lines{
+        {"points", text_of(j["points"])},
+        {"sigma (Sq)", sigma},
+        {"Sa", with_unit(j["Sa_um"], "um")},
+        {"Ssk", text_of(j["Ssk"])},
+        {"Sku", text_of(j["Sku"])},
+        {"Sp", with_unit(j["Sp_um"], "um")},
+        {"Sv", with_unit(j["Sv_um"], "um")},
+        {"Sz", with_unit(j["Sz_um"], "um")},
+        {"T (1/e, x)", T},
+        {"T (1/e, y)", with_unit(j["T_y_um"], "um")},
+    };
+    for (const Correlation c : kCorrelations)  // "T (Gaussian fit)", "T (exponential fit)"
+        lines.emplace_back("T (" + std::string(info(c).adjective) + " fit)",
+                           with_unit(j["T_fit_" + std::string(info(c).name) + "_um"], "um"));
+    lines.insert(lines.end(), {
+                                  {"correlation (AIC)", text_of(j["correlation"])},
+                                  {"T (extrapolated)", with_unit(j["T_extrapolated_um"], "um")},
+                                  {"period (ACF, x)", with_unit(j["period_um"], "um")},
+                                  {"period (ACF, y)", with_unit(j["period_y_um"], "um")},
+                                  {"Sal (s = 0.2)", with_unit(j["Sal_um"], "um")},
+                                  {"Str", Str},
+                                  {"RMS slope along x (Rdq)", text_of(j["rms_slope"])},
+                                  {"RMS slope along y (Rdq)", text_of(j["rms_slope_y"])},
+                                  {"RMS gradient (Sdq)", text_of(j["Sdq"])},
+                                  {"m = sigma*sqrt(2)/T", text_of(j["m_from_T"])},
+                              });
+    print_lines(out, lines);
     for (const std::string& w : s.warnings) out << "warning: " << w << '\n';
     return out.str();
 }

@@ -94,15 +94,7 @@ std::vector<cd> centred_phases(std::size_t n, double u, double d) {
 
 // The diffuse kernel's spectrum shape: the series sum without its prefactor.
 double series_shape(Correlation c, double g, double T2_vxy2) {
-    return c == Correlation::Gaussian ? gaussian_series_sum(g, T2_vxy2)
-                                      : exponential_series_sum(g, T2_vxy2);
-}
-
-double diffuse_series(Correlation c, double F2, double T_um, double area_um2, double g,
-                      double vxy2) {
-    return c == Correlation::Gaussian
-               ? diffuse_power_gaussian_series(F2, T_um, area_um2, g, vxy2)
-               : diffuse_power_exponential_series(F2, T_um, area_um2, g, vxy2);
+    return diffuse_series_sum(c, g, T2_vxy2);
 }
 
 // ρ0 of a sampled square patch: the Dirichlet kernel Π sin(n u d/2)/(n sin(u d/2)) (→ the
@@ -303,7 +295,7 @@ ScatterResult summarise(const Plan& p, const ScatterOptions& o, const std::vecto
     res.layout = p.layout;
     res.lattice_index = p.m;
     res.series_diffuse =
-        diffuse_series(o.correlation, p.F2, o.T_um, res.area_um2, res.g, p.v.vxy2());
+        diffuse_power_series(o.correlation, p.F2, o.T_um, res.area_um2, res.g, p.v.vxy2());
     double rho0 = 1.0;
     if (p.kind == 1) {
         rho0 = 0.0;  // a nonzero lattice frequency: the plate's sum vanishes
@@ -397,9 +389,9 @@ std::complex<double> scattering_integral_at(const surface::HeightMap& map,
 // ---------------------------------------------------------------------------------------------
 
 void check_scatter_options(const ScatterOptions& o) {
-    if (o.correlation != Correlation::Gaussian && o.correlation != Correlation::Exponential) {
-        throw InvalidArgument(
-            "simulation option correlation is invalid: it must be gaussian or exponential");
+    if (!is_valid(o.correlation)) {
+        throw InvalidArgument("simulation option correlation is invalid: it must be " +
+                              correlation_names_text());
     }
     check_length_um("sigma", o.sigma_um);
     if (!(o.sigma_um <= kMaxLengthUm * 1e-2)) {
@@ -456,9 +448,7 @@ ScatterGrid choose_scatter_grid(const Geometry& geom, const ScatterOptions& o) {
     } else {
         double patch_over_T = o.patch_over_T;
         if (patch_over_T == 0.0) {
-            patch_over_T = o.correlation == Correlation::Gaussian
-                               ? 6.0
-                               : std::max(8.0, std::log(4.0 * std::max(g, 1.0) / kAliasTolerance));
+            patch_over_T = simulation_patch_over_T(o.correlation, g, kAliasTolerance);
         }
         const double want = std::ceil(patch_over_T * T / grid.dx_um);
         if (!(want <= static_cast<double>(kMaxGridSide))) {

@@ -202,8 +202,7 @@ std::optional<double> correlation_length_1e(const Curve& acf) {
 }
 
 double acf_model(Correlation model, double lag_um, double T_um) {
-    const double r = std::abs(lag_um) / T_um;
-    return model == Correlation::Gaussian ? std::exp(-r * r) : std::exp(-r);
+    return acf(model, std::abs(lag_um) / T_um);
 }
 
 namespace {
@@ -281,14 +280,12 @@ AcfModelFit fit_acf_models(const Curve& acf, double max_lag_um) {
         constexpr int kParameters = 1;
         return n * std::log(std::max(rss, 1e-300) / n) + 2.0 * kParameters;
     };
-    const double Tg = fit_T(x, y, Correlation::Gaussian);
-    const double Te = fit_T(x, y, Correlation::Exponential);
-    fit.T_gaussian_um = Tg;
-    fit.T_exponential_um = Te;
-    fit.aic_gaussian = aic(residual_sum(x, y, Correlation::Gaussian, Tg));
-    fit.aic_exponential = aic(residual_sum(x, y, Correlation::Exponential, Te));
-    fit.better =
-        fit.aic_gaussian <= fit.aic_exponential ? Correlation::Gaussian : Correlation::Exponential;
+    for (const Correlation c : kCorrelations) {
+        const double T = fit_T(x, y, c);
+        fit.T_um[c] = T;
+        fit.aic[c] = aic(residual_sum(x, y, c, T));
+        if (!fit.better || fit.aic[c] < fit.aic[*fit.better]) fit.better = c;
+    }
     return fit;
 }
 

@@ -91,10 +91,9 @@ void check_grid_options(const GenerationOptions& o) {
 }
 
 void check_options(const GenerationOptions& o) {
-    if (o.correlation != Correlation::Gaussian && o.correlation != Correlation::Exponential) {
-        throw InvalidArgument(
-            "generation option correlation is invalid: it must be gaussian or "
-            "exponential");
+    if (!is_valid(o.correlation)) {
+        throw InvalidArgument("generation option correlation is invalid: it must be " +
+                              correlation_names_text());
     }
     check_in_range("T_um", o.T_um, kMinLengthUm, kMaxLengthUm);
     check_grid_options(o);
@@ -135,10 +134,10 @@ std::vector<double> images_within(double u, double period, double r_max, bool pe
 // C_p(0) = 1 (it exceeds 1 by the images' overlap, e.g. by 2e^{−L/T} for an exponential ACF).
 // Images farther than r_max, where C < 1e−18, are left out.
 void fill_periodised_acf(const GenerationOptions& o, fft::RealToComplex& f) {
-    const bool gaussian = o.correlation == Correlation::Gaussian;
+    const Correlation c = o.correlation;
     const double T = o.T_um;
     constexpr double kCutoff = 41.5;  // e^{−41.5} ≈ 1e−18
-    const double r_max = gaussian ? T * std::sqrt(kCutoff) : T * kCutoff;
+    const double r_max = T * acf_cutoff_over_T(c, kCutoff);
     const double lx = static_cast<double>(o.nx) * o.dx_um;
     const double ly = static_cast<double>(o.ny) * o.dy_um;
     const bool profile = o.ny == 1;
@@ -149,12 +148,13 @@ void fill_periodised_acf(const GenerationOptions& o, fft::RealToComplex& f) {
     for (std::size_t jx = 0; jx <= hx; ++jx) {
         x_images[jx] = images_within(static_cast<double>(jx) * o.dx_um, lx, r_max, true);
     }
-    if (gaussian) {
-        // exp(−(x² + y²)/T²) = exp(−x²/T²) exp(−y²/T²): C_p is the product of the 1-D sums.
+    if (info(c).separable) {
+        // ρ(√(x² + y²)/T) = ρ(|x|/T) ρ(|y|/T) (Gaussian: exp(−(x² + y²)/T²) = exp(−x²/T²)
+        // exp(−y²/T²)): C_p is the product of the 1-D sums.
         const auto periodised_1d = [&](const std::vector<double>& images) {
             double sum = 0;
             for (const double u : images) {
-                sum += std::exp(-u * u / (T * T));
+                sum += acf(c, std::abs(u) / T);
             }
             return sum;
         };
@@ -181,7 +181,7 @@ void fill_periodised_acf(const GenerationOptions& o, fft::RealToComplex& f) {
                     for (const double yn : y_images) {
                         const double r2 = xm * xm + yn * yn;
                         if (r2 <= r_max * r_max) {
-                            sum += std::exp(-std::sqrt(r2) / T);
+                            sum += acf(c, std::sqrt(r2) / T);
                         }
                     }
                 }

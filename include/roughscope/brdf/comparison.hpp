@@ -45,6 +45,7 @@
 #include "roughscope/brdf/curet.hpp"
 #include "roughscope/brdf/table.hpp"
 #include "roughscope/fit/engine.hpp"
+#include "roughscope/scattering/correlation.hpp"
 #include "roughscope/scattering/factors.hpp"
 #include "roughscope/scattering/reflectance_models.hpp"
 
@@ -156,6 +157,19 @@ struct TwoPointEstimate {
     std::string gaussian_reason;                     // why unavailable (e.g. NoSolution)
     std::optional<double> sigma_over_T_exponential;  // Eq. 19
     std::string exponential_reason;
+    // The same by correlation (the named members are the form the CLI reads).
+    std::optional<double>& sigma_over_T(Correlation c) {
+        return c == Correlation::Gaussian ? sigma_over_T_gaussian : sigma_over_T_exponential;
+    }
+    const std::optional<double>& sigma_over_T(Correlation c) const {
+        return c == Correlation::Gaussian ? sigma_over_T_gaussian : sigma_over_T_exponential;
+    }
+    std::string& correlation_reason(Correlation c) {
+        return c == Correlation::Gaussian ? gaussian_reason : exponential_reason;
+    }
+    const std::string& correlation_reason(Correlation c) const {
+        return c == Correlation::Gaussian ? gaussian_reason : exponential_reason;
+    }
 };
 
 // A measurement the comparison treats specially.

@@ -32,33 +32,20 @@ namespace roughscope {
 // =============================================================================================
 // Contract: §4.2 very-rough slope estimators, viewer on the normal (θs = φs = 0).
 
-// Eq. 17: σ/T_G from E1/E2 at incidence θ1, θ2 (Gaussian correlation, very rough).
-double sigma_over_T_gaussian_from_ratio(double E1_over_E2, double theta1_rad, double theta2_rad,
-                                        GeometricFactor factor = GeometricFactor::VernoldHarvey);
-
-// Eq. 19: σ/T_E from E1/E2 (exponential correlation, Eq. 5 as published).
-double sigma_over_T_exponential_from_ratio(double E1_over_E2, double theta1_rad, double theta2_rad,
-                                           GeometricFactor factor = GeometricFactor::VernoldHarvey);
+// Eq. 17 (Gaussian correlation) / Eq. 19 (exponential, Eq. 5 as published): σ/T from E1/E2 at
+// incidence θ1, θ2, very rough (correlation.hpp: sigma_over_T_from_normal_view_ratio).
+double sigma_over_T_from_ratio(Correlation correlation, double E1_over_E2, double theta1_rad,
+                               double theta2_rad,
+                               GeometricFactor factor = GeometricFactor::VernoldHarvey);
 
 // =============================================================================================
-// Valid ranges of the brightness ratio E1/E2.
+// Valid ranges of the brightness ratio E1/E2 (RatioRange: correlation.hpp).
 
-// An open interval (lower, upper) of ratios for which an estimator has a solution; upper may be
-// +inf. The bounds are the ratios the model produces in its limits (e.g. σ/T → ∞ and σ/T → 0).
-struct RatioRange {
-    double lower = 0.0;
-    double upper = 0.0;
-    bool contains(double ratio) const { return ratio > lower && ratio < upper; }
-};
-
-// Eq. 16: E1/E2 = C exp{(T²/4σ²)(a2 − a1)} with a = v_xy²/v_z², C = F1² v_z2²/(F2² v_z1²).
+// Eq. 16: E1/E2 = C exp{(T²/4σ²)(a2 − a1)} with a = v_xy²/v_z², C = F1² v_z2²/(F2² v_z1²):
 // θ1 < θ2: (C, ∞); θ1 > θ2: (0, C).
-RatioRange ratio_range_gaussian(double theta1_rad, double theta2_rad,
-                                GeometricFactor factor = GeometricFactor::VernoldHarvey);
-
 // Eq. 18: E1/E2 = C {(1 + a2 T²/σ²)/(1 + a1 T²/σ²)}^{3/2}: between C and C (a2/a1)^{3/2}.
-RatioRange ratio_range_exponential(double theta1_rad, double theta2_rad,
-                                   GeometricFactor factor = GeometricFactor::VernoldHarvey);
+RatioRange ratio_range(Correlation correlation, double theta1_rad, double theta2_rad,
+                       GeometricFactor factor = GeometricFactor::VernoldHarvey);
 
 // Eq. 14: with σ known the ratio is (g1F1²/g2F2²) exp{g2 − g1 + (T²/4)(v_xy2² − v_xy1²)}; T ∈ (0,
 // ∞) maps to the ratios between its T → 0 value and 0 or ∞.
@@ -235,11 +222,9 @@ void fill_roughness_class(RoughnessEstimate& estimate, const std::vector<Geometr
 // Analytic derivatives used by the propagation (exposed for tests).
 // d(σ/T)/d ln(E1/E2) for Eq. 17 and Eq. 19, dT/d ln(E1/E2) and dT/dσ for Eq. 15,
 // dσ/dR_spec for Eq. 13.
-double d_sigma_over_T_gaussian_d_log_ratio(double E1_over_E2, double theta1_rad, double theta2_rad,
-                                           GeometricFactor factor = GeometricFactor::VernoldHarvey);
-double d_sigma_over_T_exponential_d_log_ratio(
-    double E1_over_E2, double theta1_rad, double theta2_rad,
-    GeometricFactor factor = GeometricFactor::VernoldHarvey);
+double d_sigma_over_T_d_log_ratio(Correlation correlation, double E1_over_E2, double theta1_rad,
+                                  double theta2_rad,
+                                  GeometricFactor factor = GeometricFactor::VernoldHarvey);
 double d_correlation_length_d_log_ratio(double E1_over_E2, double sigma_um, double theta1_rad,
                                         double theta2_rad, double wavelength_um,
                                         GeometricFactor factor = GeometricFactor::VernoldHarvey);
@@ -248,5 +233,29 @@ double d_correlation_length_d_sigma(double E1_over_E2, double sigma_um, double t
                                     GeometricFactor factor = GeometricFactor::VernoldHarvey);
 double d_sigma_d_specular_reflectance(double R_spec, double theta_rad, double wavelength_um,
                                       double R0 = kDefaultSmoothReflectanceR0);
+
+// =============================================================================================
+// The two-name forms kept for the photograph, CLI and Python code (src/image, python/); they
+// forward to sigma_over_T_from_ratio and ratio_range.
+inline double sigma_over_T_gaussian_from_ratio(  // Eq. 17
+    double E1_over_E2, double theta1_rad, double theta2_rad,
+    GeometricFactor factor = GeometricFactor::VernoldHarvey) {
+    return sigma_over_T_from_ratio(Correlation::Gaussian, E1_over_E2, theta1_rad, theta2_rad,
+                                   factor);
+}
+inline double sigma_over_T_exponential_from_ratio(  // Eq. 19
+    double E1_over_E2, double theta1_rad, double theta2_rad,
+    GeometricFactor factor = GeometricFactor::VernoldHarvey) {
+    return sigma_over_T_from_ratio(Correlation::Exponential, E1_over_E2, theta1_rad, theta2_rad,
+                                   factor);
+}
+inline RatioRange ratio_range_gaussian(  // Eq. 16
+    double theta1_rad, double theta2_rad, GeometricFactor factor = GeometricFactor::VernoldHarvey) {
+    return ratio_range(Correlation::Gaussian, theta1_rad, theta2_rad, factor);
+}
+inline RatioRange ratio_range_exponential(  // Eq. 18
+    double theta1_rad, double theta2_rad, GeometricFactor factor = GeometricFactor::VernoldHarvey) {
+    return ratio_range(Correlation::Exponential, theta1_rad, theta2_rad, factor);
+}
 
 }  // namespace roughscope

@@ -120,15 +120,23 @@ struct FitResult {
 FitResult fit_roughness(const std::vector<Measurement>& measurements,
                         const FitOptions& options = {});
 
-// Fits the same data with both correlation functions (Gaussian, exponential), all other options
-// as given. preferred is the one with the lower AIC; delta_aic = AIC(other) − AIC(preferred).
-// A NotIdentifiable fit is never preferred over an identifiable one; delta_aic is NaN unless
-// both are identifiable.
+// Fits the same data with every correlation function (kCorrelations: Gaussian, exponential),
+// all other options as given. preferred is the one with the lowest AIC (the first on a tie);
+// delta_aic = AIC(next best) − AIC(preferred). A NotIdentifiable fit is never preferred over an
+// identifiable one; delta_aic is NaN unless all are identifiable.
 struct CorrelationComparison {
+    // One fit per correlation function, read by correlation through operator[] (the two named
+    // members are the form the photograph, CLI and Python code read).
     FitResult gaussian;
     FitResult exponential;
     Correlation preferred = Correlation::Gaussian;
     double delta_aic = 0.0;
+    FitResult& operator[](Correlation c) {
+        return c == Correlation::Gaussian ? gaussian : exponential;
+    }
+    const FitResult& operator[](Correlation c) const {
+        return c == Correlation::Gaussian ? gaussian : exponential;
+    }
 };
 CorrelationComparison compare_correlations(const std::vector<Measurement>& measurements,
                                            const FitOptions& options = {});

@@ -24,13 +24,12 @@
 #include <cmath>
 #include <string_view>
 
+#include "roughscope/scattering/correlation.hpp"
 #include "roughscope/scattering/factors.hpp"
 #include "roughscope/scattering/geometry.hpp"
 #include "roughscope/scattering/validity.hpp"
 
 namespace roughscope {
-
-enum class Correlation { Gaussian, Exponential };
 
 enum class Regime {
     Auto,                  // Series when σ, T (and λ) are known; see ModelOptions::auto_tolerance
@@ -74,19 +73,17 @@ struct SeriesResult {
     double relative_error_bound = 0.0;
 };
 
-// S_G(g, a) = e^{−g} Σ_{n≥1} gⁿ/(n! n) exp(−a/n),  a = T² v_xy²/4                   (Eq. 2)
-SeriesResult gaussian_series(double g, double T2_vxy2);
-double gaussian_series_sum(double g, double T2_vxy2);  // gaussian_series(...).value
-
-// S_E(g, b) = e^{−g} Σ_{n≥1} gⁿ/n! · n/(n² + b)^{3/2},  b = T² v_xy²
-SeriesResult exponential_series(double g, double T2_vxy2);
-double exponential_series_sum(double g, double T2_vxy2);  // exponential_series(...).value
+// S(g, b) = e^{−g} Σ_{n≥1} gⁿ/n! h(n), b = T² v_xy², h = series_term_weight (correlation.hpp):
+// exp(−b/4n)/n for the Gaussian (Eq. 2), n/(n² + b)^{3/2} for the exponential correlation.
+SeriesResult diffuse_series(Correlation correlation, double g, double T2_vxy2);
+inline double diffuse_series_sum(Correlation correlation, double g, double T2_vxy2) {
+    return diffuse_series(correlation, g, T2_vxy2).value;
+}
 
 // Textbook summation from n = 1 with a fixed number of terms and e^{−g} applied at the end:
 // the baseline the benchmarks compare against. Overflows (returns inf/nan) beyond g ≈ 709 and
 // is inaccurate when max_terms < ~g + 10√g. Not for production use.
-double gaussian_series_sum_naive(double g, double T2_vxy2, int max_terms);
-double exponential_series_sum_naive(double g, double T2_vxy2, int max_terms);
+double diffuse_series_sum_naive(Correlation correlation, double g, double T2_vxy2, int max_terms);
 
 // ---------------------------------------------------------------------------------------------
 // The individual terms as pure functions (unchecked inputs; F2 = F², vxy2 = v_xy², vz2 = v_z²).
@@ -103,16 +100,18 @@ inline double specular_amplitude_rho0(double vx, double vy, double X_um, double 
 // Coherent term of Eq. 1: ρ0² e^{−g}.
 inline double coherent_power(double rho0, double g) { return rho0 * rho0 * std::exp(-g); }
 
-// Eq. 2.
-inline double diffuse_power_gaussian_series(double F2, double T_um, double area_um2, double g,
-                                            double vxy2) {
-    return kPi * T_um * T_um / area_um2 * F2 * gaussian_series_sum(g, T_um * T_um * vxy2);
+// Eq. 2 (and the exact exponential series): D = prefactor (T²/A) F² S(g, T² v_xy²).
+inline double diffuse_power_series(Correlation c, double F2, double T_um, double area_um2, double g,
+                                   double vxy2) {
+    return info(c).diffuse_prefactor * T_um * T_um / area_um2 * F2 *
+           diffuse_series_sum(c, g, T_um * T_um * vxy2);
 }
 
-// Eq. 3.
-inline double diffuse_power_slightly_rough_gaussian(double F2, double T_um, double area_um2,
-                                                    double g, double vxy2) {
-    return kPi * T_um * T_um / area_um2 * g * F2 * std::exp(-g - T_um * T_um * vxy2 / 4.0);
+// Eq. 3 (and the first exponential term): the n = 1 term of the series, (T²/A) F² g e^{−g}
+// W(T v_xy) with W = power_spectrum.
+inline double diffuse_power_slightly_rough(Correlation c, double F2, double T_um, double area_um2,
+                                           double g, double vxy2) {
+    return T_um * T_um / area_um2 * F2 * g * std::exp(-g) * power_spectrum(c, T_um * T_um * vxy2);
 }
 
 // t² = q_xy²/((σ/T)² q_z²) = T² v_xy²/(σ² v_z²), the argument of the very-rough forms: finite
@@ -126,71 +125,41 @@ inline double very_rough_argument(double qxy2, double qz2, double sigma_over_T) 
     return t * t;
 }
 
-// Eq. 4.
-inline double diffuse_power_very_rough_gaussian(double F2, double sigma_um, double T_um,
-                                                double area_um2, double vz2, double vxy2) {
+// Eq. 4 / Eq. 5 as published: prefactor T²/(A σ²) F²/v_z² P(T² v_xy²/(σ² v_z²)).
+inline double diffuse_power_very_rough(Correlation c, double F2, double sigma_um, double T_um,
+                                       double area_um2, double vz2, double vxy2) {
     const double s2 = sigma_um * sigma_um, T2 = T_um * T_um;
-    return kPi * T2 / (area_um2 * s2) * F2 / vz2 * std::exp(-T2 * vxy2 / (4.0 * s2 * vz2));
+    return info(c).diffuse_prefactor * T2 / (area_um2 * s2) * F2 / vz2 *
+           very_rough_profile(c, T2 * vxy2 / (s2 * vz2));
 }
 
-// Exact exponential-correlation series (see file comment).
-inline double diffuse_power_exponential_series(double F2, double T_um, double area_um2, double g,
-                                               double vxy2) {
-    return 2.0 * kPi * T_um * T_um / area_um2 * F2 * exponential_series_sum(g, T_um * T_um * vxy2);
-}
-
-// First term (n = 1) of the exact exponential series.
-inline double diffuse_power_slightly_rough_exponential(double F2, double T_um, double area_um2,
-                                                       double g, double vxy2) {
-    const double b = T_um * T_um * vxy2;
-    return 2.0 * kPi * T_um * T_um / area_um2 * F2 * g * std::exp(-g) / std::pow(1.0 + b, 1.5);
-}
-
-// Eq. 5, exactly as published.
-inline double diffuse_power_very_rough_exponential(double F2, double sigma_um, double T_um,
-                                                   double area_um2, double vz2, double vxy2) {
-    const double s2 = sigma_um * sigma_um, T2 = T_um * T_um;
-    return 2.0 * kPi * T2 / (area_um2 * s2) * F2 /
-           (vz2 * std::pow(1.0 + T2 * vxy2 / (s2 * vz2), 1.5));
-}
-
-// g → ∞ limit of the exact exponential series: (2πT²/A) F² g/(g² + T² v_xy²)^{3/2}.
-inline double diffuse_power_very_rough_exponential_series_limit(double F2, double T_um,
-                                                                double area_um2, double g,
-                                                                double vxy2) {
-    const double b = T_um * T_um * vxy2;
-    return 2.0 * kPi * T_um * T_um / area_um2 * F2 * g / std::pow(g * g + b, 1.5);
+// g → ∞ limit of the exact series, prefactor (T²/A) F² h(g) (h = series_term_weight); Eq. 4
+// itself where the closed form is that limit (Gaussian).
+inline double diffuse_power_very_rough_series_limit(Correlation c, double F2, double sigma_um,
+                                                    double T_um, double area_um2, double g,
+                                                    double vz2, double vxy2) {
+    if (info(c).closed_form_is_series_limit)
+        return diffuse_power_very_rough(c, F2, sigma_um, T_um, area_um2, vz2, vxy2);
+    return info(c).diffuse_prefactor * T_um * T_um / area_um2 * F2 *
+           series_term_weight(c, g, T_um * T_um * vxy2);
 }
 
 // Very-rough brightness shapes, which depend on the slope ratio σ/T only (constants dropped):
-//   Gaussian (Eq. 4):    F²/q_z² · exp(−q_xy² /(4 (σ/T)² q_z²))
-//   Exponential (Eq. 5): F²/(q_z² [1 + q_xy²/((σ/T)² q_z²)]^{3/2})
-// with q = v/k. Eq. 4 = (πT²/(Aσ²k²)) × shape, Eq. 5 = (2πT²/(Aσ²k²)) × shape.
-// Finite for every σ/T > 0 (σ/T → 0 gives 0 off the specular direction, the specular value on
-// it; σ/T → ∞ gives F²/q_z²).
-inline double very_rough_shape_gaussian(double F2, const ScatteringDirection& q,
-                                        double sigma_over_T) {
-    return F2 / q.qz2() * std::exp(-0.25 * very_rough_argument(q.qxy2(), q.qz2(), sigma_over_T));
-}
-inline double very_rough_shape_exponential(double F2, const ScatteringDirection& q,
-                                           double sigma_over_T) {
-    return F2 /
-           (q.qz2() * std::pow(1.0 + very_rough_argument(q.qxy2(), q.qz2(), sigma_over_T), 1.5));
+// F²/q_z² P(t²), t² = q_xy²/((σ/T)² q_z²), q = v/k: Eq. 4 = (πT²/(Aσ²k²)) × shape, Eq. 5 =
+// (2πT²/(Aσ²k²)) × shape. Finite for every σ/T > 0 (σ/T → 0 gives 0 off the specular
+// direction, the specular value on it; σ/T → ∞ gives F²/q_z²).
+inline double very_rough_shape(Correlation c, double F2, const ScatteringDirection& q,
+                               double sigma_over_T) {
+    return F2 / q.qz2() *
+           very_rough_profile(c, very_rough_argument(q.qxy2(), q.qz2(), sigma_over_T));
 }
 
-// Natural logarithms of the two shapes, finite where the shapes underflow (ratios of very-rough
-// brightnesses at two geometries are formed from these):
-//   Gaussian:    ln F² − ln q_z² − q_xy²/(4 (σ/T)² q_z²)
-//   Exponential: ln F² − ln q_z² − (3/2) ln(1 + q_xy²/((σ/T)² q_z²))
-inline double log_very_rough_shape_gaussian(double F2, const ScatteringDirection& q,
-                                            double sigma_over_T) {
-    return std::log(F2) - std::log(q.qz2()) -
-           0.25 * very_rough_argument(q.qxy2(), q.qz2(), sigma_over_T);
-}
-inline double log_very_rough_shape_exponential(double F2, const ScatteringDirection& q,
-                                               double sigma_over_T) {
-    return std::log(F2) - std::log(q.qz2()) -
-           1.5 * std::log1p(very_rough_argument(q.qxy2(), q.qz2(), sigma_over_T));
+// Its natural logarithm, ln F² − ln q_z² + ln P(t²), finite where the shape underflows (ratios
+// of very-rough brightnesses at two geometries are formed from these).
+inline double log_very_rough_shape(Correlation c, double F2, const ScatteringDirection& q,
+                                   double sigma_over_T) {
+    return std::log(F2) - std::log(q.qz2()) +
+           log_very_rough_profile(c, very_rough_argument(q.qxy2(), q.qz2(), sigma_over_T));
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -267,5 +236,47 @@ inline constexpr double kQuadratureMaxG = 1e4;
 inline constexpr double kQuadratureMaxTvxy = 100.0;
 double diffuse_power_quadrature(Correlation correlation, double F2, double T_um, double area_um2,
                                 double g, double vxy2);
+
+// ---------------------------------------------------------------------------------------------
+// The two-name forms kept for the photograph, CLI and Python code (python/bind_core.cpp); they
+// forward to the functions above.
+inline double gaussian_series_sum(double g, double T2_vxy2) {
+    return diffuse_series_sum(Correlation::Gaussian, g, T2_vxy2);
+}
+inline double exponential_series_sum(double g, double T2_vxy2) {
+    return diffuse_series_sum(Correlation::Exponential, g, T2_vxy2);
+}
+inline double diffuse_power_gaussian_series(double F2, double T_um, double area_um2, double g,
+                                            double vxy2) {
+    return diffuse_power_series(Correlation::Gaussian, F2, T_um, area_um2, g, vxy2);
+}
+inline double diffuse_power_exponential_series(double F2, double T_um, double area_um2, double g,
+                                               double vxy2) {
+    return diffuse_power_series(Correlation::Exponential, F2, T_um, area_um2, g, vxy2);
+}
+inline double diffuse_power_slightly_rough_gaussian(double F2, double T_um, double area_um2,
+                                                    double g, double vxy2) {
+    return diffuse_power_slightly_rough(Correlation::Gaussian, F2, T_um, area_um2, g, vxy2);
+}
+inline double diffuse_power_slightly_rough_exponential(double F2, double T_um, double area_um2,
+                                                       double g, double vxy2) {
+    return diffuse_power_slightly_rough(Correlation::Exponential, F2, T_um, area_um2, g, vxy2);
+}
+inline double diffuse_power_very_rough_gaussian(double F2, double sigma_um, double T_um,
+                                                double area_um2, double vz2, double vxy2) {
+    return diffuse_power_very_rough(Correlation::Gaussian, F2, sigma_um, T_um, area_um2, vz2, vxy2);
+}
+inline double diffuse_power_very_rough_exponential(double F2, double sigma_um, double T_um,
+                                                   double area_um2, double vz2, double vxy2) {
+    return diffuse_power_very_rough(Correlation::Exponential, F2, sigma_um, T_um, area_um2, vz2,
+                                    vxy2);
+}
+// (2πT²/A) F² g/(g² + T² v_xy²)^{3/2}: σ does not enter (nor v_z, beyond g).
+inline double diffuse_power_very_rough_exponential_series_limit(double F2, double T_um,
+                                                                double area_um2, double g,
+                                                                double vxy2) {
+    return info(Correlation::Exponential).diffuse_prefactor * T_um * T_um / area_um2 * F2 *
+           series_term_weight(Correlation::Exponential, g, T_um * T_um * vxy2);
+}
 
 }  // namespace roughscope

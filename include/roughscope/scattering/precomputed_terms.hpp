@@ -5,11 +5,11 @@
 //
 // Very rough, with m = σ/T and, per geometry k (q = v/k, see beckmann.hpp),
 //   a_k = F² · rad / q_z²,   b_k = q_xy² / q_z²:
-//   Gaussian (Eq. 4):    B_k(m) = a_k exp(−b_k / (4 m²))
-//   exponential (Eq. 5): B_k(m) = a_k (1 + b_k / m²)^{−3/2}
+//   B_k(m) = a_k P(b_k / m²), P = very_rough_profile (correlation.hpp): exp(−t²/4) (Eq. 4),
+//   (1 + t²)^{−3/2} (Eq. 5)
 // the same numbers as very_rough_brightness (relative difference ≲ 1e-13, from the rounding of the
-// exponential's argument), with the derivative d B_k / d ln m in closed form:
-//   Gaussian: B_k · b_k / (2 m²);   exponential: B_k · 3 (b_k/m²) / (1 + b_k/m²).
+// exponential's argument), with the derivative d B_k / d ln m = B_k d ln P/d ln m in closed form
+// (d_log_very_rough_profile_d_log_slope: t²/2 for Eq. 4, 3t²/(1 + t²) for Eq. 5).
 //
 // Oren–Nayar: L_k(σ, ρ) = ρ A_k(σ) + ρ² B_k(σ) (L1 ∝ ρ, L2 ∝ ρ², reflectance_models.hpp) with
 //   A_k(σ) = (cos θi/π) (C1(σ) + c2(σ) G2_k + c3(σ) G3_k),   B_k(σ) = c4(σ) G4_k,

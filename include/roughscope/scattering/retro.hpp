@@ -7,23 +7,40 @@
 // θ in radians, [0, π/2); lengths in µm. Inputs validated (InvalidArgument).
 #pragma once
 
+#include "roughscope/scattering/correlation.hpp"
+#include "roughscope/scattering/factors.hpp"
+
 namespace roughscope {
 
-// Eq. 7: original B–K (F_Beck), Gaussian correlation, very rough: exp(−T² tan²θ/(4σ²))/cos⁶θ.
-double retro_beckmann_gaussian_very_rough(double theta_rad, double sigma_over_T);
-
-// Eq. 8: original B–K, exponential correlation (Eq. 5): 1/(cos⁶θ [1 + (T/σ)² tan²θ]^{3/2}).
-double retro_beckmann_exponential_very_rough(double theta_rad, double sigma_over_T);
-
-// Eq. 9: V–H modified B–K, Gaussian correlation: exp(−T² tan²θ/(4σ²))/cos θ.
-double retro_vh_gaussian_very_rough(double theta_rad, double sigma_over_T);
-
-// Eq. 10: V–H modified B–K, exponential correlation: 1/(cos θ [1 + (T/σ)² tan²θ]^{3/2}).
-double retro_vh_exponential_very_rough(double theta_rad, double sigma_over_T);
+// Eq. 7–10, very rough: P((T/σ)² tan²θ)/cos⁶θ with F_Beck (Eq. 7 Gaussian, Eq. 8 exponential)
+// or P((T/σ)² tan²θ)/cos θ with F_VH (Eq. 9, Eq. 10), P = very_rough_profile (correlation.hpp):
+// exp(−t²/4) or (1 + t²)^{−3/2}. factor must be Beckmann or VernoldHarvey (else InvalidArgument).
+double retro_very_rough(Correlation correlation, GeometricFactor factor, double theta_rad,
+                        double sigma_over_T);
 
 // Eq. 11: V–H, Gaussian correlation, slightly rough:
 // cos³θ exp(−k²([T sin θ]² + [2σ cos θ]²)), k = 2π/λ.
 double retro_vh_gaussian_slightly_rough(double theta_rad, double sigma_um, double T_um,
                                         double wavelength_um);
+
+// The two-name forms kept for the photograph, CLI and Python code; they forward to
+// retro_very_rough.
+inline double retro_beckmann_gaussian_very_rough(double theta_rad, double sigma_over_T) {  // Eq. 7
+    return retro_very_rough(Correlation::Gaussian, GeometricFactor::Beckmann, theta_rad,
+                            sigma_over_T);
+}
+inline double retro_beckmann_exponential_very_rough(double theta_rad,
+                                                    double sigma_over_T) {  // Eq. 8
+    return retro_very_rough(Correlation::Exponential, GeometricFactor::Beckmann, theta_rad,
+                            sigma_over_T);
+}
+inline double retro_vh_gaussian_very_rough(double theta_rad, double sigma_over_T) {  // Eq. 9
+    return retro_very_rough(Correlation::Gaussian, GeometricFactor::VernoldHarvey, theta_rad,
+                            sigma_over_T);
+}
+inline double retro_vh_exponential_very_rough(double theta_rad, double sigma_over_T) {  // Eq. 10
+    return retro_very_rough(Correlation::Exponential, GeometricFactor::VernoldHarvey, theta_rad,
+                            sigma_over_T);
+}
 
 }  // namespace roughscope

@@ -39,12 +39,18 @@ Json specular_estimate_json(const SpecularInput& input, const RoughnessEstimate&
 Json correlation_length_estimate_json(const CorrelationLengthInput& input,
                                       const RoughnessEstimate& estimate, bool with_stderr);
 
-// `estimate slope` with one or both correlation functions (input.correlation is ignored; give the
+// `estimate slope` with one or more correlation functions (input.correlation is ignored; give the
 // estimates that were computed). θK, ξK, m come from the Gaussian estimate when there is one (as
-// in Table 2). Keys: estimator, sigma_over_T, sigma_over_T_gaussian, sigma_over_T_exponential,
-// sigma_um, T_um (T_um_gaussian/_exponential with both and σ known), derived keys, E1_over_E2,
-// valid_ratio_range_gaussian/_exponential ([lower, upper|null]; null off normal view),
-// geometry1/2, factor, radiometry, warnings. InvalidArgument if neither estimate is given.
+// in Table 2; the first given in kCorrelations order). Keys (<c> = each correlation's name,
+// scattering/correlation.hpp): estimator, sigma_over_T, sigma_over_T_<c> (sigma_over_T_gaussian,
+// sigma_over_T_exponential), sigma_um, T_um (T_um_<c> with all and σ known), derived keys,
+// E1_over_E2, valid_ratio_range_<c> of each given ([lower, upper|null]; null off normal view),
+// geometry1/2, factor, radiometry, warnings (prefixed "<c>: " when more than one is given).
+// InvalidArgument if no estimate is given.
+Json slope_estimate_json(const SlopeInput& input,
+                         const PerCorrelation<std::optional<RoughnessEstimate>>& estimates,
+                         bool with_stderr);
+// The two-name form kept for the CLI and Python code: forwards to the one above.
 Json slope_estimate_json(const SlopeInput& input, const std::optional<RoughnessEstimate>& gaussian,
                          const std::optional<RoughnessEstimate>& exponential, bool with_stderr);
 
@@ -55,9 +61,10 @@ Json slope_estimate_json(const SlopeInput& input, const std::optional<RoughnessE
 // unavailable), residuals and predicted (with_residuals), message, report, warnings.
 Json to_json(const FitResult& fit, bool with_residuals);
 
-// Both correlation functions: preferred_correlation, delta_aic, the preferred fit's σ/T (and σ, T),
-// sigma_over_T_gaussian/_exponential (+ _stderr), θK, ξK, m, class and g of the Gaussian fit,
-// gaussian and exponential (each to_json(FitResult)), warnings (prefixed by the correlation).
+// Every correlation function: preferred_correlation, delta_aic, the preferred fit's σ/T (and σ,
+// T), sigma_over_T_<c> (+ _stderr; sigma_over_T_gaussian, sigma_over_T_exponential), θK, ξK, m,
+// class and g of the Gaussian fit, then one to_json(FitResult) per correlation under its name
+// (gaussian, exponential), warnings (prefixed by the correlation).
 Json to_json(const CorrelationComparison& comparison, bool with_residuals);
 
 // `estimate fit`: estimator, measurements, factor, radiometry, residual, loss, then the keys of

@@ -79,10 +79,18 @@ struct SurfaceStatistics {
     // Standard error of T_um from the variance of the ACF estimator at the crossing (Bartlett's
     // formula over the 2-D lags of the central lobe, delta method: docs/surface.md).
     std::optional<double> T_stderr_um;
-    // Least-squares fits of exp(−τ²/T²) and exp(−|τ|/T) to the ACF; the better by AIC.
+    // Least-squares fits of each correlation function ρ(τ/T) (scattering/correlation.hpp) to the
+    // ACF; the better by AIC. (Two named fields: the form the Python module's statistics
+    // converter writes; T_fit_um(c) reads them by correlation.)
     std::optional<double> T_fit_gaussian_um;
     std::optional<double> T_fit_exponential_um;
-    std::optional<Correlation> correlation;  // scattering/beckmann.hpp
+    std::optional<Correlation> correlation;  // scattering/correlation.hpp
+    std::optional<double>& T_fit_um(Correlation c) {
+        return c == Correlation::Gaussian ? T_fit_gaussian_um : T_fit_exponential_um;
+    }
+    const std::optional<double>& T_fit_um(Correlation c) const {
+        return c == Correlation::Gaussian ? T_fit_gaussian_um : T_fit_exponential_um;
+    }
     // T against 1/L over sub-profiles, extrapolated to 1/L = 0.
     std::optional<double> T_extrapolated_um;
     // A periodic component: the lag of the ACF's first maximum after a significant negative
@@ -139,15 +147,14 @@ std::optional<double> correlation_length_1e(const Curve& acf);
 // (exponential), for a lag τ and a correlation length T > 0 (µm).
 double acf_model(Correlation model, double lag_um, double T_um);
 
-// Least-squares fits of C = exp(−τ²/T²) and C = exp(−|τ|/T) to the points of `acf` with
-// τ ≤ max_lag_um; AIC = n ln(RSS/n) + 2k (k = 1 for both) names the better model. A fit needs 3
+// Least-squares fits of C = ρ(|τ|/T) for every correlation function (scattering/correlation.hpp:
+// exp(−τ²/T²), exp(−|τ|/T)) to the points of `acf` with τ ≤ max_lag_um; AIC = n ln(RSS/n) + 2k
+// (k = 1 for each) names the better model (the first in kCorrelations on a tie). A fit needs 3
 // points; InvalidArgument when max_lag_um is not > 0 or x and y differ in size.
 struct AcfModelFit {
     std::size_t points = 0;
-    std::optional<double> T_gaussian_um;
-    std::optional<double> T_exponential_um;
-    double aic_gaussian = 0;
-    double aic_exponential = 0;
+    PerCorrelation<std::optional<double>> T_um;  // the fitted T of each model
+    PerCorrelation<double> aic;                  // its AIC
     std::optional<Correlation> better;
 };
 AcfModelFit fit_acf_models(const Curve& acf, double max_lag_um);

@@ -514,9 +514,9 @@ TEST(Uncertainty, AnalyticDerivativesMatchFiniteDifferences) {
             return rs::sigma_over_T_exponential_from_ratio(std::exp(lr), t1, t2);
         };
         const double lr = std::log(r);
-        EXPECT_NEAR(rs::d_sigma_over_T_gaussian_d_log_ratio(r, t1, t2),
+        EXPECT_NEAR(rs::d_sigma_over_T_d_log_ratio(rs::Correlation::Gaussian, r, t1, t2),
                     (G(lr + h) - G(lr - h)) / (2 * h), 1e-5 * std::abs(G(lr)));
-        EXPECT_NEAR(rs::d_sigma_over_T_exponential_d_log_ratio(r, t1, t2),
+        EXPECT_NEAR(rs::d_sigma_over_T_d_log_ratio(rs::Correlation::Exponential, r, t1, t2),
                     (E(lr + h) - E(lr - h)) / (2 * h), 1e-5 * std::abs(E(lr)));
     }
     auto T = [&](double s, double lr) {

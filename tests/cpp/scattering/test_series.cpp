@@ -26,10 +26,10 @@
 
 namespace {
 
+using roughscope::Correlation;
+using roughscope::diffuse_series_sum_naive;
 using roughscope::exponential_series_sum;
-using roughscope::exponential_series_sum_naive;
 using roughscope::gaussian_series_sum;
-using roughscope::gaussian_series_sum_naive;
 
 struct ReferenceRow {
     std::string kind;  // "gaussian" or "exponential"
@@ -147,8 +147,9 @@ TEST(SeriesNaive, AgreesWithReferenceForModerateG) {
     for (const ReferenceRow& r : reference_rows()) {
         if (r.g > 50.0) continue;
         const int terms = static_cast<int>(r.g + 10.0 * std::sqrt(r.g) + 20.0);
-        const double s = r.kind == "gaussian" ? gaussian_series_sum_naive(r.g, r.X, terms)
-                                              : exponential_series_sum_naive(r.g, r.X, terms);
+        const double s = r.kind == "gaussian"
+                             ? diffuse_series_sum_naive(Correlation::Gaussian, r.g, r.X, terms)
+                             : diffuse_series_sum_naive(Correlation::Exponential, r.g, r.X, terms);
         // The naive sum starts at n = 1 and stops after `terms`; when large X moves the peak
         // of the summand beyond that, it is not expected to agree.
         if (r.X > 4.0 * terms) continue;
@@ -164,8 +165,10 @@ TEST(SeriesNaive, BreaksBeyondG709WhereTheCarefulSumDoesNot) {
     for (const ReferenceRow& r : reference_rows()) {
         if (r.g < 750.0 || r.g > 1e5) continue;
         const int terms = static_cast<int>(r.g + 10.0 * std::sqrt(r.g) + 20.0);
-        const double naive = r.kind == "gaussian" ? gaussian_series_sum_naive(r.g, r.X, terms)
-                                                  : exponential_series_sum_naive(r.g, r.X, terms);
+        const double naive =
+            r.kind == "gaussian"
+                ? diffuse_series_sum_naive(Correlation::Gaussian, r.g, r.X, terms)
+                : diffuse_series_sum_naive(Correlation::Exponential, r.g, r.X, terms);
         const double careful =
             r.kind == "gaussian" ? gaussian_series_sum(r.g, r.X) : exponential_series_sum(r.g, r.X);
         EXPECT_LE(relative_error(careful, r.value), 1e-12);
@@ -398,11 +401,11 @@ TEST(SeriesEveryG, LargeGFollowsTheVeryRoughLimitWithItsFirstCorrection) {
 }
 
 TEST(SeriesEveryG, MethodAndBoundAreReported) {
-    const auto small = roughscope::gaussian_series(3.0, 1.0);
+    const auto small = roughscope::diffuse_series(Correlation::Gaussian, 3.0, 1.0);
     EXPECT_EQ(small.method, roughscope::DiffuseMethod::Summation);
     EXPECT_GT(small.relative_error_bound, 0.0);
     EXPECT_LE(small.relative_error_bound, 1e-12);
-    const auto large = roughscope::exponential_series(1e15, 1e30);
+    const auto large = roughscope::diffuse_series(Correlation::Exponential, 1e15, 1e30);
     EXPECT_EQ(large.method, roughscope::DiffuseMethod::LargeGExpansion);
     EXPECT_GT(large.relative_error_bound, 0.0);
     EXPECT_LE(large.relative_error_bound, 1e-14);
@@ -412,7 +415,7 @@ TEST(SeriesEveryG, MethodAndBoundAreReported) {
     const double c = 0.25, R1 = c * c / 2 - 2 * c + 1;
     const double R2 = c * c * c * c / 8 - 11 * c * c * c / 6 + 15 * c * c / 2 - 9 * c + 2;
     for (double g : {1e5, 1e6, 1e7, 1e9}) {
-        const auto s = roughscope::gaussian_series(g, 4.0 * c * g);
+        const auto s = roughscope::diffuse_series(Correlation::Gaussian, g, 4.0 * c * g);
         const double expansion = std::exp(-c) / g * (1.0 + R1 / g + R2 / (g * g));
         EXPECT_NEAR(s.value / expansion, 1.0, s.relative_error_bound + 1e-14) << g;
     }

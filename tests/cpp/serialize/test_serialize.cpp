@@ -186,6 +186,51 @@ TEST(SerializeEstimation, SlopeDocumentMatchesTheEstimator) {
                  InvalidArgument);
 }
 
+// The keys generated from the correlation names are the documented ones (docs/estimation.md), in
+// the documented order, with every correlation function given.
+TEST(SerializeEstimation, SlopeKeysGeneratedPerCorrelationAreTheDocumentedOnes) {
+    SlopeInput in;
+    in.E1_over_E2 = 1.880176;
+    in.geom1 = make_geometry(deg_to_rad(45.0), 0.0, 0.0);
+    in.geom2 = make_geometry(deg_to_rad(67.5), 0.0, 0.0);
+    in.sigma_um = 2.0;
+    PerCorrelation<std::optional<RoughnessEstimate>> estimates;
+    for (const Correlation c : kCorrelations) {
+        in.correlation = c;
+        estimates[c] = estimate_slope(in);
+    }
+    const Json j = serialize::slope_estimate_json(in, estimates, true);
+    std::vector<std::string> keys;
+    for (const auto& item : j.items()) keys.push_back(item.key());
+    const std::vector<std::string> documented{"estimator",
+                                              "sigma_over_T",
+                                              "sigma_over_T_stderr",
+                                              "sigma_over_T_gaussian",
+                                              "sigma_over_T_gaussian_stderr",
+                                              "sigma_over_T_exponential",
+                                              "sigma_over_T_exponential_stderr",
+                                              "sigma_um",
+                                              "T_um",
+                                              "T_um_stderr",
+                                              "T_um_gaussian",
+                                              "T_um_gaussian_stderr",
+                                              "T_um_exponential",
+                                              "T_um_exponential_stderr"};
+    ASSERT_GE(keys.size(), documented.size());
+    EXPECT_EQ(std::vector<std::string>(keys.begin(), keys.begin() + documented.size()), documented);
+    for (const char* k : {"valid_ratio_range_gaussian", "valid_ratio_range_exponential"})
+        EXPECT_TRUE(j.contains(k)) << k;
+    // Each correlation's value is its own estimator's; the two-name form gives the same document.
+    for (const Correlation c : kCorrelations)
+        EXPECT_EQ(j[correlation_key("sigma_over_T", c)].get<double>(),
+                  estimates[c]->sigma_over_T->value);
+    EXPECT_EQ(serialize::slope_estimate_json(in, estimates[Correlation::Gaussian],
+                                             estimates[Correlation::Exponential], true)
+                  .dump(),
+              j.dump());
+    EXPECT_THROW(serialize::slope_estimate_json(in, {}, false), InvalidArgument);
+}
+
 TEST(SerializeEstimation, FitOptionsFromNamedValues) {
     const FitOptions o = serialize::fit_options_from(Json{{"model", "slightly_rough"},
                                                           {"correlation", "exponential"},

@@ -147,10 +147,10 @@ TEST(SurfaceAcfFit, ExactCurvesGiveTheirTAndModel) {
     ASSERT_TRUE(fg.better && fe.better);
     EXPECT_EQ(*fg.better, Correlation::Gaussian);
     EXPECT_EQ(*fe.better, Correlation::Exponential);
-    EXPECT_NEAR(*fg.T_gaussian_um, 7.0, 1e-3);
-    EXPECT_NEAR(*fe.T_exponential_um, 7.0, 1e-3);
-    EXPECT_LT(fg.aic_gaussian, fg.aic_exponential);
-    EXPECT_LT(fe.aic_exponential, fe.aic_gaussian);
+    EXPECT_NEAR(*fg.T_um[Correlation::Gaussian], 7.0, 1e-3);
+    EXPECT_NEAR(*fe.T_um[Correlation::Exponential], 7.0, 1e-3);
+    EXPECT_LT(fg.aic[Correlation::Gaussian], fg.aic[Correlation::Exponential]);
+    EXPECT_LT(fe.aic[Correlation::Exponential], fe.aic[Correlation::Gaussian]);
     // Too few points: no fit.
     EXPECT_FALSE(fit_acf_models(g, 0.6).better.has_value());
 }
