@@ -112,10 +112,7 @@ RatioInverseTable RatioInverseTable::sigma_over_T(const Geometry& geom1, const G
                 const double x = std::exp(lx), r = ratio(x);
                 double slope = std::numeric_limits<double>::quiet_NaN();
                 try {
-                    slope =
-                        x / (correlation == Correlation::Gaussian
-                                 ? d_sigma_over_T_gaussian_d_log_ratio(r, t1, t2, model.factor)
-                                 : d_sigma_over_T_exponential_d_log_ratio(r, t1, t2, model.factor));
+                    slope = x / d_sigma_over_T_d_log_ratio(correlation, r, t1, t2, model.factor);
                 } catch (const Error&) {
                     // A ratio beyond double's range or the closed form's: not a node.
                 }

@@ -229,9 +229,7 @@ TEST(RatioInverseTable, NodesAreTheEstimationTopicsRatio) {
             const auto v = table.lookup(y[j]);
             ASSERT_TRUE(v.has_value()) << j;
             EXPECT_NEAR(v->x, x[j], 1e-14 * x[j]) << j;
-            const double d = c == Correlation::Gaussian
-                                 ? d_sigma_over_T_gaussian_d_log_ratio(ratio, kTheta1, kTheta2)
-                                 : d_sigma_over_T_exponential_d_log_ratio(ratio, kTheta1, kTheta2);
+            const double d = d_sigma_over_T_d_log_ratio(c, ratio, kTheta1, kTheta2);
             worst_slope = std::max(worst_slope, std::abs(v->dx_dlog_ratio - d) / std::abs(d));
         }
         EXPECT_LT(worst_slope, 1e-12) << to_string(c);
