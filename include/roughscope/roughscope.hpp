@@ -24,6 +24,7 @@
 // kernel
 #include "roughscope/scattering/beckmann.hpp"
 #include "roughscope/scattering/brightness_batch.hpp"
+#include "roughscope/scattering/correlation.hpp"
 #include "roughscope/scattering/factors.hpp"
 #include "roughscope/scattering/geometry.hpp"
 #include "roughscope/scattering/precomputed_terms.hpp"
