@@ -63,7 +63,10 @@ inline constexpr std::array<CorrelationInfo, kCorrelationCount> kCorrelationInfo
      2.0 * std::numbers::pi, false, false, false, false},
 }};
 
-constexpr const CorrelationInfo& info(Correlation c) { return kCorrelationInfo[index_of(c)]; }
+// (An invalid value — checked with is_valid at the API boundaries — reads the first row.)
+constexpr const CorrelationInfo& info(Correlation c) {
+    return kCorrelationInfo[is_valid(c) ? index_of(c) : 0];
+}
 
 // A JSON key or column name for one correlation: `stem` + "_" + name ("sigma_over_T_gaussian").
 inline std::string correlation_key(std::string_view stem, Correlation c) {
