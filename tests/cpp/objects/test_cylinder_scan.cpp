@@ -23,37 +23,6 @@ using namespace roughscope::image::detail;
 using roughscope::testing::cylinder_law_image;
 using roughscope::testing::lambert_law;
 
-// Per bin, pixel by pixel from the definition: the bin ⌊asin(d/R) / w⌋ of the right half, d from
-// the axis (across_distance_px), |d| ≤ limb · R, in the region, not flagged (counted apart).
-struct Expected {
-    std::vector<std::size_t> count, flagged;
-    std::vector<double> sum, across_sum;
-};
-Expected sums_by_definition(const LinearImage& img, const std::uint8_t* region,
-                            const CylinderAxis& axis, double width_rad, std::size_t bins,
-                            double limb_fraction) {
-    Expected e{std::vector<std::size_t>(bins, 0), std::vector<std::size_t>(bins, 0),
-               std::vector<double>(bins, 0.0), std::vector<double>(bins, 0.0)};
-    const double R = axis.radius_px;
-    for (std::size_t r = 0; r < img.height; ++r)
-        for (std::size_t c = 0; c < img.width; ++c) {
-            const std::size_t i = r * img.width + c;
-            const double d =
-                axis.across_distance_px(static_cast<double>(c) + 0.5, static_cast<double>(r) + 0.5);
-            if (std::abs(d) > limb_fraction * R || d < 0 || (region && !region[i])) continue;
-            const auto b =
-                std::min(bins - 1, static_cast<std::size_t>(std::asin(d / R) / width_rad));
-            if (img.flags[i] != 0) {
-                ++e.flagged[b];
-                continue;
-            }
-            ++e.count[b];
-            e.sum[b] += img.values[i];
-            e.across_sum[b] += d;
-        }
-    return e;
-}
-
 TEST(CylinderScan, SumsDoNotDependOnTheNumberOfThreads) {
     const CylinderAxis axis = cylinder_axis_from_line(250.0, 300.0, 0.2, 1.0, 150.0);
     const LinearImage img =
