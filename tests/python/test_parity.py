@@ -211,10 +211,10 @@ def test_image_info_is_one_schema(tmp_path, index):
     """A photograph's ImageInfo has one conversion (serialize/measure.hpp): the `info` of each
     capture of `measure --json` and the `info` of Python's read_image are the same document for
     the same image and options, and the capture's metadata keys repeat its values."""
-    from roughscope import _core, report_measure
+    from roughscope import _core, demo
 
-    spec = report_measure.DEMO_SAMPLES[index]
-    capture_file = report_measure.write_demo_sample(spec, tmp_path)
+    spec = demo.SAMPLES[index]
+    capture_file = demo.write_sample(spec, tmp_path)
     doc = json.loads(pathlib.Path(capture_file).read_text(encoding="utf-8"))
     result = cli_json("measure", capture_file)
     for spec_capture, capture in zip(doc["captures"], result["captures"]):
