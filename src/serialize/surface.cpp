@@ -108,7 +108,7 @@ Json to_json(const StatisticsInput& input, const surface::SurfaceStatistics& s, 
     j["T_y_um"] = number(s.T_y_um);
     j["T_stderr_um"] = number(s.T_stderr_um);
     for (const Correlation c : kCorrelations)
-        j["T_fit_" + std::string(info(c).name) + "_um"] = number(s.T_fit_um(c));
+        j["T_fit_" + std::string(info(c).name) + "_um"] = number(s.fitted_T_um(c));
     j["correlation"] = s.correlation ? Json(std::string(to_string(*s.correlation))) : Json(nullptr);
     j["T_extrapolated_um"] = number(s.T_extrapolated_um);
     j["period_um"] = number(s.period_um);

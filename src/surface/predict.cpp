@@ -33,7 +33,7 @@ SurfaceFromStatistics surface_from_statistics(const SurfaceStatistics& stats,
             "the height statistics name no correlation function (neither fit succeeded): "
             "Gaussian assumed");
     }
-    const std::optional<double> fitted = stats.T_fit_um(out.surface.correlation);
+    const std::optional<double> fitted = stats.fitted_T_um(out.surface.correlation);
     if (stats.T_um && std::isfinite(*stats.T_um) && *stats.T_um > 0.0) {
         out.surface.T_um = *stats.T_um;
         out.T_source = "T_um";

@@ -484,7 +484,7 @@ SurfaceStatistics surface_statistics(HeightMap map, const StatisticsOptions& opt
     if (st.T_um) {
         const double max_lag = std::min(kFitLagOverT * *st.T_um, 0.5 * levelled.length_x_um());
         const AcfModelFit fit = fit_acf_models(acf_x, max_lag);
-        for (const Correlation c : kCorrelations) st.T_fit_um(c) = fit.T_um[c];
+        for (const Correlation c : kCorrelations) st.fitted_T_um(c) = fit.T_um[c];
         st.correlation = fit.better;
         st.T_extrapolated_um = extrapolated_T_um(levelled, estimator, *st.T_um / levelled.dx_um);
         st.m_from_T = st.sigma_um * std::sqrt(2.0) / *st.T_um;

@@ -81,14 +81,14 @@ struct SurfaceStatistics {
     std::optional<double> T_stderr_um;
     // Least-squares fits of each correlation function ρ(τ/T) (scattering/correlation.hpp) to the
     // ACF; the better by AIC. (Two named fields: the form the Python module's statistics
-    // converter writes; T_fit_um(c) reads them by correlation.)
+    // converter writes; fitted_T_um(c) reads them by correlation.)
     std::optional<double> T_fit_gaussian_um;
     std::optional<double> T_fit_exponential_um;
     std::optional<Correlation> correlation;  // scattering/correlation.hpp
-    std::optional<double>& T_fit_um(Correlation c) {
+    std::optional<double>& fitted_T_um(Correlation c) {
         return c == Correlation::Gaussian ? T_fit_gaussian_um : T_fit_exponential_um;
     }
-    const std::optional<double>& T_fit_um(Correlation c) const {
+    const std::optional<double>& fitted_T_um(Correlation c) const {
         return c == Correlation::Gaussian ? T_fit_gaussian_um : T_fit_exponential_um;
     }
     // T against 1/L over sub-profiles, extrapolated to 1/L = 0.
