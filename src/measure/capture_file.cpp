@@ -349,13 +349,27 @@ void check_specular_geometry(const JsonNode& c, const CaptureSpec& spec,
                      "°, phi_s = ", format_message(deg[2], 15), "°"));
 }
 
+double tolerance(const JsonNode& j, std::string_view key, double hi, std::string_view unit) {
+    return j.at(key).number(0.0, hi, unit);
+}
+
+void parse_capture_uncertainty(const JsonNode& j, CaptureTolerances& t) {
+    j.only({"angle_deg", "theta_i_deg", "theta_s_deg", "phi_s_deg", "exposure_rel"});
+    if (j.has("angle_deg"))
+        t.theta_i_deg = t.theta_s_deg = t.phi_s_deg = tolerance(j, "angle_deg", 45.0, "°");
+    if (j.has("theta_i_deg")) t.theta_i_deg = tolerance(j, "theta_i_deg", 45.0, "°");
+    if (j.has("theta_s_deg")) t.theta_s_deg = tolerance(j, "theta_s_deg", 45.0, "°");
+    if (j.has("phi_s_deg")) t.phi_s_deg = tolerance(j, "phi_s_deg", 45.0, "°");
+    if (j.has("exposure_rel")) t.exposure_rel = tolerance(j, "exposure_rel", 1.0, "");
+}
+
 // "captures": [...] (and the check of "exposures_equal" against the exposures they give).
 void parse_captures(const Context& ctx, const JsonNode& doc, bool curved, MeasureRequest& request) {
     if (!doc.has("captures") || !doc.at("captures").is_array() || doc.at("captures").size() == 0)
         doc.fail_at("captures", "must be a non-empty array of captures");
     for (const JsonNode& c : doc.at("captures").array()) {
         c.only({"image", "bracket", "theta_i_deg", "theta_s_deg", "phi_s_deg", "light", "view",
-                "exposure_s", "role", "description"});
+                "exposure_s", "role", "uncertainty", "description"});
         CaptureSpec spec;
         if (c.has("image") == c.has("bracket"))
             c.fail("needs \"image\" (a file) or \"bracket\" (an exposure bracket), one of them");
@@ -372,6 +386,7 @@ void parse_captures(const Context& ctx, const JsonNode& doc, bool curved, Measur
         const std::array<double, 3> deg = parse_capture_geometry(c, curved, spec);
         if (const auto e = c.find("exposure_s")) spec.exposure_s = Context::exposure(*e);
         if (c.has("role")) spec.role = c.at("role").named(parse_capture_role);
+        if (c.has("uncertainty")) parse_capture_uncertainty(c.at("uncertainty"), spec.uncertainty);
         if (spec.role == CaptureRole::Specular && !curved) check_specular_geometry(c, spec, deg);
         request.captures.push_back(std::move(spec));
     }
@@ -441,6 +456,28 @@ void parse_statistics(const JsonNode& s, RegionStatisticsOptions& o) {
     }
 }
 
+// "uncertainty": the setup's standard uncertainties (k = 1, budget.hpp) and how to propagate
+// them; a capture's own "uncertainty" overrides its angles and exposure.
+void parse_uncertainty(const JsonNode& j, MeasureRequest& request) {
+    j.only({"angle_deg", "exposure_rel", "black_level_dn", "response_gamma", "wavelength_um",
+            "flat_field_rel", "method", "seed", "max_trials"});
+    SetupTolerances& t = request.uncertainty;
+    if (j.has("angle_deg")) t.angle_deg = tolerance(j, "angle_deg", 45.0, "°");
+    if (j.has("exposure_rel")) t.exposure_rel = tolerance(j, "exposure_rel", 1.0, "");
+    if (j.has("black_level_dn")) t.black_level_dn = tolerance(j, "black_level_dn", 1e9, " DN");
+    if (j.has("response_gamma")) t.response_gamma = tolerance(j, "response_gamma", 5.0, "");
+    if (j.has("wavelength_um")) t.wavelength_um = tolerance(j, "wavelength_um", 1.0, " µm");
+    if (j.has("flat_field_rel")) t.flat_field_rel = tolerance(j, "flat_field_rel", 1.0, "");
+    if (j.has("method")) request.propagation.method = j.at("method").named(parse_propagation_method);
+    if (j.has("seed"))
+        request.propagation.seed =
+            static_cast<std::uint64_t>(j.at("seed").integer(0, 9'007'199'254'740'992LL));
+    if (j.has("max_trials"))
+        request.propagation.max_trials = static_cast<std::size_t>(
+            j.at("max_trials").integer(static_cast<long long>(request.propagation.batch_trials),
+                                       10'000'000));
+}
+
 MeasureRequest parse_document(const io::JsonValue& value, const std::string& path) {
     const JsonNode doc(value, path);
     const Context ctx{std::filesystem::path(path).parent_path()};
@@ -467,6 +504,7 @@ MeasureRequest parse_document(const io::JsonValue& value, const std::string& pat
               "object",
               "maps",
               "exposures_equal",
+              "uncertainty",
               "description"});
     MeasureRequest request;
     request.source = path;
@@ -509,6 +547,7 @@ MeasureRequest parse_document(const io::JsonValue& value, const std::string& pat
     if (doc.has("highlight")) parse_highlight(doc.at("highlight"), request.highlight);
     if (doc.has("statistics")) parse_statistics(doc.at("statistics"), request.statistics);
     if (doc.has("object")) request.object = parse_object(ctx, doc.at("object"));
+    if (doc.has("uncertainty")) parse_uncertainty(doc.at("uncertainty"), request);
     if (doc.has("maps")) request.maps = parse_maps(ctx, doc.at("maps"));
     const bool curved = request.object.shape != ObjectShape::Plane;
     if (doc.has("roi"))

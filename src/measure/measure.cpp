@@ -89,6 +89,7 @@ void check_request(const MeasureRequest& request) {
                                          ", ", check::format_number(kMaxExposureS), "] s"));
     }
     check_combination(request);
+    detail::check_tolerances(request);
 }
 
 // What the captures, the object and the maps ask for together. A capture file's combination
@@ -789,6 +790,9 @@ MeasureResult measure(const MeasureRequest& request) {
         }
     }
     if (diffuse.size() >= 2) estimate_diffuse(diffuse, request, known, result);
+    result.uncertainty = uncertainty_budget(request, result);
+    if (result.uncertainty)
+        for (const auto& w : result.uncertainty->warnings) result.warnings.push_back(w);
 
     if (request.maps) {
         MapOptions options = request.maps->options;

@@ -79,4 +79,8 @@ void check_same_recording(const LinearImage& frame, const LinearImage& capture,
 void assumption_warnings(const MeasureRequest& request, const CaptureSpec& spec,
                          const ImageInfo& info, std::vector<std::string>& warnings);
 
+// Throws InvalidArgument naming the key unless every declared standard uncertainty of the setup
+// and of the captures (budget.hpp) is finite and ≥ 0 (budget.cpp).
+void check_tolerances(const MeasureRequest& request);
+
 }  // namespace roughscope::image::detail

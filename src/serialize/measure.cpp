@@ -308,6 +308,48 @@ Json to_json(const image::RegionStatistics& s) {
     return out;
 }
 
+namespace {
+
+// The budget (measure/budget.hpp): for each headline quantity Q, Q_uncertainty (k = 1) and
+// Q_interval95 beside Q and Q_stderr (the statistical part), and the budget's lines.
+void put_budget(Json& out, const std::optional<image::UncertaintyBudget>& b) {
+    for (const char* q : image::kBudgetQuantities) {
+        out[std::string(q) + "_uncertainty"] = Json();
+        out[std::string(q) + "_interval95"] = Json();
+    }
+    Json budget = Json::object();
+    if (b) {
+        for (const image::QuantityBudget& q : b->quantities) {
+            const OutputUncertainty& u = q.result;
+            out[q.quantity + "_uncertainty"] = number(u.uncertainty);
+            out[q.quantity + "_interval95"] =
+                Json::array({number(u.interval95_low), number(u.interval95_high)});
+            Json lines = Json::array();
+            for (const BudgetLine& line : u.budget) {
+                Json l;
+                l["source"] = line.source;
+                l["u_input"] = number(line.u_input);
+                l["sensitivity"] = number(line.sensitivity);
+                l["contribution"] = number(line.contribution);
+                l["fraction"] = number(line.fraction);
+                lines.push_back(l);
+            }
+            budget[q.quantity] = lines;
+        }
+    }
+    out["uncertainty_method"] = b ? Json(std::string(to_string(b->method))) : Json();
+    out["uncertainty_method_reason"] =
+        b && !b->method_reason.empty() ? Json(b->method_reason) : Json();
+    out["uncertainty_trials"] =
+        b && !b->quantities.empty() && b->method == PropagationMethod::MonteCarlo
+            ? Json(b->quantities.front().result.trials)
+            : Json();
+    out["uncertainty_budget"] = b ? budget : Json();
+    out["uncertainty_assumed"] = b ? Json(b->assumed) : Json();
+}
+
+}  // namespace
+
 Json to_json(const image::MeasureResult& r, const image::MeasureRequest& request) {
     Json out;
     out["format"] = "roughscope-measurement";
@@ -424,6 +466,7 @@ Json to_json(const image::MeasureResult& r, const image::MeasureRequest& request
     Json captures = Json::array();
     for (const auto& c : r.captures) captures.push_back(capture_json(c));
     out["captures"] = captures;
+    put_budget(out, r.uncertainty);
     out["warnings"] = r.warnings;
     return out;
 }

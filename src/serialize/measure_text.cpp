@@ -36,6 +36,32 @@ std::string value_with_error(const Json& doc, const std::string& key,
     return unit.empty() ? text : concat(text, " ", unit);
 }
 
+// The value to the decimal place that "value ± error" gives it (core/uncertainty.hpp).
+std::string at_place_of(double value, double error, const std::string& name) {
+    const std::string text = format_uncertain(value, error, kTextDigits, name);
+    return text.substr(0, text.find(" ± "));
+}
+
+// With a budget (measure/budget.hpp): "0.300 ± 0.012 (k=1, 95 % [0.277, 0.324]); largest:
+// theta_i of capture 2 (71 %)"; without one, the value and its statistical standard error.
+std::string value_with_uncertainty(const Json& doc, const std::string& key,
+                                   const std::string& unit = "") {
+    const auto& u = doc[key + "_uncertainty"];
+    if (doc[key].is_null() || u.is_null()) return value_with_error(doc, key, unit);
+    const double value = doc[key].get<double>();
+    const double uncertainty = u.get<double>();
+    const auto& interval = doc[key + "_interval95"];
+    std::string text = format_uncertain(value, uncertainty, kTextDigits, key);
+    if (!unit.empty()) text = concat(text, " ", unit);
+    text = concat(text, " (k=1, 95 % [", at_place_of(interval[0].get<double>(), uncertainty, key),
+                  ", ", at_place_of(interval[1].get<double>(), uncertainty, key), "])");
+    const auto& lines = doc["uncertainty_budget"][key];
+    if (!lines.empty())
+        text = concat(text, "; largest: ", printable_text(lines[0]["source"].get<std::string>()),
+                      " (", format_fixed(100.0 * lines[0]["fraction"].get<double>(), 0), " %)");
+    return text;
+}
+
 }  // namespace
 
 std::string measure_text(const Json& doc) {
@@ -47,11 +73,11 @@ std::string measure_text(const Json& doc) {
             "region",
             concat(printable_text(doc["region"]["description"].get<std::string>()), " (",
                    std::to_string(doc["region"]["pixels"].get<std::size_t>()), " pixels)"));
-    items.emplace_back("E1/E2", value_with_error(doc, "E1_over_E2"));
-    items.emplace_back("sigma/T (Gaussian)", value_with_error(doc, "sigma_over_T_gaussian"));
-    items.emplace_back("sigma/T (exponential)", value_with_error(doc, "sigma_over_T_exponential"));
-    items.emplace_back("sigma", value_with_error(doc, "sigma_um", "um"));
-    items.emplace_back("T", value_with_error(doc, "T_um", "um"));
+    items.emplace_back("E1/E2", value_with_uncertainty(doc, "E1_over_E2"));
+    items.emplace_back("sigma/T (Gaussian)", value_with_uncertainty(doc, "sigma_over_T_gaussian"));
+    items.emplace_back("sigma/T (exponential)", value_with_uncertainty(doc, "sigma_over_T_exponential"));
+    items.emplace_back("sigma", value_with_uncertainty(doc, "sigma_um", "um"));
+    items.emplace_back("T", value_with_uncertainty(doc, "T_um", "um"));
     items.emplace_back("theta_K", value_with_error(doc, "theta_K_deg", "deg"));
     items.emplace_back("xi_K", value_with_error(doc, "xi_K"));
     const auto& cls = doc["roughness_class"];
@@ -94,6 +120,14 @@ std::string measure_text(const Json& doc) {
     std::ostringstream out;
     out << key_value_lines(items);
     // Names and paths from the capture file: control characters escaped (core/text.hpp).
+    if (const auto& m = doc["uncertainty_method"]; !m.is_null())
+        out << concat("uncertainty: ", m.get<std::string>() == "monte_carlo"
+                                           ? concat("Monte Carlo (", std::to_string(
+                                                        doc["uncertainty_trials"].get<std::size_t>()),
+                                                    " trials)")
+                                           : std::string("first order"),
+                      "; ± is the combined standard uncertainty (setup and pixel noise), "
+                      "--json gives each quantity's budget\n");
     for (const auto& w : doc["warnings"])
         out << "warning: " << printable_text(w.get<std::string>()) << '\n';
     return out.str();

@@ -22,6 +22,7 @@
 #include "roughscope/estimation/estimation.hpp"
 #include "roughscope/fit/fit.hpp"
 #include "roughscope/maps/maps.hpp"
+#include "roughscope/measure/budget.hpp"
 #include "roughscope/objects/cylinder.hpp"
 #include "roughscope/objects/sphere.hpp"
 #include "roughscope/photo/hdr.hpp"
@@ -72,6 +73,7 @@ struct CaptureSpec {
     // MeasureRequest::exposures_equal says they are the same.
     std::optional<double> exposure_s;
     CaptureRole role = CaptureRole::Diffuse;
+    CaptureTolerances uncertainty;  // the capture's own standard uncertainties (budget.hpp)
 };
 
 // What was photographed (docs/measure.md "Curved objects and maps"): a flat sample (the §4
@@ -135,6 +137,10 @@ struct MeasureRequest {
     // every result is the same whatever the number. Each capture in flight holds its decoded
     // image, so the peak memory grows with the number.
     std::size_t threads = 0;
+    // The setup's standard uncertainties and how they are propagated (budget.hpp,
+    // docs/uncertainty.md).
+    SetupTolerances uncertainty;
+    PropagationOptions propagation;
 };
 
 // Standard errors: a standard error that the captures cannot give (a region of one pixel, or no
@@ -184,8 +190,17 @@ struct MeasureResult {
     std::optional<CylinderProfile> cylinder;
     std::optional<SphereResult> sphere;
     std::optional<RoughnessMap> map;
+    // A flat sample's budget (budget.hpp): the declared (or assumed) setup uncertainties and the
+    // pixel noise propagated to E1/E2, σ/T, σ and T. Absent for curved objects and maps alone.
+    std::optional<UncertaintyBudget> uncertainty;
     std::vector<std::string> warnings;
 };
+
+// The budget of a flat sample's measurement (measure() fills MeasureResult::uncertainty with it):
+// from the first two diffuse captures (E1/E2, σ/T, T given σ) and the first specular capture (σ)
+// or the given σ. Absent when the result has none of those quantities.
+std::optional<UncertaintyBudget> uncertainty_budget(const MeasureRequest& request,
+                                                    const MeasureResult& result);
 
 // Reads every capture, measures the region and estimates what the captures allow. Throws
 // DataError (a file: missing, unreadable, sizes that differ; a dark frame or flat field recorded

@@ -1,0 +1,64 @@
+// The uncertainty budget of a measurement (docs/uncertainty.md): the setup's declared standard
+// uncertainties (the capture file's "uncertainty"), propagated with the pixel noise to every
+// headline quantity by estimation/propagation.hpp.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "roughscope/estimation/propagation.hpp"
+
+namespace roughscope::image {
+
+// Standard uncertainties (k = 1) of a setup. Unset: the default of a hand-set bench below, listed
+// in the result as assumed.
+struct SetupTolerances {
+    std::optional<double> angle_deg;       // every light and view zenith and azimuth, degrees
+    std::optional<double> exposure_rel;    // each capture's exposure scale, relative
+    std::optional<double> black_level_dn;  // the black level: one error for every photograph, DN
+    std::optional<double> response_gamma;  // γ, or the sRGB curve's exponent (2.4)
+    std::optional<double> wavelength_um;   // the effective wavelength, µm
+    std::optional<double> flat_field_rel;  // the flat field between two regions, relative
+};
+
+// A capture's own standard uncertainties, over the setup's.
+struct CaptureTolerances {
+    std::optional<double> theta_i_deg;
+    std::optional<double> theta_s_deg;
+    std::optional<double> phi_s_deg;
+    std::optional<double> exposure_rel;
+};
+
+// The defaults of a hand-set bench (docs/uncertainty.md "Defaults"): angles read off a protractor
+// to about ½°, a shutter repeatable to 1 %, a black level known to 0.2 % of full scale (RAW: 0.05
+// %, the metadata's), a response exponent to 0.05, the effective wavelength of a colour channel
+// or of the RGB average to 20 nm, a flat field to 1 % (0.2 % when one is given).
+inline constexpr double kDefaultAngleUncertaintyDeg = 0.5;
+inline constexpr double kDefaultExposureUncertaintyRel = 0.01;
+inline constexpr double kDefaultBlackLevelFraction = 0.002;
+inline constexpr double kDefaultRawBlackLevelFraction = 0.0005;
+inline constexpr double kDefaultResponseGammaUncertainty = 0.05;
+inline constexpr double kDefaultWavelengthUncertaintyUm = 0.02;
+inline constexpr double kDefaultFlatFieldUncertaintyRel = 0.01;
+inline constexpr double kDefaultFlatFieldGivenUncertaintyRel = 0.002;
+
+// The headline quantities, in the order of UncertaintyBudget::quantities.
+inline constexpr const char* kBudgetQuantities[] = {
+    "E1_over_E2", "sigma_over_T_gaussian", "sigma_over_T_exponential", "sigma_um", "T_um"};
+
+struct QuantityBudget {
+    std::string quantity;  // one of kBudgetQuantities
+    OutputUncertainty result;
+};
+
+struct UncertaintyBudget {
+    PropagationMethod method = PropagationMethod::FirstOrder;  // as used
+    std::string method_reason;  // why Monte Carlo was used, else empty
+    std::vector<QuantityBudget> quantities;  // those the measurement has, in kBudgetQuantities order
+    // The tolerances taken from the defaults ("angle_deg = 0.5"): the budget rests on them.
+    std::vector<std::string> assumed;
+    std::vector<std::string> warnings;
+};
+
+}  // namespace roughscope::image

@@ -1,0 +1,254 @@
+// The uncertainty budget of a measurement (measure/budget.hpp, docs/uncertainty.md) on synthetic
+// captures (simulation/capture.hpp) whose setup is off from the capture file's nominal values by
+// errors drawn from the declared uncertainties: the true σ/T must lie inside the stated 95 %
+// interval in at least 90 % of the runs; the largest source of the budget is the one declared
+// largest; first order and Monte Carlo agree where the model is near-linear; the budget's value
+// is the measured value; assumed tolerances are said.
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <filesystem>
+#include <random>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "../io/test_files.hpp"
+#include "../maps/map_captures.hpp"
+#include "roughscope/core/errors.hpp"
+#include "roughscope/core/text.hpp"
+#include "roughscope/io/output_file.hpp"
+#include "roughscope/measure/measure.hpp"
+#include "roughscope/simulation/capture.hpp"
+
+namespace roughscope::image {
+namespace {
+
+namespace fs = std::filesystem;
+namespace sim = roughscope::simulation;
+using roughscope::testing::very_rough_truth;
+
+// The true setup of one run, and what the capture file says of it.
+struct Bench {
+    double theta1_deg = 30.0, theta2_deg = 45.0;  // true light zeniths
+    double view_x_deg = 0.0, view_y_deg = 0.0;   // true camera tilt (in and out of the plane)
+    double exposure1 = 1.0, exposure2 = 1.0;     // true exposure times, s
+    double black_dn = 2000.0;                    // true black level, DN
+};
+
+constexpr double kNominalBlackDn = 2000.0;
+
+// Renders the pair of `bench` as 16-bit TIFFs (32 × 32) and measures it with the nominal setup
+// (30°, 45°, camera on the normal, 1 s, black 2000 DN) and the declared `uncertainty` object.
+MeasureResult measure_bench(const fs::path& dir, const Bench& bench, double sigma_over_T,
+                            Correlation correlation, const std::string& uncertainty,
+                            std::uint64_t seed) {
+    sim::Scene scene;
+    scene.width = scene.height = 32;
+    scene.view = Eigen::Vector3d(std::tan(deg_to_rad(bench.view_x_deg)),
+                                 std::tan(deg_to_rad(bench.view_y_deg)), 1.0)
+                     .normalized();
+    const sim::SurfaceTruth truth = very_rough_truth(sigma_over_T, correlation);
+    const double peak = std::max(
+        sim::surface_brightness(truth, normal_view_geometry(deg_to_rad(30.0))),
+        sim::surface_brightness(truth, normal_view_geometry(deg_to_rad(45.0))));
+    sim::CaptureOptions options;
+    options.keep_geometry = false;
+    options.keep_radiance = false;
+    options.threads = 1;
+    std::vector<std::string> files;
+    for (int k = 0; k < 2; ++k) {
+        sim::CameraModel camera;
+        camera.bit_depth = 16;
+        camera.full_well_e = 1e6;
+        camera.gain_dn_per_e = 0.05;
+        camera.black_level_dn = bench.black_dn;
+        camera.electrons_per_unit_s = 0.6 * camera.full_well_e / peak;
+        camera.exposure_s = k == 0 ? bench.exposure1 : bench.exposure2;
+        camera.seed = seed * 2 + static_cast<std::uint64_t>(k);
+        scene.light = sim::direction_from_angles(
+            deg_to_rad(k == 0 ? bench.theta1_deg : bench.theta2_deg), kPi);
+        const sim::Capture c = sim::render_capture(scene, {truth}, {}, camera, options);
+        files.push_back((dir / concat("c", std::to_string(k), ".tiff")).string());
+        io::write_file_atomic(files.back(), sim::encode_capture_tiff(c));
+    }
+    const std::string text = concat(
+        R"({"roi": {"rect": [4, 4, 24, 24]}, "black_level_dn": )",
+        check::format_number(kNominalBlackDn), R"(, "uncertainty": )", uncertainty,
+        R"(, "captures": [{"image": ")", files[0],
+        R"(", "theta_i_deg": 30, "exposure_s": 1}, {"image": ")", files[1],
+        R"(", "theta_i_deg": 45, "exposure_s": 1}]})");
+    return measure(parse_capture_file(text, (dir / "capture.json").string()));
+}
+
+const QuantityBudget* quantity(const MeasureResult& r, const std::string& name) {
+    if (!r.uncertainty) return nullptr;
+    for (const auto& q : r.uncertainty->quantities)
+        if (q.quantity == name) return &q;
+    return nullptr;
+}
+
+// ≥ 200 runs: angles (in and out of the plane of incidence), exposures and black level drawn
+// from the declared uncertainties; the truth inside the 95 % interval in ≥ 90 % of the runs, for
+// both correlations (each rendered with its own model).
+TEST(MeasureBudget, TheIntervalCoversTheTruthOfAPerturbedBench) {
+    const fs::path dir = testing::fresh_dir("budget_coverage");
+    const double u_angle = 0.5, u_exposure = 0.01, u_black = 40.0;
+    const std::string declared = concat(
+        R"({"angle_deg": )", check::format_number(u_angle), R"(, "exposure_rel": )",
+        check::format_number(u_exposure), R"(, "black_level_dn": )", check::format_number(u_black),
+        "}");
+    std::mt19937_64 rng(20261207);
+    std::normal_distribution<double> z(0.0, 1.0);
+    for (const Correlation correlation : {Correlation::Gaussian, Correlation::Exponential}) {
+        const std::string key = correlation_key("sigma_over_T", correlation);
+        const double truth = 0.3;
+        int covered = 0, runs = 0;
+        double width_sum = 0.0;
+        for (int run = 0; run < 110; ++run) {
+            Bench b;
+            b.theta1_deg += u_angle * z(rng);
+            b.theta2_deg += u_angle * z(rng);
+            b.view_x_deg = u_angle * z(rng);
+            b.view_y_deg = u_angle * z(rng);
+            b.exposure1 *= 1.0 + u_exposure * z(rng);
+            b.exposure2 *= 1.0 + u_exposure * z(rng);
+            b.black_dn += u_black * z(rng);
+            const MeasureResult r = measure_bench(dir, b, truth, correlation, declared,
+                                                  static_cast<std::uint64_t>(run));
+            const QuantityBudget* q = quantity(r, key);
+            ASSERT_NE(q, nullptr) << key;
+            ++runs;
+            width_sum += q->result.interval95_high - q->result.interval95_low;
+            if (truth >= q->result.interval95_low && truth <= q->result.interval95_high) ++covered;
+            // Nothing assumed: every source was declared.
+            EXPECT_TRUE(r.uncertainty->assumed.empty());
+        }
+        const double coverage = static_cast<double>(covered) / runs;
+        EXPECT_GE(coverage, 0.90) << key << ": " << covered << " of " << runs;
+        // Not covered by being huge: the mean interval is within a few per cent of σ/T.
+        EXPECT_LT(width_sum / runs, 0.5 * truth) << key;
+        std::printf("[ budget   ] %s: truth inside the 95 %% interval in %d of %d runs, mean "
+                    "width %.4f\n",
+                    key.c_str(), covered, runs, width_sum / runs);
+    }
+}
+
+// The control: the same bench declared ten times better than it is: the intervals no longer
+// cover the truth (the coverage test above can fail).
+TEST(MeasureBudget, AnUnderstatedSetupIsNotCovered) {
+    const fs::path dir = testing::fresh_dir("budget_understated");
+    std::mt19937_64 rng(7);
+    std::normal_distribution<double> z(0.0, 1.0);
+    int covered = 0;
+    const int runs = 60;
+    for (int run = 0; run < runs; ++run) {
+        Bench b;
+        b.theta1_deg += 0.5 * z(rng);
+        b.theta2_deg += 0.5 * z(rng);
+        b.exposure1 *= 1.0 + 0.01 * z(rng);
+        b.exposure2 *= 1.0 + 0.01 * z(rng);
+        b.black_dn += 40.0 * z(rng);
+        const MeasureResult r =
+            measure_bench(dir, b, 0.3, Correlation::Gaussian,
+                          R"({"angle_deg": 0.05, "exposure_rel": 0.001, "black_level_dn": 4})",
+                          static_cast<std::uint64_t>(run));
+        const QuantityBudget* q = quantity(r, "sigma_over_T_gaussian");
+        ASSERT_NE(q, nullptr);
+        if (0.3 >= q->result.interval95_low && 0.3 <= q->result.interval95_high) ++covered;
+    }
+    EXPECT_LT(covered, runs * 6 / 10) << covered << " of " << runs;
+}
+
+// The largest declared source leads the budget: one tolerance made dominant at a time.
+TEST(MeasureBudget, TheLargestDeclaredSourceLeadsTheBudget) {
+    const fs::path dir = testing::fresh_dir("budget_largest");
+    const Bench nominal;
+    const struct {
+        const char* declared;
+        const char* leader;  // the start of the leading source's name
+    } cases[] = {
+        {R"({"angle_deg": 3, "exposure_rel": 0.001, "black_level_dn": 1})", "theta_i of capture"},
+        {R"({"angle_deg": 0.01, "exposure_rel": 0.05, "black_level_dn": 1})", "exposure of capture"},
+        {R"({"angle_deg": 0.01, "exposure_rel": 0.001, "black_level_dn": 400})", "black level"},
+    };
+    for (const auto& c : cases) {
+        const MeasureResult r =
+            measure_bench(dir, nominal, 0.3, Correlation::Gaussian, c.declared, 7);
+        const QuantityBudget* q = quantity(r, "sigma_over_T_gaussian");
+        ASSERT_NE(q, nullptr);
+        ASSERT_FALSE(q->result.budget.empty());
+        EXPECT_EQ(q->result.budget[0].source.rfind(c.leader, 0), 0U)
+            << c.declared << ": " << q->result.budget[0].source;
+        double sum = 0.0;
+        for (const auto& line : q->result.budget) sum += line.fraction;
+        EXPECT_NEAR(sum, 1.0, 1e-9);
+    }
+}
+
+// The budget's value is the measured value; u covers at least the statistical standard error;
+// Monte Carlo agrees with first order on this near-linear case (u within 10 %).
+TEST(MeasureBudget, FirstOrderAndMonteCarloAgreeWhereTheModelIsNearLinear) {
+    const fs::path dir = testing::fresh_dir("budget_methods");
+    const Bench nominal;
+    const std::string fo = R"({"angle_deg": 0.5, "exposure_rel": 0.01, "black_level_dn": 40,
+                               "method": "first_order"})";
+    const std::string mc = R"({"angle_deg": 0.5, "exposure_rel": 0.01, "black_level_dn": 40,
+                               "method": "monte_carlo", "seed": 3})";
+    const MeasureResult a = measure_bench(dir, nominal, 0.3, Correlation::Gaussian, fo, 11);
+    const MeasureResult b = measure_bench(dir, nominal, 0.3, Correlation::Gaussian, mc, 11);
+    ASSERT_TRUE(a.uncertainty && b.uncertainty);
+    EXPECT_EQ(a.uncertainty->method, PropagationMethod::FirstOrder);
+    EXPECT_EQ(b.uncertainty->method, PropagationMethod::MonteCarlo);
+    for (const char* name : {"E1_over_E2", "sigma_over_T_gaussian", "sigma_over_T_exponential"}) {
+        const QuantityBudget* qa = quantity(a, name);
+        const QuantityBudget* qb = quantity(b, name);
+        ASSERT_TRUE(qa && qb) << name;
+        EXPECT_NEAR(qb->result.uncertainty, qa->result.uncertainty, 0.1 * qa->result.uncertainty)
+            << name;
+        EXPECT_GE(qb->result.trials, 20000U);
+    }
+    ASSERT_TRUE(a.slope_gaussian && a.E1_over_E2);
+    EXPECT_DOUBLE_EQ(quantity(a, "sigma_over_T_gaussian")->result.value,
+                     a.slope_gaussian->sigma_over_T->value);
+    EXPECT_DOUBLE_EQ(quantity(a, "E1_over_E2")->result.value, a.E1_over_E2->value);
+    EXPECT_GT(quantity(a, "sigma_over_T_gaussian")->result.uncertainty,
+              a.slope_gaussian->sigma_over_T->std_error);
+}
+
+// Near the end of Eq. 16's valid range (σ/T large: E1/E2 close to its limit C) the model is not
+// near-linear: Auto takes Monte Carlo and its interval is wider than first order's.
+TEST(MeasureBudget, MonteCarloIsWiderNearTheEndOfTheRatiosRange) {
+    const fs::path dir = testing::fresh_dir("budget_range_end");
+    const Bench nominal;
+    const std::string fo = R"({"angle_deg": 1, "exposure_rel": 0.01, "black_level_dn": 40,
+                               "method": "first_order"})";
+    const std::string au = R"({"angle_deg": 1, "exposure_rel": 0.01, "black_level_dn": 40})";
+    const MeasureResult a = measure_bench(dir, nominal, 2.0, Correlation::Gaussian, fo, 5);
+    const MeasureResult b = measure_bench(dir, nominal, 2.0, Correlation::Gaussian, au, 5);
+    const QuantityBudget* qa = quantity(a, "sigma_over_T_gaussian");
+    const QuantityBudget* qb = quantity(b, "sigma_over_T_gaussian");
+    ASSERT_TRUE(qa && qb);
+    EXPECT_EQ(b.uncertainty->method, PropagationMethod::MonteCarlo) << b.uncertainty->method_reason;
+    EXPECT_GT(qb->result.interval95_high - qb->result.interval95_low,
+              qa->result.interval95_high - qa->result.interval95_low);
+}
+
+// Without declared tolerances the defaults are used and the result says so.
+TEST(MeasureBudget, AssumedTolerancesAreSaid) {
+    const fs::path dir = testing::fresh_dir("budget_assumed");
+    const MeasureResult r = measure_bench(dir, Bench{}, 0.3, Correlation::Gaussian, "{}", 2);
+    ASSERT_TRUE(r.uncertainty);
+    EXPECT_FALSE(r.uncertainty->assumed.empty());
+    bool said = false;
+    for (const auto& w : r.warnings) said = said || w.find("assumed tolerances") != std::string::npos;
+    EXPECT_TRUE(said);
+    EXPECT_THROW(measure_bench(dir, Bench{}, 0.3, Correlation::Gaussian, R"({"angle_deg": -1})", 2),
+                 DataError);
+    EXPECT_THROW(measure_bench(dir, Bench{}, 0.3, Correlation::Gaussian, R"({"angles": 1})", 2),
+                 DataError);
+}
+
+}  // namespace
+}  // namespace roughscope::image
