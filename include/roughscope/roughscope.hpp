@@ -34,6 +34,7 @@
 
 // estimation: the closed forms of §4, the two-geometry solver, uncertainty
 #include "roughscope/estimation/estimation.hpp"
+#include "roughscope/estimation/propagation.hpp"
 
 // fit: the least-squares engine and the roughness fits
 #include "roughscope/fit/engine.hpp"
@@ -78,6 +79,7 @@
 #include "roughscope/objects/sphere.hpp"
 
 // measure: the capture file and the measurement
+#include "roughscope/measure/budget.hpp"
 #include "roughscope/measure/measure.hpp"
 
 // serialize: every result type to JSON, CSV, Markdown and text

@@ -86,9 +86,23 @@ HEADLINE = [
 ]
 
 
+def _combined(doc, key):
+    """'± u (k=1), 95 % [low, high]' of the budget (docs/uncertainty.md), or '–'."""
+    value, u = doc.get(key), doc.get(key + "_uncertainty")
+    interval = doc.get(key + "_interval95")
+    if value is None or u is None or not interval:
+        return "–"
+    low, high = (_core.format_uncertain(x, u).split(" ± ")[0] for x in interval)
+    return f"{_core.format_uncertain(value, u)}, 95 % [{low}, {high}]"
+
+
 def values_table(doc, truth=None):
-    """The headline values with their standard errors (and the truth, when known)."""
-    head = "<tr><th class='l'>quantity</th><th>measured</th>"
+    """The headline values with their standard errors: the statistical one (pixel noise) and
+    the combined one of the uncertainty budget (and the truth, when known)."""
+    budget = doc.get("uncertainty_method") is not None
+    head = "<tr><th class='l'>quantity</th><th>measured ± s.e. (pixel noise)</th>"
+    if budget:
+        head += "<th>± combined u (setup and noise, k=1)</th>"
     head += "<th>truth</th><th>within 2σ</th></tr>" if truth else "</tr>"
     rows = []
     for key, label, unit in HEADLINE:
@@ -97,6 +111,8 @@ def values_table(doc, truth=None):
             continue
         cells = f"<td class='l'>{escape(label)}{(' (' + unit + ')') if unit else ''}</td>"
         cells += f"<td>{escape(fmt(value, err))}</td>"
+        if budget:
+            cells += f"<td>{escape(_combined(doc, key))}</td>"
         if truth:
             t = truth.get(key)
             cells += (f"<td>{escape(fmt(t))}</td>"
@@ -105,10 +121,60 @@ def values_table(doc, truth=None):
     cls = doc.get("roughness_class")
     if cls:
         assumed = " (assumed by the estimator)" if doc.get("roughness_class_assumed") else ""
-        span = 4 if truth else 2
+        span = (4 if truth else 2) + (1 if budget else 0)
         rows.append(f"<tr><td class='l'>roughness class</td>"
                     f"<td colspan='{span - 1}'>{escape(cls.replace('_', ' ') + assumed)}</td></tr>")
     return f"<table>{head}{''.join(rows)}</table>"
+
+
+BUDGET_LABELS = {"E1_over_E2": "E1/E2", "sigma_over_T_gaussian": "σ/T (Gaussian)",
+                 "sigma_over_T_exponential": "σ/T (exponential)", "sigma_um": "σ",
+                 "T_um": "T"}
+
+
+def budget_png(doc, top=6):
+    """PNG bytes of the uncertainty budget: per quantity, the share (u_i(y)²/u(y)², %) of its
+    largest sources as horizontal bars; None without a budget."""
+    budget = doc.get("uncertainty_budget") or {}
+    quantities = [q for q in BUDGET_LABELS if budget.get(q)]
+    if not quantities:
+        return None
+    from ._plotting import pyplot
+
+    plt = pyplot()
+    fig, axes = plt.subplots(len(quantities), 1, figsize=(6.4, 1.0 + 1.5 * len(quantities)),
+                             dpi=90, squeeze=False)
+    for ax, q in zip(axes[:, 0], quantities):
+        lines = [line for line in budget[q] if line["fraction"] > 0][:top][::-1]
+        ax.barh([line["source"] for line in lines],
+                [100.0 * line["fraction"] for line in lines], color="#3a86ff")
+        ax.set_xlim(0, 100)
+        ax.set_title(f"{BUDGET_LABELS[q]} = "
+                     f"{_core.format_uncertain(doc[q], doc[q + '_uncertainty'])} (k=1)",
+                     fontsize=10)
+        ax.tick_params(labelsize=9)
+    axes[-1, 0].set_xlabel("share of u(y)² (%)", fontsize=9)
+    fig.tight_layout()
+    buffer = io.BytesIO()
+    fig.savefig(buffer, format="png")
+    plt.close(fig)
+    return buffer.getvalue()
+
+
+def budget_html(doc):
+    """The budget's figure and its method, or '' without a budget."""
+    png = budget_png(doc)
+    if png is None:
+        return ""
+    method = doc.get("uncertainty_method")
+    how = ("Monte Carlo (JCGM 101), " + str(doc.get("uncertainty_trials")) + " trials"
+           if method == "monte_carlo" else "first order (GUM, JCGM 100 §5.1)")
+    assumed = doc.get("uncertainty_assumed") or []
+    note = (" Assumed, not declared: " + ", ".join(assumed) + "." if assumed else "")
+    return ("<figure>" + embedded_image(png, "uncertainty budget") +
+            f"<figcaption>Uncertainty budget: each source's share of the combined variance, "
+            f"propagated by {escape(how)} (docs/uncertainty.md).{escape(note)}</figcaption>"
+            "</figure>")
 
 
 def captures_table(doc):
@@ -159,6 +225,9 @@ def measurement_html(doc, capture_file=None, truth=None, title=None):
     if title:
         parts.append(f"<h3>{escape(title)}</h3>")
     parts.append(values_table(doc, truth))
+    budget = budget_html(doc)
+    if budget:
+        parts.append(budget)
     capture_file = capture_file or doc.get("capture_file")
     figures = []
     if capture_file and pathlib.Path(capture_file).is_file():

@@ -43,11 +43,11 @@ Outputs evaluate(const PropagationModel& model, std::span<const double> x, std::
 void check_inputs(std::span<const UncertainInput> inputs, const PropagationOptions& options) {
     for (std::size_t i = 0; i < inputs.size(); ++i) {
         const UncertainInput& in = inputs[i];
-        const std::string name = concat("uncertainty input ", std::to_string(i), " (", in.source,
-                                        ")");
+        const std::string name =
+            concat("uncertainty input ", std::to_string(i), " (", in.source, ")");
         if (in.source.empty())
-            throw InvalidArgument(concat("uncertainty input ", std::to_string(i),
-                                         ": no source named"));
+            throw InvalidArgument(
+                concat("uncertainty input ", std::to_string(i), ": no source named"));
         check::finite(concat(name, ": value"), in.value);
         check::non_negative(concat(name, ": u"), in.u);
     }
@@ -55,14 +55,13 @@ void check_inputs(std::span<const UncertainInput> inputs, const PropagationOptio
         throw InvalidArgument(concat("propagation: batch_trials = ",
                                      std::to_string(options.batch_trials), " must be ≥ 100"));
     if (options.max_trials < options.batch_trials)
-        throw InvalidArgument(concat("propagation: max_trials = ",
-                                     std::to_string(options.max_trials),
-                                     " must be ≥ batch_trials = ",
-                                     std::to_string(options.batch_trials)));
+        throw InvalidArgument(
+            concat("propagation: max_trials = ", std::to_string(options.max_trials),
+                   " must be ≥ batch_trials = ", std::to_string(options.batch_trials)));
     if (options.significant_digits < 1 || options.significant_digits > 3)
-        throw InvalidArgument(concat("propagation: significant_digits = ",
-                                     std::to_string(options.significant_digits),
-                                     " must be 1, 2 or 3"));
+        throw InvalidArgument(
+            concat("propagation: significant_digits = ", std::to_string(options.significant_digits),
+                   " must be 1, 2 or 3"));
     check::positive("propagation: nonlinearity_limit", options.nonlinearity_limit);
 }
 
@@ -104,11 +103,10 @@ FirstOrder first_order(std::span<const UncertainInput> inputs, const Propagation
                 second[o] += 0.5 * d * d;
             } else if (plus[o] || minus[o]) {
                 c = plus[o] ? (*plus[o] - *y0[o]) / u : (*y0[o] - *minus[o]) / u;
-                out.nonlinear[o] = concat("no value at ", inputs[i].source, " ", plus[o] ? "−" : "+",
-                                          " its uncertainty");
+                out.nonlinear[o] = concat("no value at ", inputs[i].source, " ",
+                                          plus[o] ? "−" : "+", " its uncertainty");
             } else {
-                out.nonlinear[o] =
-                    concat("no value at ", inputs[i].source, " ± its uncertainty");
+                out.nonlinear[o] = concat("no value at ", inputs[i].source, " ± its uncertainty");
             }
             out.budgets[o].push_back(BudgetLine{inputs[i].source, u, c, std::abs(c) * u, 0.0});
         }
@@ -118,18 +116,16 @@ FirstOrder first_order(std::span<const UncertainInput> inputs, const Propagation
         for (const BudgetLine& line : out.budgets[o]) var += line.contribution * line.contribution;
         out.u[o] = std::sqrt(var);
         for (BudgetLine& line : out.budgets[o])
-            line.fraction = var > 0.0 && std::isfinite(var)
-                                ? line.contribution * line.contribution / var
-                                : 0.0;
+            line.fraction =
+                var > 0.0 && std::isfinite(var) ? line.contribution * line.contribution / var : 0.0;
         std::stable_sort(out.budgets[o].begin(), out.budgets[o].end(),
                          [](const BudgetLine& a, const BudgetLine& b) {
                              return a.contribution > b.contribution;
                          });
         if (out.nonlinear[o].empty() && std::isfinite(var) && second[o] > limit * limit * var)
-            out.nonlinear[o] = concat("the second-order term is ",
-                                      format_significant(std::sqrt(second[o] / var), 2),
-                                      " of the first-order uncertainty (limit ",
-                                      format_significant(limit, 2), ")");
+            out.nonlinear[o] = concat(
+                "the second-order term is ", format_significant(std::sqrt(second[o] / var), 2),
+                " of the first-order uncertainty (limit ", format_significant(limit, 2), ")");
     }
     return out;
 }
@@ -237,8 +233,7 @@ MonteCarlo monte_carlo(std::span<const UncertainInput> inputs, const Propagation
     std::vector<std::vector<double>> all(outputs);
     // Per output, the per-batch estimate, u, low and high.
     std::vector<std::array<std::vector<double>, 4>> history(outputs);
-    for (std::size_t batch = 0; out.trials + options.batch_trials <= options.max_trials;
-         ++batch) {
+    for (std::size_t batch = 0; out.trials + options.batch_trials <= options.max_trials; ++batch) {
         auto values = monte_carlo_batch(inputs, model, outputs, options, batch);
         out.trials += options.batch_trials;
         for (std::size_t o = 0; o < outputs; ++o) {
@@ -289,9 +284,8 @@ Propagation propagate_uncertainty(std::span<const UncertainInput> inputs,
     const FirstOrder fo = first_order(inputs, model, y0, options.nonlinearity_limit);
 
     Propagation result;
-    result.method = options.method == PropagationMethod::MonteCarlo
-                        ? PropagationMethod::MonteCarlo
-                        : PropagationMethod::FirstOrder;
+    result.method = options.method == PropagationMethod::MonteCarlo ? PropagationMethod::MonteCarlo
+                                                                    : PropagationMethod::FirstOrder;
     if (options.method == PropagationMethod::Auto) {
         for (std::size_t o = 0; o < n; ++o)
             if (y0[o] && !fo.nonlinear[o].empty()) {

@@ -9,10 +9,10 @@
 #include <utility>
 #include <vector>
 
+#include "measure_inputs.hpp"
 #include "roughscope/core/errors.hpp"
 #include "roughscope/core/numbers.hpp"
 #include "roughscope/core/text.hpp"
-#include "measure_inputs.hpp"
 #include "roughscope/measure/measure.hpp"
 #include "roughscope/scattering/correlation.hpp"
 
@@ -27,10 +27,10 @@ constexpr double kSrgbExponent = 2.4;
 // A region's mean on the linear scale of photo/image.hpp and what reading it did: enough to move
 // it by an error of the black level or of the response's exponent.
 struct RegionMean {
-    double mean = 0.0;    // m: (s − b)/(W − b), s the linear code
-    double white_dn = 1.0;  // W
-    double black_dn = 0.0;  // b (the mean over the planes)
-    double gamma = 0.0;     // the exponent the response was inverted with; 0: linear
+    double mean = 0.0;           // m: (s − b)/(W − b), s the linear code
+    double white_dn = 1.0;       // W
+    double black_dn = 0.0;       // b (the mean over the planes)
+    double gamma = 0.0;          // the exponent the response was inverted with; 0: linear
     bool read_from_file = true;  // false: a merged bracket (its own response curve)
 };
 
@@ -95,9 +95,9 @@ class Tolerances {
         return fallback;
     }
     double angle_rad(const std::optional<double>& capture) {
-        return deg_to_rad(capture ? *capture
-                                  : get(setup_.angle_deg, "angle_deg",
-                                        kDefaultAngleUncertaintyDeg, "°"));
+        return deg_to_rad(
+            capture ? *capture
+                    : get(setup_.angle_deg, "angle_deg", kDefaultAngleUncertaintyDeg, "°"));
     }
     const SetupTolerances& setup() const { return setup_; }
 
@@ -186,8 +186,8 @@ void BudgetModel::build() {
                                   kDefaultResponseGammaUncertainty, ""));
     }
     // λ enters σ (Eq. 13) and T given σ (through g), not the very-rough σ/T.
-    const bool specular_sigma = !request_.sigma_um && !specular.empty() && result_.sigma &&
-                                result_.sigma->sigma_um;
+    const bool specular_sigma =
+        !request_.sigma_um && !specular.empty() && result_.sigma && result_.sigma->sigma_um;
     if (specular_sigma || (pair.size() >= 2 && result_.correlation_length))
         lambda_ = add("wavelength", request_.wavelength_um,
                       tol_.get(tol_.setup().wavelength_um, "wavelength_um",
@@ -201,7 +201,8 @@ void BudgetModel::build() {
         wanted_[3] = true;
     }
     if (pair.size() >= 2 && (sigma_given_ != kNone || specular_)) {
-        const bool from_slope = result_.slope_gaussian && result_.slope_gaussian->T_um && !result_.fit;
+        const bool from_slope =
+            result_.slope_gaussian && result_.slope_gaussian->T_um && !result_.fit;
         wanted_[4] = (result_.correlation_length && result_.correlation_length->T_um) || from_slope;
     }
 }
@@ -239,13 +240,13 @@ void BudgetModel::build_diffuse(const std::vector<std::size_t>& pair) {
                            g.theta_s_rad == 0.0 ? 0.0 : tol_.angle_rad(t.phi_s_deg));
         }
         const bool needs_exposure = c.exposure_source.rfind("not needed", 0) != 0;
-        in.exposure = add(concat("exposure of ", name), 0.0,
-                          needs_exposure && c.spec.bracket.empty()
-                              ? (t.exposure_rel ? *t.exposure_rel
-                                                : tol_.get(tol_.setup().exposure_rel,
-                                                           "exposure_rel",
-                                                           kDefaultExposureUncertaintyRel, ""))
-                              : 0.0);
+        in.exposure =
+            add(concat("exposure of ", name), 0.0,
+                needs_exposure && c.spec.bracket.empty()
+                    ? (t.exposure_rel ? *t.exposure_rel
+                                      : tol_.get(tol_.setup().exposure_rel, "exposure_rel",
+                                                 kDefaultExposureUncertaintyRel, ""))
+                    : 0.0);
         in.noise = add(concat("pixel noise of ", name), 0.0, c.brightness_relative_stderr);
         in.region = region_mean(c.region.average.mean, c.info, !c.spec.bracket.empty());
         in.exposure_scale = c.exposure_scale;
@@ -261,10 +262,10 @@ void BudgetModel::build_specular(std::size_t k) {
     SpecularInputs in;
     in.theta = add(concat("theta of ", name, " (specular)"), c.spec.geometry.theta_i_rad,
                    tol_.angle_rad(c.spec.uncertainty.theta_i_deg));
-    in.noise_tot = add(concat("pixel noise of the highlight of ", name), 0.0,
-                       h.E_tot_relative_stderr);
-    in.noise_dif = add(concat("pixel noise of the surround of ", name), 0.0,
-                       h.E_dif_relative_stderr);
+    in.noise_tot =
+        add(concat("pixel noise of the highlight of ", name), 0.0, h.E_tot_relative_stderr);
+    in.noise_dif =
+        add(concat("pixel noise of the surround of ", name), 0.0, h.E_dif_relative_stderr);
     in.flat = add("flat field (highlight vs surround)", 0.0,
                   tol_.get(tol_.setup().flat_field_rel, "flat_field_rel",
                            request_.flat_field ? kDefaultFlatFieldGivenUncertaintyRel
@@ -338,12 +339,11 @@ void BudgetModel::operator()(std::span<const double> x, std::span<std::optional<
         if (result_.correlation_length && result_.correlation_length->T_um) {
             options.regime = result_.correlation_length_regime.value_or(Regime::SlightlyRough);
             const Correlation c = request_.correlation;
-            y[4] = closed && info(c).slightly_rough_inverse &&
-                           options.regime == Regime::SlightlyRough
-                       ? correlation_length_from_ratio(*ratio, *s, g1->theta_i_rad,
-                                                       g2->theta_i_rad, lambda(x),
-                                                       request_.factor)
-                       : correlation_length_two_geometries(*ratio, *g1, *g2, *s, c, options);
+            y[4] =
+                closed && info(c).slightly_rough_inverse && options.regime == Regime::SlightlyRough
+                    ? correlation_length_from_ratio(*ratio, *s, g1->theta_i_rad, g2->theta_i_rad,
+                                                    lambda(x), request_.factor)
+                    : correlation_length_two_geometries(*ratio, *g1, *g2, *s, c, options);
         } else if (y[1]) {
             y[4] = *s / *y[1];
         }

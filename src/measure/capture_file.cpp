@@ -468,14 +468,15 @@ void parse_uncertainty(const JsonNode& j, MeasureRequest& request) {
     if (j.has("response_gamma")) t.response_gamma = tolerance(j, "response_gamma", 5.0, "");
     if (j.has("wavelength_um")) t.wavelength_um = tolerance(j, "wavelength_um", 1.0, " µm");
     if (j.has("flat_field_rel")) t.flat_field_rel = tolerance(j, "flat_field_rel", 1.0, "");
-    if (j.has("method")) request.propagation.method = j.at("method").named(parse_propagation_method);
+    if (j.has("method"))
+        request.propagation.method = j.at("method").named(parse_propagation_method);
     if (j.has("seed"))
         request.propagation.seed =
             static_cast<std::uint64_t>(j.at("seed").integer(0, 9'007'199'254'740'992LL));
     if (j.has("max_trials"))
         request.propagation.max_trials = static_cast<std::size_t>(
-            j.at("max_trials").integer(static_cast<long long>(request.propagation.batch_trials),
-                                       10'000'000));
+            j.at("max_trials")
+                .integer(static_cast<long long>(request.propagation.batch_trials), 10'000'000));
 }
 
 MeasureRequest parse_document(const io::JsonValue& value, const std::string& path) {

@@ -75,7 +75,8 @@ std::string measure_text(const Json& doc) {
                    std::to_string(doc["region"]["pixels"].get<std::size_t>()), " pixels)"));
     items.emplace_back("E1/E2", value_with_uncertainty(doc, "E1_over_E2"));
     items.emplace_back("sigma/T (Gaussian)", value_with_uncertainty(doc, "sigma_over_T_gaussian"));
-    items.emplace_back("sigma/T (exponential)", value_with_uncertainty(doc, "sigma_over_T_exponential"));
+    items.emplace_back("sigma/T (exponential)",
+                       value_with_uncertainty(doc, "sigma_over_T_exponential"));
     items.emplace_back("sigma", value_with_uncertainty(doc, "sigma_um", "um"));
     items.emplace_back("T", value_with_uncertainty(doc, "T_um", "um"));
     items.emplace_back("theta_K", value_with_error(doc, "theta_K_deg", "deg"));
@@ -121,13 +122,14 @@ std::string measure_text(const Json& doc) {
     out << key_value_lines(items);
     // Names and paths from the capture file: control characters escaped (core/text.hpp).
     if (const auto& m = doc["uncertainty_method"]; !m.is_null())
-        out << concat("uncertainty: ", m.get<std::string>() == "monte_carlo"
-                                           ? concat("Monte Carlo (", std::to_string(
-                                                        doc["uncertainty_trials"].get<std::size_t>()),
-                                                    " trials)")
-                                           : std::string("first order"),
-                      "; ± is the combined standard uncertainty (setup and pixel noise), "
-                      "--json gives each quantity's budget\n");
+        out << concat(
+            "uncertainty: ",
+            m.get<std::string>() == "monte_carlo"
+                ? concat("Monte Carlo (",
+                         std::to_string(doc["uncertainty_trials"].get<std::size_t>()), " trials)")
+                : std::string("first order"),
+            "; ± is the combined standard uncertainty (setup and pixel noise), "
+            "--json gives each quantity's budget\n");
     for (const auto& w : doc["warnings"])
         out << "warning: " << printable_text(w.get<std::string>()) << '\n';
     return out.str();

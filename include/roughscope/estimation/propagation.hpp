@@ -68,10 +68,10 @@ struct BudgetLine {
 };
 
 struct OutputUncertainty {
-    double value = 0.0;        // y = f(x)
-    double uncertainty = 0.0;  // u(y), k = 1
-    double interval95_low = 0.0;  // the 95 % coverage interval: y ± 1.96 u(y) (first order) or
-    double interval95_high = 0.0;  // the probabilistically symmetric one (Monte Carlo)
+    double value = 0.0;              // y = f(x)
+    double uncertainty = 0.0;        // u(y), k = 1
+    double interval95_low = 0.0;     // the 95 % coverage interval: y ± 1.96 u(y) (first order) or
+    double interval95_high = 0.0;    // the probabilistically symmetric one (Monte Carlo)
     std::vector<BudgetLine> budget;  // inputs with u > 0, largest contribution first
     // Monte Carlo only: trials run, and the fraction of them without a value (left out).
     std::size_t trials = 0;

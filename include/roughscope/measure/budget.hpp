@@ -44,8 +44,8 @@ inline constexpr double kDefaultFlatFieldUncertaintyRel = 0.01;
 inline constexpr double kDefaultFlatFieldGivenUncertaintyRel = 0.002;
 
 // The headline quantities, in the order of UncertaintyBudget::quantities.
-inline constexpr const char* kBudgetQuantities[] = {
-    "E1_over_E2", "sigma_over_T_gaussian", "sigma_over_T_exponential", "sigma_um", "T_um"};
+inline constexpr const char* kBudgetQuantities[] = {"E1_over_E2", "sigma_over_T_gaussian",
+                                                    "sigma_over_T_exponential", "sigma_um", "T_um"};
 
 struct QuantityBudget {
     std::string quantity;  // one of kBudgetQuantities
@@ -55,7 +55,8 @@ struct QuantityBudget {
 struct UncertaintyBudget {
     PropagationMethod method = PropagationMethod::FirstOrder;  // as used
     std::string method_reason;  // why Monte Carlo was used, else empty
-    std::vector<QuantityBudget> quantities;  // those the measurement has, in kBudgetQuantities order
+    std::vector<QuantityBudget>
+        quantities;  // those the measurement has, in kBudgetQuantities order
     // The tolerances taken from the defaults ("angle_deg = 0.5"): the budget rests on them.
     std::vector<std::string> assumed;
     std::vector<std::string> warnings;

@@ -32,9 +32,9 @@ using roughscope::testing::very_rough_truth;
 // The true setup of one run, and what the capture file says of it.
 struct Bench {
     double theta1_deg = 30.0, theta2_deg = 45.0;  // true light zeniths
-    double view_x_deg = 0.0, view_y_deg = 0.0;   // true camera tilt (in and out of the plane)
-    double exposure1 = 1.0, exposure2 = 1.0;     // true exposure times, s
-    double black_dn = 2000.0;                    // true black level, DN
+    double view_x_deg = 0.0, view_y_deg = 0.0;    // true camera tilt (in and out of the plane)
+    double exposure1 = 1.0, exposure2 = 1.0;      // true exposure times, s
+    double black_dn = 2000.0;                     // true black level, DN
 };
 
 constexpr double kNominalBlackDn = 2000.0;
@@ -50,9 +50,9 @@ MeasureResult measure_bench(const fs::path& dir, const Bench& bench, double sigm
                                  std::tan(deg_to_rad(bench.view_y_deg)), 1.0)
                      .normalized();
     const sim::SurfaceTruth truth = very_rough_truth(sigma_over_T, correlation);
-    const double peak = std::max(
-        sim::surface_brightness(truth, normal_view_geometry(deg_to_rad(30.0))),
-        sim::surface_brightness(truth, normal_view_geometry(deg_to_rad(45.0))));
+    const double peak =
+        std::max(sim::surface_brightness(truth, normal_view_geometry(deg_to_rad(30.0))),
+                 sim::surface_brightness(truth, normal_view_geometry(deg_to_rad(45.0))));
     sim::CaptureOptions options;
     options.keep_geometry = false;
     options.keep_radiance = false;
@@ -73,12 +73,11 @@ MeasureResult measure_bench(const fs::path& dir, const Bench& bench, double sigm
         files.push_back((dir / concat("c", std::to_string(k), ".tiff")).string());
         io::write_file_atomic(files.back(), sim::encode_capture_tiff(c));
     }
-    const std::string text = concat(
-        R"({"roi": {"rect": [4, 4, 24, 24]}, "black_level_dn": )",
-        check::format_number(kNominalBlackDn), R"(, "uncertainty": )", uncertainty,
-        R"(, "captures": [{"image": ")", files[0],
-        R"(", "theta_i_deg": 30, "exposure_s": 1}, {"image": ")", files[1],
-        R"(", "theta_i_deg": 45, "exposure_s": 1}]})");
+    const std::string text = concat(R"({"roi": {"rect": [4, 4, 24, 24]}, "black_level_dn": )",
+                                    check::format_number(kNominalBlackDn), R"(, "uncertainty": )",
+                                    uncertainty, R"(, "captures": [{"image": ")", files[0],
+                                    R"(", "theta_i_deg": 30, "exposure_s": 1}, {"image": ")",
+                                    files[1], R"(", "theta_i_deg": 45, "exposure_s": 1}]})");
     return measure(parse_capture_file(text, (dir / "capture.json").string()));
 }
 
@@ -95,10 +94,10 @@ const QuantityBudget* quantity(const MeasureResult& r, const std::string& name) 
 TEST(MeasureBudget, TheIntervalCoversTheTruthOfAPerturbedBench) {
     const fs::path dir = testing::fresh_dir("budget_coverage");
     const double u_angle = 0.5, u_exposure = 0.01, u_black = 40.0;
-    const std::string declared = concat(
-        R"({"angle_deg": )", check::format_number(u_angle), R"(, "exposure_rel": )",
-        check::format_number(u_exposure), R"(, "black_level_dn": )", check::format_number(u_black),
-        "}");
+    const std::string declared =
+        concat(R"({"angle_deg": )", check::format_number(u_angle), R"(, "exposure_rel": )",
+               check::format_number(u_exposure), R"(, "black_level_dn": )",
+               check::format_number(u_black), "}");
     std::mt19937_64 rng(20261207);
     std::normal_distribution<double> z(0.0, 1.0);
     for (const Correlation correlation : {Correlation::Gaussian, Correlation::Exponential}) {
@@ -129,9 +128,10 @@ TEST(MeasureBudget, TheIntervalCoversTheTruthOfAPerturbedBench) {
         EXPECT_GE(coverage, 0.90) << key << ": " << covered << " of " << runs;
         // Not covered by being huge: the mean interval is within a few per cent of σ/T.
         EXPECT_LT(width_sum / runs, 0.5 * truth) << key;
-        std::printf("[ budget   ] %s: truth inside the 95 %% interval in %d of %d runs, mean "
-                    "width %.4f\n",
-                    key.c_str(), covered, runs, width_sum / runs);
+        std::printf(
+            "[ budget   ] %s: truth inside the 95 %% interval in %d of %d runs, mean "
+            "width %.4f\n",
+            key.c_str(), covered, runs, width_sum / runs);
     }
 }
 
@@ -170,7 +170,8 @@ TEST(MeasureBudget, TheLargestDeclaredSourceLeadsTheBudget) {
         const char* leader;  // the start of the leading source's name
     } cases[] = {
         {R"({"angle_deg": 3, "exposure_rel": 0.001, "black_level_dn": 1})", "theta_i of capture"},
-        {R"({"angle_deg": 0.01, "exposure_rel": 0.05, "black_level_dn": 1})", "exposure of capture"},
+        {R"({"angle_deg": 0.01, "exposure_rel": 0.05, "black_level_dn": 1})",
+         "exposure of capture"},
         {R"({"angle_deg": 0.01, "exposure_rel": 0.001, "black_level_dn": 400})", "black level"},
     };
     for (const auto& c : cases) {
@@ -242,7 +243,8 @@ TEST(MeasureBudget, AssumedTolerancesAreSaid) {
     ASSERT_TRUE(r.uncertainty);
     EXPECT_FALSE(r.uncertainty->assumed.empty());
     bool said = false;
-    for (const auto& w : r.warnings) said = said || w.find("assumed tolerances") != std::string::npos;
+    for (const auto& w : r.warnings)
+        said = said || w.find("assumed tolerances") != std::string::npos;
     EXPECT_TRUE(said);
     EXPECT_THROW(measure_bench(dir, Bench{}, 0.3, Correlation::Gaussian, R"({"angle_deg": -1})", 2),
                  DataError);
