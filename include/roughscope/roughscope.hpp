@@ -72,8 +72,9 @@
 #include "roughscope/maps/maps.hpp"
 #include "roughscope/maps/registration.hpp"
 
-// objects: curved objects of known shape (silhouette, cylinder, sphere)
+// objects: curved objects of known shape (silhouette, cylinder, sphere), the mirror sphere's light
 #include "roughscope/objects/cylinder.hpp"
+#include "roughscope/objects/mirror_sphere.hpp"
 #include "roughscope/objects/silhouette.hpp"
 #include "roughscope/objects/sphere.hpp"
 
