@@ -82,6 +82,7 @@
 #include "roughscope/measure/measure.hpp"
 
 // serialize: every result type to JSON, CSV, Markdown and text
+#include "roughscope/serialize/calibration.hpp"
 #include "roughscope/serialize/capture.hpp"
 #include "roughscope/serialize/comparison.hpp"
 #include "roughscope/serialize/estimation.hpp"
