@@ -79,6 +79,19 @@ void check_circle_in_image(const CircleFit& c, const LinearImage& image) {
     check_axis("y", c.centre_y_px, image.height);
 }
 
+// InvalidArgument unless the input uncertainties are at most the radius (beyond it the circle is
+// not known at all, and the propagated angle would overflow).
+void check_uncertainties_within_radius(const MirrorSphereOptions& o, double radius_px) {
+    const auto check_one = [&](const char* name, double value) {
+        if (value > radius_px)
+            throw InvalidArgument(concat("mirror sphere ", name, " = ", format_number(value),
+                                         " px is outside the valid range [0, ",
+                                         format_number(radius_px), "] px (at most the radius)"));
+    };
+    check_one("circle_uncertainty_px", o.circle_uncertainty_px);
+    check_one("centroid_floor_px", o.centroid_floor_px);
+}
+
 // The pixels whose centre lies inside the circle (and on the mask; none without a value).
 Disc disc_pixels(const LinearImage& image, const CircleFit& c, const std::uint8_t* mask) {
     Disc disc;
@@ -356,6 +369,7 @@ MirrorSphereLight mirror_sphere_light(const LinearImage& image, const CircleFit&
                                      " entries, the image ", image_name(image), " has ",
                                      std::to_string(image.pixel_count()), " pixels"));
     check_circle_in_image(circle, image);
+    check_uncertainties_within_radius(options, circle.radius_px);
     MirrorSphereLight out;
     out.circle = circle;
     const Disc disc = disc_pixels(image, circle, sphere_mask ? sphere_mask->data() : nullptr);

@@ -29,10 +29,10 @@ struct MirrorSphereOptions {
     // Pixels of the highlight: those above b + threshold_fraction · (peak − b) (b: the median of
     // the disc, peak: its largest channel average, saturated pixels included), in (0, 1).
     double threshold_fraction = 0.5;
-    // Standard uncertainty (k = 1) of each of the circle's cx, cy and r, px, ≥ 0 (finite).
+    // Standard uncertainty (k = 1) of each of the circle's cx, cy and r, px, in [0, r].
     double circle_uncertainty_px = 0.5;
     // The floor of the highlight centroid's standard uncertainty (per axis, px, ≥ 0): pixel
-    // quantisation and a lobe that is not quite symmetric.
+    // quantisation and a lobe that is not quite symmetric. At most r.
     double centroid_floor_px = 0.1;
     // A highlight farther than this fraction of r from the centre is near the limb, where the
     // light's direction changes fast with the highlight's position (a warning), in (0, 1].
@@ -72,7 +72,8 @@ struct MirrorSphereLight {
 // centroid is the brightness-weighted mean of the reflected directions R of its pixels (an
 // orthographic mirror sphere samples directions uniformly, so this is the lobe's centre also
 // where the blob is stretched near the limb); L is that mean, normalised.
-// Throws InvalidArgument for an inconsistent image or mask, bad options, a circle that is not
+// Throws InvalidArgument for an inconsistent image or mask, bad options (also an uncertainty
+// above r), a circle that is not
 // finite, has r < kMirrorSphereMinRadiusPx or does not lie inside the image; DataError when the
 // disc holds no highlight (peak not above the background: the message gives both).
 MirrorSphereLight mirror_sphere_light(const LinearImage& image, const CircleFit& circle,

@@ -300,6 +300,8 @@ TEST(MirrorSphere, RefusesBadInput) {
     o = {};
     o.circle_uncertainty_px = -1;
     EXPECT_THROW(mirror_sphere_light(img, circle_of(s), nullptr, o), InvalidArgument);
+    o.circle_uncertainty_px = 1e300;  // above r: refused, not an overflowing angle
+    EXPECT_THROW(mirror_sphere_light(img, circle_of(s), nullptr, o), InvalidArgument);
     const std::vector<std::uint8_t> short_mask(10, 1);
     EXPECT_THROW(mirror_sphere_light(img, circle_of(s), &short_mask), InvalidArgument);
     // A sphere without a highlight: matte (the light's lobe off), noisy.
