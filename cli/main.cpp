@@ -29,6 +29,7 @@ int main(int argc, char** argv) {
     roughscope::cli::register_surface(app);
     roughscope::cli::register_simulate(app);
     roughscope::cli::register_measure(app);
+    roughscope::cli::register_calibrate(app);
     // Last: the completion script describes every subcommand registered before it.
     roughscope::cli::register_completion(app);
 

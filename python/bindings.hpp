@@ -36,11 +36,12 @@ void bind_brdf_tables(pybind11::module_& m);
 // python/bind_surface.cpp: height files; statistics, generation and prediction (§3.1)
 void bind_height_files(pybind11::module_& m);
 void bind_surface_analysis(pybind11::module_& m);
-void bind_simulation(pybind11::module_& m);  // python/bind_simulation.cpp: Kirchhoff Monte Carlo
-void bind_capture(pybind11::module_& m);     // python/bind_capture.cpp: synthetic captures
-void bind_image(pybind11::module_& m);       // python/bind_image.cpp: photographs to roughness
-void bind_report(pybind11::module_& m);      // python/bind_report.cpp: what the report draws
-void bind_documents(pybind11::module_& m);   // python/bind_documents.cpp: text and documents
+void bind_simulation(pybind11::module_& m);   // python/bind_simulation.cpp: Kirchhoff Monte Carlo
+void bind_capture(pybind11::module_& m);      // python/bind_capture.cpp: synthetic captures
+void bind_image(pybind11::module_& m);        // python/bind_image.cpp: photographs to roughness
+void bind_calibration(pybind11::module_& m);  // python/bind_calibration.cpp: the light's direction
+void bind_report(pybind11::module_& m);       // python/bind_report.cpp: what the report draws
+void bind_documents(pybind11::module_& m);    // python/bind_documents.cpp: text and documents
 
 // Results cross into Python as real objects, built from the library's serializer
 // (roughscope/serialize): objects → dict (key order kept), arrays → list, numbers → int/float,

@@ -347,6 +347,7 @@ PYBIND11_MODULE(_core, m) {
     roughscope::python::bind_simulation(m);
     roughscope::python::bind_capture(m);
     roughscope::python::bind_image(m);
+    roughscope::python::bind_calibration(m);
     roughscope::python::bind_report(m);
     roughscope::python::bind_documents(m);
 }

@@ -73,8 +73,9 @@
 #include "roughscope/maps/maps.hpp"
 #include "roughscope/maps/registration.hpp"
 
-// objects: curved objects of known shape (silhouette, cylinder, sphere)
+// objects: curved objects of known shape (silhouette, cylinder, sphere), the mirror sphere's light
 #include "roughscope/objects/cylinder.hpp"
+#include "roughscope/objects/mirror_sphere.hpp"
 #include "roughscope/objects/silhouette.hpp"
 #include "roughscope/objects/sphere.hpp"
 
@@ -83,6 +84,7 @@
 #include "roughscope/measure/measure.hpp"
 
 // serialize: every result type to JSON, CSV, Markdown and text
+#include "roughscope/serialize/calibration.hpp"
 #include "roughscope/serialize/capture.hpp"
 #include "roughscope/serialize/comparison.hpp"
 #include "roughscope/serialize/estimation.hpp"

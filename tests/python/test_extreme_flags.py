@@ -20,7 +20,7 @@ import subprocess
 
 import pytest
 
-from conftest import cli_path
+from conftest import REPO_ROOT, cli_path
 
 # Drives the CLI: also run against the sanitizer build (`make sanitize`, DEVELOPERS.md).
 pytestmark = pytest.mark.cli
@@ -245,3 +245,11 @@ def test_simulate_scatter_flags_at_the_extremes(tmp_path):
          "10", "--layout", "fixed"],
     ])
     assert runs >= 20  # 2 bases x 11 numeric flags
+
+
+def test_calibrate_light_flags_at_the_extremes():
+    image = str(REPO_ROOT / "docs" / "examples" / "mirror-sphere.png")
+    assert sweep(["calibrate", "light"], [
+        [image, "--sphere", "64,64,56"],
+        [image, "--sphere", "64,64,56", "--circle-uncertainty", "0", "--json"],
+    ]) >= 2
