@@ -17,6 +17,8 @@
 #include "roughscope/core/numbers.hpp"
 #include "roughscope/core/text.hpp"
 #include "roughscope/measure/measure.hpp"
+#include "roughscope/objects/mirror_sphere.hpp"
+#include "roughscope/photo/read.hpp"
 #include "roughscope/scattering/beckmann.hpp"
 #include "roughscope/scattering/factors.hpp"
 #include "roughscope/scattering/geometry.hpp"
@@ -269,7 +271,42 @@ MapRequest parse_maps(const Context& ctx, const JsonNode& j) {
 // vectors (the sample's normal +z; for a curved object the camera frame, view +z by default, and
 // neither given: L = V = +z, the retro-reflection of §5.2). Returns (θi, θs, φs) in degrees as
 // typed (from vectors: as computed), for messages that echo them.
-std::array<double, 3> parse_capture_geometry(const JsonNode& c, bool curved, CaptureSpec& spec) {
+// "light": {"mirror_sphere": {"image": F, "circle": [cx, cy, r], "circle_uncertainty_px": u}}: the
+// light's direction from
+// the highlight of a mirror sphere in its own photograph (objects/mirror_sphere.hpp; camera frame,
+// which is the sample's when the camera looks along its normal), read as the captures are; its
+// standard uncertainty becomes the capture's theta_i_deg uncertainty (budget.hpp) unless the
+// capture declares one.
+Eigen::Vector3d calibrated_light(const Context& ctx, const JsonNode& j, const ReadOptions& read,
+                                 CaptureSpec& spec) {
+    j.only({"mirror_sphere"});
+    const JsonNode m = j.at("mirror_sphere");
+    m.only({"image", "circle", "circle_uncertainty_px"});
+    MirrorSphereOptions options;
+    if (m.has("circle_uncertainty_px"))
+        options.circle_uncertainty_px = m.at("circle_uncertainty_px").number(0.0, 1e6, " px");
+    const std::string image = ctx.path(m.at("image"));
+    const std::vector<double> c = m.at("circle").numbers(3);
+    CircleFit circle;
+    circle.centre_x_px = c[0];
+    circle.centre_y_px = c[1];
+    circle.radius_px = c[2];
+    MirrorSphereLight light;
+    try {
+        light = mirror_sphere_light(read_image(image, read), circle, nullptr, options);
+    } catch (const Error& e) {
+        m.fail(e.what());
+    }
+    spec.uncertainty.theta_i_deg = light.angle_uncertainty_deg;
+    return light.light;
+}
+
+std::array<double, 3> parse_capture_geometry(const Context& ctx, const JsonNode& c, bool curved,
+                                             const ReadOptions& read, CaptureSpec& spec) {
+    // A light vector, or one calibrated from a mirror sphere.
+    const auto light_of = [&](const JsonNode& j) {
+        return j.is_object() ? calibrated_light(ctx, j, read, spec) : unit_vector(j);
+    };
     const bool angles = c.has("theta_i_deg") || c.has("theta_s_deg") || c.has("phi_s_deg");
     const bool vectors = c.has("light") || c.has("view");
     if (angles && vectors)
@@ -279,7 +316,7 @@ std::array<double, 3> parse_capture_geometry(const JsonNode& c, bool curved, Cap
                                      rad_to_deg(g.phi_s_rad)};
     };
     if (curved && !angles) {
-        spec.light = c.has("light") ? unit_vector(c.at("light")) : Eigen::Vector3d::UnitZ();
+        spec.light = c.has("light") ? light_of(c.at("light")) : Eigen::Vector3d::UnitZ();
         spec.view = c.has("view") ? unit_vector(c.at("view")) : Eigen::Vector3d::UnitZ();
         for (const auto& [name, v] :
              {std::pair{"light", *spec.light}, std::pair{"view", *spec.view}})
@@ -292,9 +329,16 @@ std::array<double, 3> parse_capture_geometry(const JsonNode& c, bool curved, Cap
         return degrees(spec.geometry);
     }
     if (vectors) {
-        if (!c.has("light") || !c.has("view")) c.fail("light and view must both be given");
-        const Eigen::Vector3d L = unit_vector(c.at("light"));
-        const Eigen::Vector3d V = unit_vector(c.at("view"));
+        const bool sphere = c.has("light") && c.at("light").is_object();
+        if (!c.has("light") || (!c.has("view") && !sphere))
+            c.fail("light and view must both be given");
+        const Eigen::Vector3d L = light_of(c.at("light"));
+        const Eigen::Vector3d V =
+            c.has("view") ? unit_vector(c.at("view")) : Eigen::Vector3d::UnitZ();
+        if (sphere && (V - Eigen::Vector3d::UnitZ()).norm() > 1e-12)
+            c.fail_at("view",
+                      "a light from a mirror sphere is in the camera's frame: the camera must look "
+                      "along the sample's normal (view [0, 0, 1], or no view)");
         for (const auto& [name, v] : {std::pair{"light", L}, std::pair{"view", V}})
             if (!(v.z() > kGrazingCos))
                 c.fail_at(name,
@@ -383,7 +427,8 @@ void parse_captures(const Context& ctx, const JsonNode& doc, bool curved, Measur
         } else {
             spec.image = ctx.path(c.at("image"));
         }
-        const std::array<double, 3> deg = parse_capture_geometry(c, curved, spec);
+        const std::array<double, 3> deg =
+            parse_capture_geometry(ctx, c, curved, request.read, spec);
         if (const auto e = c.find("exposure_s")) spec.exposure_s = Context::exposure(*e);
         if (c.has("role")) spec.role = c.at("role").named(parse_capture_role);
         if (c.has("uncertainty")) parse_capture_uncertainty(c.at("uncertainty"), spec.uncertainty);

@@ -41,9 +41,9 @@ constexpr double kNominalBlackDn = 2000.0;
 
 // Renders the pair of `bench` as 16-bit TIFFs (32 × 32) and measures it with the nominal setup
 // (30°, 45°, camera on the normal, 1 s, black 2000 DN) and the declared `uncertainty` object.
-MeasureResult measure_bench(const fs::path& dir, const Bench& bench, double sigma_over_T,
-                            Correlation correlation, const std::string& uncertainty,
-                            std::uint64_t seed) {
+std::vector<std::string> render_bench(const fs::path& dir, const Bench& bench,
+                                      double sigma_over_T, Correlation correlation,
+                                      std::uint64_t seed) {
     sim::Scene scene;
     scene.width = scene.height = 32;
     scene.view = Eigen::Vector3d(std::tan(deg_to_rad(bench.view_x_deg)),
@@ -73,6 +73,14 @@ MeasureResult measure_bench(const fs::path& dir, const Bench& bench, double sigm
         files.push_back((dir / concat("c", std::to_string(k), ".tiff")).string());
         io::write_file_atomic(files.back(), sim::encode_capture_tiff(c));
     }
+    return files;
+}
+
+MeasureResult measure_bench(const fs::path& dir, const Bench& bench, double sigma_over_T,
+                            Correlation correlation, const std::string& uncertainty,
+                            std::uint64_t seed) {
+    const std::vector<std::string> files =
+        render_bench(dir, bench, sigma_over_T, correlation, seed);
     const std::string text = concat(R"({"roi": {"rect": [4, 4, 24, 24]}, "black_level_dn": )",
                                     check::format_number(kNominalBlackDn), R"(, "uncertainty": )",
                                     uncertainty, R"(, "captures": [{"image": ")", files[0],
@@ -234,6 +242,85 @@ TEST(MeasureBudget, MonteCarloIsWiderNearTheEndOfTheRatiosRange) {
     EXPECT_EQ(b.uncertainty->method, PropagationMethod::MonteCarlo) << b.uncertainty->method_reason;
     EXPECT_GT(qb->result.interval95_high - qb->result.interval95_low,
               qa->result.interval95_high - qa->result.interval95_low);
+}
+
+// A 16-bit TIFF of a mirror sphere (circle (128, 128, 100) in a 256 × 256 image, camera along +z)
+// lit from `light`: a 2° lobe about the mirror direction of the view plus a dim diffuse term.
+std::string write_mirror_sphere(const fs::path& file, const Eigen::Vector3d& light) {
+    sim::Capture c;
+    c.width = c.height = 256;
+    c.bit_depth = 16;
+    c.dn.assign(c.width * c.height, 200);
+    c.saturated.assign(c.width * c.height, 0);
+    const double cx = 128.0, cy = 128.0, r = 100.0, lobe = deg_to_rad(2.0);
+    for (std::size_t y = 0; y < c.height; ++y)
+        for (std::size_t x = 0; x < c.width; ++x) {
+            const double nx = (x + 0.5 - cx) / r, ny = -(y + 0.5 - cy) / r;
+            const double rho2 = nx * nx + ny * ny;
+            if (rho2 >= 1.0) continue;
+            const Eigen::Vector3d n(nx, ny, std::sqrt(1.0 - rho2));
+            const Eigen::Vector3d mirror = 2.0 * n.z() * n - Eigen::Vector3d::UnitZ();
+            const double angle = std::acos(std::clamp(mirror.dot(light), -1.0, 1.0));
+            const double value = 0.9 * std::exp(-angle * angle / (2 * lobe * lobe)) +
+                                 0.02 * std::max(0.0, n.dot(light));
+            c.dn[y * c.width + x] = static_cast<std::uint16_t>(std::lround(200 + 60000 * value));
+        }
+    io::write_file_atomic(file, sim::encode_capture_tiff(c));
+    return file.string();
+}
+
+// Lights set off the nominal 30°/45° and calibrated from a mirror sphere: σ/T as if the light
+// were known, and the calibration's uncertainty in the budget; the nominal angles are worse.
+TEST(MeasureBudget, AMirrorSphereGivesTheLight) {
+    const fs::path dir = testing::fresh_dir("budget_mirror_sphere");
+    Bench b;
+    b.theta1_deg = 31.0;
+    b.theta2_deg = 44.0;
+    const std::vector<std::string> files = render_bench(dir, b, 0.3, Correlation::Gaussian, 9);
+    std::string spheres[2];
+    for (int k = 0; k < 2; ++k)
+        spheres[k] = write_mirror_sphere(
+            dir / concat("sphere", std::to_string(k), ".tiff"),
+            sim::direction_from_angles(deg_to_rad(k == 0 ? b.theta1_deg : b.theta2_deg), kPi));
+    const std::string head =
+        R"({"roi": {"rect": [4, 4, 24, 24]}, "black_level_dn": 2000, "uncertainty": {"angle_deg": 0.5, "exposure_rel": 0.001, "black_level_dn": 1}, "captures": [)";
+    const auto capture = [&](int k, const std::string& light) {
+        return concat(R"({"image": ")", files[k], R"(", "exposure_s": 1, )", light, "}");
+    };
+    const auto sphere_light = [&](int k) {
+        return concat(R"("light": {"mirror_sphere": {"image": ")", spheres[k],
+                      R"(", "circle": [128, 128, 100], "circle_uncertainty_px": 0.05}})");
+    };
+    const MeasureResult calibrated = measure(parse_capture_file(
+        concat(head, capture(0, sphere_light(0)), ", ", capture(1, sphere_light(1)), "]}"),
+        (dir / "c.json").string()));
+    const MeasureResult nominal = measure(parse_capture_file(
+        concat(head, capture(0, R"("theta_i_deg": 30)"), ", ",
+               capture(1, R"("theta_i_deg": 45)"), "]}"),
+        (dir / "c.json").string()));
+    const double with_sphere = calibrated.slope_gaussian->sigma_over_T->value;
+    const double with_nominal = nominal.slope_gaussian->sigma_over_T->value;
+    EXPECT_NEAR(rad_to_deg(calibrated.captures[0].spec.geometry.theta_i_rad), 31.0, 0.1);
+    EXPECT_NEAR(rad_to_deg(calibrated.captures[1].spec.geometry.theta_i_rad), 44.0, 0.1);
+    EXPECT_NEAR(with_sphere, 0.3, 0.003);
+    EXPECT_GT(std::abs(with_nominal - 0.3), 3.0 * std::abs(with_sphere - 0.3));
+    // The calibration's uncertainty (well below the declared 0.5°) is the light's in the budget.
+    const QuantityBudget* q = quantity(calibrated, "sigma_over_T_gaussian");
+    ASSERT_NE(q, nullptr);
+    bool found = false;
+    for (const auto& line : q->result.budget)
+        if (line.source == "theta_i of capture 1") {
+            found = true;
+            EXPECT_LT(rad_to_deg(line.u_input), 0.3);
+            EXPECT_GT(line.u_input, 0.0);
+        }
+    EXPECT_TRUE(found);
+    // The camera must look along the sample's normal for a light in the camera frame.
+    EXPECT_THROW(measure(parse_capture_file(
+                     concat(head, capture(0, sphere_light(0) + R"(, "view": [0.1, 0, 1])"),
+                            ", ", capture(1, sphere_light(1)), "]}"),
+                     (dir / "c.json").string())),
+                 DataError);
 }
 
 // Without declared tolerances the defaults are used and the result says so.
