@@ -109,6 +109,7 @@ class Tolerances {
 // One diffuse capture of the pair: the indices of its inputs in x.
 struct DiffuseInputs {
     std::size_t theta_i = kNone, theta_s = kNone, phi_s = kNone, exposure = kNone, noise = kNone;
+    std::size_t black = kNone;  // the capture's black reference, linear units
     RegionMean region;
     double exposure_scale = 1.0;
     bool normal_view = false;
@@ -116,6 +117,7 @@ struct DiffuseInputs {
 
 struct SpecularInputs {
     std::size_t theta = kNone, noise_tot = kNone, noise_dif = kNone, flat = kNone;
+    std::size_t black = kNone;  // the capture's black reference, linear units
     RegionMean tot, dif;
 };
 
@@ -174,12 +176,16 @@ void BudgetModel::build() {
         bracket_only = bracket_only && !c.spec.bracket.empty();
     }
     const double white = result_.captures.empty() ? 1.0 : result_.captures[0].info.white_level_dn;
-    if (!bracket_only) {
+    // A black reference region measures each capture's black level (its standard error is that
+    // capture's own input, below); else one black level error for every photograph.
+    if (!bracket_only && !request_.black_reference) {
         black_ = add("black level (every photograph)", 0.0,
                      tol_.get(tol_.setup().black_level_dn, "black_level_dn",
                               (raw ? kDefaultRawBlackLevelFraction : kDefaultBlackLevelFraction) *
                                   (white > 0.0 ? white : 1.0),
                               " DN"));
+    }
+    if (!bracket_only) {
         if (any_response)
             gamma_ = add("response exponent", 0.0,
                          tol_.get(tol_.setup().response_gamma, "response_gamma",
@@ -248,6 +254,10 @@ void BudgetModel::build_diffuse(const std::vector<std::size_t>& pair) {
                                                  kDefaultExposureUncertaintyRel, ""))
                     : 0.0);
         in.noise = add(concat("pixel noise of ", name), 0.0, c.brightness_relative_stderr);
+        if (c.black_reference)
+            in.black =
+                add(concat("black reference of ", name), 0.0,
+                    std::max(c.black_reference->stderr_pixel, c.black_reference->stderr_tiles));
         in.region = region_mean(c.region.average.mean, c.info, !c.spec.bracket.empty());
         in.exposure_scale = c.exposure_scale;
         in.normal_view = normal_view(g) && !(inputs_[in.theta_s].u > 0.0);
@@ -271,6 +281,9 @@ void BudgetModel::build_specular(std::size_t k) {
                            request_.flat_field ? kDefaultFlatFieldGivenUncertaintyRel
                                                : kDefaultFlatFieldUncertaintyRel,
                            ""));
+    if (c.black_reference)
+        in.black = add(concat("black reference of ", name), 0.0,
+                       std::max(c.black_reference->stderr_pixel, c.black_reference->stderr_tiles));
     in.tot = region_mean(h.core.average.mean, c.info, !c.spec.bracket.empty());
     in.dif = region_mean(h.annulus.average.mean, c.info, !c.spec.bracket.empty());
     specular_ = in;
@@ -279,7 +292,8 @@ void BudgetModel::build_specular(std::size_t k) {
 std::optional<double> BudgetModel::brightness(const DiffuseInputs& d,
                                               std::span<const double> x) const {
     const double m = perturbed_mean(d.region, black_ == kNone ? 0.0 : x[black_],
-                                    gamma_ == kNone ? 0.0 : x[gamma_]);
+                                    gamma_ == kNone ? 0.0 : x[gamma_]) -
+                     (d.black == kNone ? 0.0 : x[d.black]);
     const double scale = d.exposure_scale * (1.0 + x[d.exposure]);
     if (!(m > 0.0) || !(scale > 0.0)) return std::nullopt;
     return m * (1.0 + x[d.noise]) / scale;
@@ -293,8 +307,10 @@ std::optional<double> BudgetModel::sigma(std::span<const double> x) const {
     const SpecularInputs& s = *specular_;
     const double db = black_ == kNone ? 0.0 : x[black_];
     const double dg = gamma_ == kNone ? 0.0 : x[gamma_];
-    const double tot = perturbed_mean(s.tot, db, dg) * (1.0 + x[s.noise_tot]) * (1.0 + x[s.flat]);
-    const double dif = perturbed_mean(s.dif, db, dg) * (1.0 + x[s.noise_dif]);
+    const double ref = s.black == kNone ? 0.0 : x[s.black];
+    const double tot =
+        (perturbed_mean(s.tot, db, dg) - ref) * (1.0 + x[s.noise_tot]) * (1.0 + x[s.flat]);
+    const double dif = (perturbed_mean(s.dif, db, dg) - ref) * (1.0 + x[s.noise_dif]);
     const double theta = std::abs(x[s.theta]);
     if (!(tot > dif) || !(dif > 0.0) || !(theta < kPi / 2) || !(lambda(x) > 0.0))
         return std::nullopt;

@@ -551,6 +551,7 @@ MeasureRequest parse_document(const io::JsonValue& value, const std::string& pat
               "maps",
               "exposures_equal",
               "uncertainty",
+              "black_reference",
               "description"});
     MeasureRequest request;
     request.source = path;
@@ -596,6 +597,8 @@ MeasureRequest parse_document(const io::JsonValue& value, const std::string& pat
     if (doc.has("uncertainty")) parse_uncertainty(doc.at("uncertainty"), request);
     if (doc.has("maps")) request.maps = parse_maps(ctx, doc.at("maps"));
     const bool curved = request.object.shape != ObjectShape::Plane;
+    if (doc.has("black_reference"))
+        request.black_reference = parse_region(ctx, doc.at("black_reference"));
     if (doc.has("roi"))
         request.roi = parse_region(ctx, doc.at("roi"));
     else if (!curved && !request.maps)

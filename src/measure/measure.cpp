@@ -529,6 +529,7 @@ struct CaptureOutcome {
 struct FirstCapture {
     LinearImage header;
     RegionSpans spans;
+    RegionSpans black_spans;  // the black reference's, when given
     std::vector<std::uint8_t> mask;
 };
 
@@ -588,6 +589,19 @@ class CaptureRun {
         }
     }
 
+    // The black reference's mean, per channel, subtracted from the capture (measure.hpp).
+    void subtract_black_reference(LinearImage& image, const RegionSpans& spans,
+                                  CaptureMeasurement& capture) const {
+        const RegionStatistics black = keyed(request_, "black_reference", [&] {
+            return region_statistics(image, spans, request_.statistics);
+        });
+        std::vector<double> offset;
+        for (const ChannelStatistics& c : black.channels) offset.push_back(c.mean);
+        if (offset.size() != image.channels) offset.assign(image.channels, black.average.mean);
+        subtract_offset(image, offset);
+        capture.black_reference = black.average;
+    }
+
     void measure_capture(std::size_t k) {
         const CaptureSpec& spec = request_.captures[k];
         const std::string src = where(request_);
@@ -609,6 +623,10 @@ class CaptureRun {
                 });
                 if (needs_mask()) first.mask = rasterize(first.spans);
             }
+            if (request_.black_reference)
+                first.black_spans = keyed(request_, "black_reference", [&] {
+                    return region_spans(*request_.black_reference, image.width, image.height);
+                });
             first_.set_value(std::move(first));
             first_published_ = true;
         }
@@ -636,6 +654,7 @@ class CaptureRun {
         };
         if (dark_) correct(*dark_, "dark_frame", true);
         if (flat_) correct(*flat_, "flat_field", false);
+        if (request_.black_reference) subtract_black_reference(image, first.black_spans, capture);
         const std::vector<std::uint8_t>* roi_mask = request_.roi ? &first.mask : nullptr;
         const ObjectShape shape = request_.object.shape;
         if (shape == ObjectShape::Cylinder) {

@@ -57,6 +57,24 @@ void subtract_dark_frame(LinearImage& image, const LinearImage& dark) {
     }
 }
 
+void subtract_offset(LinearImage& image, const std::vector<double>& offset) {
+    check_linear_image(image);
+    if (offset.size() != image.channels)
+        throw InvalidArgument(concat("black offset: ", std::to_string(offset.size()),
+                                     " values for an image of ", std::to_string(image.channels),
+                                     " channel(s)"));
+    for (const double o : offset) check::finite("black offset", o);
+    const std::size_t pixels = image.pixel_count();
+    for (std::size_t c = 0; c < image.channels; ++c) {
+        float* v = image.values.data() + c * pixels;
+        const auto o = static_cast<float>(offset[c]);
+        for (std::size_t i = 0; i < pixels; ++i) {
+            v[i] -= o;
+            if (v[i] <= 0.0F) image.flags[i] |= kPixelClippedLow;
+        }
+    }
+}
+
 void divide_flat_field(LinearImage& image, const LinearImage& flat) {
     check_same_shape(image, flat, "flat field");
     const std::size_t pixels = image.pixel_count();

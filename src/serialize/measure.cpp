@@ -66,6 +66,7 @@ Json capture_json(const image::CaptureMeasurement& c) {
         out["brightness_relative_stderr"] = Json();
     }
     out["region"] = to_json(c.region);
+    out["black_reference"] = c.black_reference ? channel_json(*c.black_reference) : Json();
     if (c.highlight) {
         const image::HighlightMeasurement& h = *c.highlight;
         Json hj;

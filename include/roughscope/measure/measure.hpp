@@ -110,6 +110,10 @@ struct MeasureRequest {
     std::vector<BracketShot> response_bracket;
     std::optional<std::string> dark_frame;  // image subtracted from every capture
     std::optional<std::string> flat_field;  // image every capture is divided by (mean 1)
+    // A region that receives no light (a light trap, black velvet): its mean in each capture,
+    // per channel, is that capture's residual black level and is subtracted from it (after the
+    // dark frame and the flat field); its standard error enters the budget per capture.
+    std::optional<Region> black_reference;
     // The measured region (every capture). Required for a flat sample without maps; for a
     // curved object it restricts the pixels used (absent: the whole object).
     std::optional<Region> roi;
@@ -155,7 +159,9 @@ struct CaptureMeasurement {
     std::string exposure_source;  // "capture file", "metadata", "equal (exposures_equal)"
     RegionStatistics region;      // diffuse: the region; specular: the core
     std::optional<HighlightMeasurement> highlight;  // specular captures only
-    double brightness = 0.0;                        // Ẽ_k = region.average.mean / s_k (diffuse)
+    // The black reference region's statistics (channel average, before its mean was subtracted).
+    std::optional<ChannelStatistics> black_reference;
+    double brightness = 0.0;  // Ẽ_k = region.average.mean / s_k (diffuse)
     double brightness_relative_stderr = 0.0;
 };
 

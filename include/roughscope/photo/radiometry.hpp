@@ -4,6 +4,8 @@
 // (e.g. 1 / exposure time). All work in place on images of the same size and channels.
 #pragma once
 
+#include <vector>
+
 #include "roughscope/photo/image.hpp"
 
 namespace roughscope::image {
@@ -20,6 +22,11 @@ void subtract_dark_frame(LinearImage& image, const LinearImage& dark);
 // Throws InvalidArgument (naming both sources) for a size or channel mismatch, or when a channel
 // of the flat has no usable pixel.
 void divide_flat_field(LinearImage& image, const LinearImage& flat);
+
+// image −= offset[c] in channel c (one offset per channel; a black level measured in the scene).
+// Like subtract_dark_frame, a pixel with any channel ≤ 0 afterwards is flagged kPixelClippedLow.
+// Throws InvalidArgument unless the image is consistent and every offset finite, one per channel.
+void subtract_offset(LinearImage& image, const std::vector<double>& offset);
 
 // image *= factor. Throws InvalidArgument unless factor is finite and > 0.
 void scale(LinearImage& image, double factor);

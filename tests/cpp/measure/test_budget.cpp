@@ -41,9 +41,10 @@ constexpr double kNominalBlackDn = 2000.0;
 
 // Renders the pair of `bench` as 16-bit TIFFs (32 × 32) and measures it with the nominal setup
 // (30°, 45°, camera on the normal, 1 s, black 2000 DN) and the declared `uncertainty` object.
-std::vector<std::string> render_bench(const fs::path& dir, const Bench& bench,
-                                      double sigma_over_T, Correlation correlation,
-                                      std::uint64_t seed) {
+// (black_strip: columns 0–3 receive no light, a light trap for "black_reference".)
+std::vector<std::string> render_bench(const fs::path& dir, const Bench& bench, double sigma_over_T,
+                                      Correlation correlation, std::uint64_t seed,
+                                      bool black_strip = false) {
     sim::Scene scene;
     scene.width = scene.height = 32;
     scene.view = Eigen::Vector3d(std::tan(deg_to_rad(bench.view_x_deg)),
@@ -64,12 +65,20 @@ std::vector<std::string> render_bench(const fs::path& dir, const Bench& bench,
         camera.full_well_e = 1e6;
         camera.gain_dn_per_e = 0.05;
         camera.black_level_dn = bench.black_dn;
+        camera.read_noise_e = 40.0;  // 2 DN: a dark region's mean has a measurable noise
         camera.electrons_per_unit_s = 0.6 * camera.full_well_e / peak;
         camera.exposure_s = k == 0 ? bench.exposure1 : bench.exposure2;
         camera.seed = seed * 2 + static_cast<std::uint64_t>(k);
         scene.light = sim::direction_from_angles(
             deg_to_rad(k == 0 ? bench.theta1_deg : bench.theta2_deg), kPi);
-        const sim::Capture c = sim::render_capture(scene, {truth}, {}, camera, options);
+        sim::SurfaceTruth trap;
+        trap.model = sim::BrightnessModel::Tabulated;
+        trap.tabulated = [](const Geometry&) { return 0.0; };
+        std::vector<std::int32_t> labels;
+        if (black_strip)
+            for (std::size_t i = 0; i < scene.width * scene.height; ++i)
+                labels.push_back(i % scene.width < 4 ? 1 : 0);
+        const sim::Capture c = sim::render_capture(scene, {truth, trap}, labels, camera, options);
         files.push_back((dir / concat("c", std::to_string(k), ".tiff")).string());
         io::write_file_atomic(files.back(), sim::encode_capture_tiff(c));
     }
@@ -294,10 +303,10 @@ TEST(MeasureBudget, AMirrorSphereGivesTheLight) {
     const MeasureResult calibrated = measure(parse_capture_file(
         concat(head, capture(0, sphere_light(0)), ", ", capture(1, sphere_light(1)), "]}"),
         (dir / "c.json").string()));
-    const MeasureResult nominal = measure(parse_capture_file(
-        concat(head, capture(0, R"("theta_i_deg": 30)"), ", ",
-               capture(1, R"("theta_i_deg": 45)"), "]}"),
-        (dir / "c.json").string()));
+    const MeasureResult nominal =
+        measure(parse_capture_file(concat(head, capture(0, R"("theta_i_deg": 30)"), ", ",
+                                          capture(1, R"("theta_i_deg": 45)"), "]}"),
+                                   (dir / "c.json").string()));
     const double with_sphere = calibrated.slope_gaussian->sigma_over_T->value;
     const double with_nominal = nominal.slope_gaussian->sigma_over_T->value;
     EXPECT_NEAR(rad_to_deg(calibrated.captures[0].spec.geometry.theta_i_rad), 31.0, 0.1);
@@ -317,10 +326,49 @@ TEST(MeasureBudget, AMirrorSphereGivesTheLight) {
     EXPECT_TRUE(found);
     // The camera must look along the sample's normal for a light in the camera frame.
     EXPECT_THROW(measure(parse_capture_file(
-                     concat(head, capture(0, sphere_light(0) + R"(, "view": [0.1, 0, 1])"),
-                            ", ", capture(1, sphere_light(1)), "]}"),
+                     concat(head, capture(0, sphere_light(0) + R"(, "view": [0.1, 0, 1])"), ", ",
+                            capture(1, sphere_light(1)), "]}"),
                      (dir / "c.json").string())),
                  DataError);
+}
+
+// A black level 1500 DN above the declared one: without a black reference σ/T is biased beyond
+// its interval; with one (a light trap in the frame) it is measured, subtracted and its standard
+// error is each capture's own source in the budget.
+TEST(MeasureBudget, ABlackReferenceMeasuresTheBlackLevel) {
+    const fs::path dir = testing::fresh_dir("budget_black_reference");
+    Bench b;
+    b.black_dn = kNominalBlackDn + 1500.0;
+    const std::vector<std::string> files =
+        render_bench(dir, b, 0.3, Correlation::Gaussian, 4, true);
+    const auto run = [&](const std::string& extra) {
+        return measure(parse_capture_file(
+            concat(R"({"roi": {"rect": [4, 4, 24, 24]}, "black_level_dn": 2000, )", extra,
+                   R"("uncertainty": {"angle_deg": 0.1, "exposure_rel": 0.001, "black_level_dn": 5},
+                      "captures": [{"image": ")",
+                   files[0], R"(", "theta_i_deg": 30, "exposure_s": 1}, {"image": ")", files[1],
+                   R"(", "theta_i_deg": 45, "exposure_s": 1}]})"),
+            (dir / "c.json").string()));
+    };
+    const MeasureResult plain = run("");
+    const MeasureResult with = run(R"("black_reference": {"rect": [0, 0, 4, 32]}, )");
+    const QuantityBudget* p = quantity(plain, "sigma_over_T_gaussian");
+    const QuantityBudget* w = quantity(with, "sigma_over_T_gaussian");
+    ASSERT_TRUE(p && w);
+    EXPECT_FALSE(0.3 >= p->result.interval95_low && 0.3 <= p->result.interval95_high)
+        << p->result.value;
+    EXPECT_TRUE(0.3 >= w->result.interval95_low && 0.3 <= w->result.interval95_high)
+        << w->result.value << " ± " << w->result.uncertainty;
+    ASSERT_TRUE(with.captures[0].black_reference);
+    // 1500 DN above the declared black: 1500/(65535 − 2000) on the linear scale.
+    EXPECT_NEAR(with.captures[0].black_reference->mean, 1500.0 / (65535.0 - 2000.0), 2e-4);
+    bool own = false, shared = false;
+    for (const auto& line : w->result.budget) {
+        own = own || line.source == "black reference of capture 1";
+        shared = shared || line.source.rfind("black level", 0) == 0;
+    }
+    EXPECT_TRUE(own);
+    EXPECT_FALSE(shared);
 }
 
 // Without declared tolerances the defaults are used and the result says so.
