@@ -75,7 +75,7 @@ def report(tmp_path_factory):
 
 def test_measurement_report_loads_every_image_without_console_errors(report, tmp_path):
     found = probe(report, tmp_path)
-    assert found["images"] == 2, found
+    assert found["images"] == 3, found  # the two photographs and the uncertainty budget
     assert found["bad"] == [], found
     assert found["errors"] == [], found
 
