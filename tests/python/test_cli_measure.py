@@ -192,7 +192,8 @@ def test_report_is_self_contained(linear_sample, tmp_path):
     proc = run(capture_file, "--report", out)
     index = out / "index.html"
     text = index.read_text()
-    assert text.count("data:image/png;base64,") == 2  # both photographs with the region
+    # both photographs with the region, and the uncertainty budget
+    assert text.count("data:image/png;base64,") == 3
     assert "σ/T" in text and "E1/E2" in text
     assert "src=\"http" not in text and "href=\"http" not in text
     assert "E1/E2" in proc.stdout
