@@ -14,7 +14,10 @@
 #include "roughscope/core/numbers.hpp"
 #include "roughscope/core/text.hpp"
 #include "roughscope/measure/measure.hpp"
+#include "roughscope/scattering/beckmann.hpp"
 #include "roughscope/scattering/correlation.hpp"
+#include "roughscope/scattering/factors.hpp"
+#include "roughscope/scattering/validity.hpp"
 
 namespace roughscope::image {
 namespace {
@@ -79,6 +82,47 @@ std::optional<Geometry> signed_geometry(double theta_i, double theta_s, double p
 }
 
 bool normal_view(const Geometry& g) { return g.theta_s_rad == 0.0; }
+
+// The model error of the very-rough Gaussian σ/T (Eq. 17, or Eq. 4 through the solver) where σ
+// is unknown: the surface is assumed very rough (g ≥ kVeryRoughMinG at both captures), and over
+// that range the exact series of Eq. 2 gives ratios that the very-rough inverse reads as
+// s'(g) ≠ s. The largest |s'(g) − s| over g = g_min … 100 g_min (g_min = SetupTolerances::
+// very_rough_min_g, default kVeryRoughMinG; σ/T = s held, σ from the smaller g of the two
+// captures) is the half-width of a rectangular input (docs/uncertainty.md).
+double very_rough_model_error(double s, const Geometry& g1, const Geometry& g2,
+                              const MeasureRequest& request, bool closed) {
+    ModelOptions o;
+    o.regime = Regime::Series;
+    o.factor = request.factor;
+    o.radiometry = request.radiometry;
+    o.wavelength_um = request.wavelength_um;
+    TwoGeometryOptions t;
+    t.factor = request.factor;
+    t.radiometry = request.radiometry;
+    const double vz = std::min(scattering_vector(g1, o.wavelength_um).vz,
+                               scattering_vector(g2, o.wavelength_um).vz);
+    double worst = 0.0;
+    for (const double factor : {1.0, 1.4, 2.0, 3.0, 5.0, 10.0, 30.0, 100.0}) {
+        const double g = factor * request.uncertainty.very_rough_min_g;
+        const double sigma = std::sqrt(g) / std::abs(vz);
+        const Surface surface{sigma, sigma / s, Correlation::Gaussian};
+        const auto brightness = [&](const Geometry& geom) {
+            return mean_scattered_power(geom, surface, o).diffuse *
+                   radiometric_factor(o.radiometry, geom);
+        };
+        try {
+            const double ratio = brightness(g1) / brightness(g2);
+            const double read =
+                closed ? sigma_over_T_from_ratio(Correlation::Gaussian, ratio, g1.theta_i_rad,
+                                                 g2.theta_i_rad, request.factor)
+                       : sigma_over_T_two_geometries(ratio, g1, g2, Correlation::Gaussian, t);
+            worst = std::max(worst, std::abs(read - s));
+        } catch (const Error&) {
+            return kNaN;  // a ratio the very-rough inverse cannot read: no bound
+        }
+    }
+    return worst;
+}
 
 // The tolerances in force: the declared ones, else the defaults (noted as assumed).
 class Tolerances {
@@ -160,6 +204,7 @@ class BudgetModel {
     std::vector<DiffuseInputs> diffuse_;
     std::optional<SpecularInputs> specular_;
     std::size_t black_ = kNone, gamma_ = kNone, lambda_ = kNone, sigma_given_ = kNone;
+    std::size_t model_gaussian_ = kNone;  // the very-rough model error of σ/T (Gaussian)
 };
 
 void BudgetModel::build() {
@@ -263,6 +308,20 @@ void BudgetModel::build_diffuse(const std::vector<std::size_t>& pair) {
         in.normal_view = normal_view(g) && !(inputs_[in.theta_s].u > 0.0);
         diffuse_.push_back(in);
     }
+    // σ unknown: the Gaussian σ/T rests on the very-rough limit; its model error is an input.
+    if (wanted_[1] && !request_.sigma_um && !(result_.sigma && result_.sigma->sigma_um)) {
+        const Geometry& g1 = result_.captures[pair[0]].spec.geometry;
+        const Geometry& g2 = result_.captures[pair[1]].spec.geometry;
+        const double b = very_rough_model_error(result_.slope_gaussian->sigma_over_T->value, g1, g2,
+                                                request_, normal_view(g1) && normal_view(g2));
+        if (std::isfinite(b)) {
+            model_gaussian_ =
+                add(concat("model: Eq. 17 (very rough) vs the exact series, g ≥ ",
+                           format_significant(request_.uncertainty.very_rough_min_g, 3)),
+                    0.0, b / std::sqrt(3.0));
+            inputs_[model_gaussian_].distribution = InputDistribution::Rectangular;
+        }
+    }
 }
 
 void BudgetModel::build_specular(std::size_t k) {
@@ -343,6 +402,7 @@ void BudgetModel::operator()(std::span<const double> x, std::span<std::optional<
                           : sigma_over_T_two_geometries(*ratio, *g1, *g2, c, options);
         } catch (const Error&) {
         }
+        if (o == 1 && y[1] && model_gaussian_ != kNone) *y[1] += x[model_gaussian_];
     }
     std::optional<double> s;
     try {
@@ -383,6 +443,10 @@ void detail::check_tolerances(const MeasureRequest& request) {
     check_tolerance(src, "response_gamma", t.response_gamma);
     check_tolerance(src, "wavelength_um", t.wavelength_um);
     check_tolerance(src, "flat_field_rel", t.flat_field_rel);
+    if (!(t.very_rough_min_g >= 1.0 && t.very_rough_min_g <= 1e6))
+        throw InvalidArgument(concat(
+            src, ": uncertainty.very_rough_min_g = ", check::format_number(t.very_rough_min_g),
+            " must be in [1, 1e6]"));
     for (std::size_t k = 0; k < request.captures.size(); ++k) {
         const CaptureTolerances& c = request.captures[k].uncertainty;
         const std::string name = concat(src, ": captures[", std::to_string(k), "]");

@@ -505,7 +505,7 @@ void parse_statistics(const JsonNode& s, RegionStatisticsOptions& o) {
 // them; a capture's own "uncertainty" overrides its angles and exposure.
 void parse_uncertainty(const JsonNode& j, MeasureRequest& request) {
     j.only({"angle_deg", "exposure_rel", "black_level_dn", "response_gamma", "wavelength_um",
-            "flat_field_rel", "method", "seed", "max_trials"});
+            "flat_field_rel", "very_rough_min_g", "method", "seed", "max_trials"});
     SetupTolerances& t = request.uncertainty;
     if (j.has("angle_deg")) t.angle_deg = tolerance(j, "angle_deg", 45.0, "°");
     if (j.has("exposure_rel")) t.exposure_rel = tolerance(j, "exposure_rel", 1.0, "");
@@ -513,6 +513,8 @@ void parse_uncertainty(const JsonNode& j, MeasureRequest& request) {
     if (j.has("response_gamma")) t.response_gamma = tolerance(j, "response_gamma", 5.0, "");
     if (j.has("wavelength_um")) t.wavelength_um = tolerance(j, "wavelength_um", 1.0, " µm");
     if (j.has("flat_field_rel")) t.flat_field_rel = tolerance(j, "flat_field_rel", 1.0, "");
+    if (j.has("very_rough_min_g"))
+        t.very_rough_min_g = j.at("very_rough_min_g").number(1.0, 1e6, "");
     if (j.has("method"))
         request.propagation.method = j.at("method").named(parse_propagation_method);
     if (j.has("seed"))

@@ -20,6 +20,9 @@ struct SetupTolerances {
     std::optional<double> response_gamma;  // γ, or the sRGB curve's exponent (2.4)
     std::optional<double> wavelength_um;   // the effective wavelength, µm
     std::optional<double> flat_field_rel;  // the flat field between two regions, relative
+    // The smallest g = σ² v_z² the sample is taken to have at either capture when σ is unknown:
+    // the very-rough σ/T (Eq. 17) carries the model error of that limit over g ≥ this.
+    double very_rough_min_g = 10.0;  // kVeryRoughMinG (scattering/validity.hpp)
 };
 
 // A capture's own standard uncertainties, over the setup's.

@@ -20,6 +20,8 @@
 #include "roughscope/core/text.hpp"
 #include "roughscope/io/output_file.hpp"
 #include "roughscope/measure/measure.hpp"
+#include "roughscope/scattering/beckmann.hpp"
+#include "roughscope/scattering/factors.hpp"
 #include "roughscope/simulation/capture.hpp"
 
 namespace roughscope::image {
@@ -44,13 +46,14 @@ constexpr double kNominalBlackDn = 2000.0;
 // (black_strip: columns 0–3 receive no light, a light trap for "black_reference".)
 std::vector<std::string> render_bench(const fs::path& dir, const Bench& bench, double sigma_over_T,
                                       Correlation correlation, std::uint64_t seed,
-                                      bool black_strip = false) {
+                                      bool black_strip = false,
+                                      const sim::SurfaceTruth* given = nullptr) {
     sim::Scene scene;
     scene.width = scene.height = 32;
     scene.view = Eigen::Vector3d(std::tan(deg_to_rad(bench.view_x_deg)),
                                  std::tan(deg_to_rad(bench.view_y_deg)), 1.0)
                      .normalized();
-    const sim::SurfaceTruth truth = very_rough_truth(sigma_over_T, correlation);
+    const sim::SurfaceTruth truth = given ? *given : very_rough_truth(sigma_over_T, correlation);
     const double peak =
         std::max(sim::surface_brightness(truth, normal_view_geometry(deg_to_rad(30.0))),
                  sim::surface_brightness(truth, normal_view_geometry(deg_to_rad(45.0))));
@@ -85,16 +88,27 @@ std::vector<std::string> render_bench(const fs::path& dir, const Bench& bench, d
     return files;
 }
 
+// The renders are the very-rough model itself (g = ∞): the declared bound on g is set so high
+// that the model error of Eq. 17 (tested on its own below) is negligible, unless given.
+std::string with_min_g(const std::string& uncertainty) {
+    if (uncertainty.find("very_rough_min_g") != std::string::npos || uncertainty == "{}")
+        return uncertainty;
+    return concat(uncertainty.substr(0, uncertainty.rfind('}')),
+                  uncertainty.find(':') == std::string::npos ? "" : ", ",
+                  R"("very_rough_min_g": 1e6})");
+}
+
 MeasureResult measure_bench(const fs::path& dir, const Bench& bench, double sigma_over_T,
                             Correlation correlation, const std::string& uncertainty,
                             std::uint64_t seed) {
     const std::vector<std::string> files =
         render_bench(dir, bench, sigma_over_T, correlation, seed);
-    const std::string text = concat(R"({"roi": {"rect": [4, 4, 24, 24]}, "black_level_dn": )",
-                                    check::format_number(kNominalBlackDn), R"(, "uncertainty": )",
-                                    uncertainty, R"(, "captures": [{"image": ")", files[0],
-                                    R"(", "theta_i_deg": 30, "exposure_s": 1}, {"image": ")",
-                                    files[1], R"(", "theta_i_deg": 45, "exposure_s": 1}]})");
+    const std::string text =
+        concat(R"({"roi": {"rect": [4, 4, 24, 24]}, "black_level_dn": )",
+               check::format_number(kNominalBlackDn), R"(, "uncertainty": )",
+               with_min_g(uncertainty), R"(, "captures": [{"image": ")", files[0],
+               R"(", "theta_i_deg": 30, "exposure_s": 1}, {"image": ")", files[1],
+               R"(", "theta_i_deg": 45, "exposure_s": 1}]})");
     return measure(parse_capture_file(text, (dir / "capture.json").string()));
 }
 
@@ -292,7 +306,7 @@ TEST(MeasureBudget, AMirrorSphereGivesTheLight) {
             dir / concat("sphere", std::to_string(k), ".tiff"),
             sim::direction_from_angles(deg_to_rad(k == 0 ? b.theta1_deg : b.theta2_deg), kPi));
     const std::string head =
-        R"({"roi": {"rect": [4, 4, 24, 24]}, "black_level_dn": 2000, "uncertainty": {"angle_deg": 0.5, "exposure_rel": 0.001, "black_level_dn": 1}, "captures": [)";
+        R"({"roi": {"rect": [4, 4, 24, 24]}, "black_level_dn": 2000, "uncertainty": {"angle_deg": 0.5, "exposure_rel": 0.001, "black_level_dn": 1, "very_rough_min_g": 1e6}, "captures": [)";
     const auto capture = [&](int k, const std::string& light) {
         return concat(R"({"image": ")", files[k], R"(", "exposure_s": 1, )", light, "}");
     };
@@ -343,11 +357,12 @@ TEST(MeasureBudget, ABlackReferenceMeasuresTheBlackLevel) {
         render_bench(dir, b, 0.3, Correlation::Gaussian, 4, true);
     const auto run = [&](const std::string& extra) {
         return measure(parse_capture_file(
-            concat(R"({"roi": {"rect": [4, 4, 24, 24]}, "black_level_dn": 2000, )", extra,
-                   R"("uncertainty": {"angle_deg": 0.1, "exposure_rel": 0.001, "black_level_dn": 5},
+            concat(
+                R"({"roi": {"rect": [4, 4, 24, 24]}, "black_level_dn": 2000, )", extra,
+                R"("uncertainty": {"angle_deg": 0.1, "exposure_rel": 0.001, "black_level_dn": 5, "very_rough_min_g": 1e6},
                       "captures": [{"image": ")",
-                   files[0], R"(", "theta_i_deg": 30, "exposure_s": 1}, {"image": ")", files[1],
-                   R"(", "theta_i_deg": 45, "exposure_s": 1}]})"),
+                files[0], R"(", "theta_i_deg": 30, "exposure_s": 1}, {"image": ")", files[1],
+                R"(", "theta_i_deg": 45, "exposure_s": 1}]})"),
             (dir / "c.json").string()));
     };
     const MeasureResult plain = run("");
@@ -369,6 +384,72 @@ TEST(MeasureBudget, ABlackReferenceMeasuresTheBlackLevel) {
     }
     EXPECT_TRUE(own);
     EXPECT_FALSE(shared);
+}
+
+// The exact B–K brightness (the series of Eq. 2, Gaussian) of σ/T = s at g = σ²v_z² (v_z at
+// 45°, the smaller of the pair's).
+sim::SurfaceTruth exact_truth(double s, double g) {
+    const double vz = scattering_vector(normal_view_geometry(deg_to_rad(45.0)), 0.555).vz;
+    const double sigma = std::sqrt(g) / std::abs(vz);
+    sim::SurfaceTruth truth;
+    truth.model = sim::BrightnessModel::Tabulated;
+    truth.sigma_um = sigma;
+    truth.T_um = sigma / s;
+    truth.tabulated = [sigma, s](const Geometry& geom) {
+        ModelOptions o;
+        o.regime = Regime::Series;
+        const ScatteredPower p =
+            mean_scattered_power(geom, Surface{sigma, sigma / s, Correlation::Gaussian}, o);
+        return p.diffuse * radiometric_factor(o.radiometry, geom);
+    };
+    return truth;
+}
+
+// Model error: surfaces of the exact series at g = 10 … 100 (very rough, but not the limit Eq. 17
+// is exact in), σ unknown: with the default bound g ≥ 10 the Gaussian σ/T's interval holds the
+// truth in ≥ 90 % of the cases; without the model error (bound 10⁶) it does not at g ≈ 10.
+TEST(MeasureBudget, TheModelErrorOfTheVeryRoughLimitIsCovered) {
+    const fs::path dir = testing::fresh_dir("budget_model_error");
+    const std::string declared =
+        R"({"angle_deg": 0.05, "exposure_rel": 0.001, "black_level_dn": 2)";
+    int covered = 0, runs = 0, covered_without = 0, runs_without = 0;
+    std::uint64_t seed = 100;
+    for (const double s : {0.15, 0.3, 0.6}) {
+        for (const double g : {10.0, 13.0, 20.0, 40.0, 100.0}) {
+            const sim::SurfaceTruth truth = exact_truth(s, g);
+            const auto files =
+                render_bench(dir, Bench{}, s, Correlation::Gaussian, ++seed, false, &truth);
+            const auto run = [&](const std::string& uncertainty) {
+                return measure(parse_capture_file(
+                    concat(R"({"roi": {"rect": [4, 4, 24, 24]}, "black_level_dn": 2000, )",
+                           R"("uncertainty": )", uncertainty, R"(, "captures": [{"image": ")",
+                           files[0], R"(", "theta_i_deg": 30, "exposure_s": 1}, {"image": ")",
+                           files[1], R"(", "theta_i_deg": 45, "exposure_s": 1}]})"),
+                    (dir / "c.json").string()));
+            };
+            const auto inside = [s](const MeasureResult& r) {
+                const QuantityBudget* q = quantity(r, "sigma_over_T_gaussian");
+                return q && s >= q->result.interval95_low && s <= q->result.interval95_high;
+            };
+            const MeasureResult r = run(declared + "}");
+            ++runs;
+            covered += inside(r) ? 1 : 0;
+            bool has_model = false;
+            for (const auto& line : quantity(r, "sigma_over_T_gaussian")->result.budget)
+                has_model = has_model || line.source.rfind("model: Eq. 17", 0) == 0;
+            EXPECT_TRUE(has_model);
+            if (g <= 13.0) {
+                ++runs_without;
+                covered_without += inside(run(declared + R"(, "very_rough_min_g": 1e6})")) ? 1 : 0;
+            }
+        }
+    }
+    EXPECT_GE(covered, runs * 9 / 10) << covered << " of " << runs;
+    EXPECT_LT(covered_without, runs_without / 2) << covered_without << " of " << runs_without;
+    std::printf(
+        "[ budget   ] model error: truth inside in %d of %d runs (without the model "
+        "error, at g ≤ 13: %d of %d)\n",
+        covered, runs, covered_without, runs_without);
 }
 
 // Without declared tolerances the defaults are used and the result says so.
