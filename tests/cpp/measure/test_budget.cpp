@@ -386,6 +386,64 @@ TEST(MeasureBudget, ABlackReferenceMeasuresTheBlackLevel) {
     EXPECT_FALSE(shared);
 }
 
+// The exact B–K brightness (the series of Eq. 2, Gaussian) of σ and T at 0.555 µm.
+sim::SurfaceTruth exact_sigma_T(double sigma, double T) {
+    sim::SurfaceTruth truth;
+    truth.model = sim::BrightnessModel::Tabulated;
+    truth.sigma_um = sigma;
+    truth.T_um = T;
+    truth.tabulated = [sigma, T](const Geometry& geom) {
+        ModelOptions o;
+        o.regime = Regime::Series;
+        const ScatteredPower p =
+            mean_scattered_power(geom, Surface{sigma, T, Correlation::Gaussian}, o);
+        return p.diffuse * radiometric_factor(o.radiometry, geom);
+    };
+    return truth;
+}
+
+// T given σ on a perturbed bench: a slightly rough surface (g < 0.1, Eq. 15's regime) whose σ is
+// given with its standard error, the light angles, camera tilt, exposures and black level drawn
+// from the declared uncertainties: the true T inside T_um's 95 % interval in ≥ 90 % of the runs.
+TEST(MeasureBudget, TheIntervalOfTGivenSigmaCoversTheTruth) {
+    const fs::path dir = testing::fresh_dir("budget_T");
+    const double sigma = 0.0105, T = 0.5, u_sigma = 0.0004;
+    std::mt19937_64 rng(31);
+    std::normal_distribution<double> z(0.0, 1.0);
+    int covered = 0;
+    const int runs = 60;
+    for (int run = 0; run < runs; ++run) {
+        Bench b;
+        b.theta1_deg += 0.5 * z(rng);
+        b.theta2_deg += 0.5 * z(rng);
+        b.view_x_deg = 0.5 * z(rng);
+        b.view_y_deg = 0.5 * z(rng);
+        b.exposure1 *= 1.0 + 0.01 * z(rng);
+        b.exposure2 *= 1.0 + 0.01 * z(rng);
+        b.black_dn += 40.0 * z(rng);
+        const double sigma_declared = sigma + u_sigma * z(rng);  // σ from elsewhere, ± u
+        const sim::SurfaceTruth truth = exact_sigma_T(sigma, T);
+        const auto files = render_bench(dir, b, sigma / T, Correlation::Gaussian,
+                                        static_cast<std::uint64_t>(run) + 500, false, &truth);
+        const MeasureResult r = measure(parse_capture_file(
+            concat(
+                R"({"roi": {"rect": [4, 4, 24, 24]}, "black_level_dn": 2000, "sigma_um": )",
+                check::format_number(sigma_declared), R"(, "sigma_um_stderr": )",
+                check::format_number(u_sigma),
+                R"(, "uncertainty": {"angle_deg": 0.5, "exposure_rel": 0.01, "black_level_dn": 40, "wavelength_um": 0.001},
+                      "captures": [{"image": ")",
+                files[0], R"(", "theta_i_deg": 30, "exposure_s": 1}, {"image": ")", files[1],
+                R"(", "theta_i_deg": 45, "exposure_s": 1}]})"),
+            (dir / "c.json").string()));
+        const QuantityBudget* q = quantity(r, "T_um");
+        ASSERT_NE(q, nullptr);
+        if (T >= q->result.interval95_low && T <= q->result.interval95_high) ++covered;
+    }
+    EXPECT_GE(covered, runs * 9 / 10) << covered << " of " << runs;
+    std::printf("[ budget   ] T given sigma: truth inside the 95 %% interval in %d of %d runs\n",
+                covered, runs);
+}
+
 // The exact B–K brightness (the series of Eq. 2, Gaussian) of σ/T = s at g = σ²v_z² (v_z at
 // 45°, the smaller of the pair's).
 sim::SurfaceTruth exact_truth(double s, double g) {
