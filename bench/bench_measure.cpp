@@ -8,6 +8,9 @@
 //        measure/decode_<format>/<rows> baseline: the two files decoded by the reference decoder
 // <rows> = 4096 is the 24-MP image (5859 x 4096); 256 a small one (the smoke run skips /4096).
 // The counter time_vs_decode of pair_<format> is its ratio to the baseline of the same format.
+//        measure/budget/<rows>/<0|1>    the uncertainty budget alone, first order (0) or Monte
+//                                       Carlo with 10⁴ trials (1); its time_vs_decode is against
+//                                       decoding the same pair
 #include <chrono>
 #include <cstddef>
 #include <cstdint>
@@ -104,6 +107,34 @@ void BM_measure_decode(benchmark::State& state, sim::CaptureFormat format) {
     for (auto _ : state) decode(p, format);
     for (const auto& f : p.files) fs::remove(f);
 }
+
+// The uncertainty budget alone (measure/budget.hpp) of a measured pair: first order (method 0)
+// or Monte Carlo with one batch of 10⁴ trials on every core (method 1), against decoding the
+// pair (OpenCV, as the TIFF baseline above, timed in the same run): the counter time_vs_decode.
+// Args: rows (256, or 4096 = a 24-MP pair), method.
+void BM_measure_budget(benchmark::State& state) {
+    Pair p = make_pair(sim::CaptureFormat::Tiff, static_cast<std::size_t>(state.range(0)));
+    p.request.uncertainty.angle_deg = 0.5;
+    const bool monte_carlo = state.range(1) == 1;
+    p.request.propagation.method = monte_carlo ? roughscope::PropagationMethod::MonteCarlo
+                                               : roughscope::PropagationMethod::FirstOrder;
+    p.request.propagation.batch_trials = 10'000;
+    p.request.propagation.max_trials = 10'000;
+    const img::MeasureResult result = img::measure(p.request);
+    for (auto _ : state) benchmark::DoNotOptimize(img::uncertainty_budget(p.request, result));
+    const double t_decode = seconds_of([&] { decode(p, sim::CaptureFormat::Tiff); }, 3);
+    const double t_budget =
+        seconds_of([&] { (void)img::uncertainty_budget(p.request, result); }, 3);
+    state.counters["time_vs_decode"] = t_budget / t_decode;
+    state.SetLabel(monte_carlo ? "monte carlo, 1e4 trials" : "first order");
+    for (const auto& f : p.files) fs::remove(f);
+}
+BENCHMARK(BM_measure_budget)
+    ->Name("measure/budget")
+    ->Args({256, 0})
+    ->Args({256, 1})
+    ->Args({4096, 1})
+    ->Unit(benchmark::kMillisecond);
 
 BENCHMARK_CAPTURE(BM_measure_pair, tiff, sim::CaptureFormat::Tiff)
     ->Name("measure/pair_tiff")
