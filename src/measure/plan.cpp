@@ -37,16 +37,8 @@ constexpr std::size_t kMaxRangePoints = 50;
 constexpr std::size_t kMaxTop = 1000;
 
 // The inputs of the model, in x (the budget's names, so that the lines read alike).
-enum Input : std::size_t {
-    kTheta1,
-    kTheta2,
-    kTilt,
-    kExposure1,
-    kExposure2,
-    kBlack,
-    kNoise1,
-    kNoise2
-};
+constexpr std::size_t kTheta1 = 0, kTheta2 = 1, kTilt = 2, kExposure1 = 3, kExposure2 = 4,
+                      kBlack = 5, kNoise1 = 6, kNoise2 = 7;
 
 // The tolerances in force, after the defaults.
 struct Tolerances {
