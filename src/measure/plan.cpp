@@ -73,6 +73,9 @@ class PairModel {
         ratio_ = model_ratio_very_rough(normal_view_geometry(theta1_rad),
                                         normal_view_geometry(theta2_rad), sigma_over_T,
                                         request.correlation, options_);
+        if (!(ratio_ > 1e-12 && ratio_ < 1e12))
+            throw NoSolution(concat("E1/E2 = ", check::format_number(ratio_),
+                                    " is beyond what a camera resolves (1e-12 to 1e12)"));
         // Fractions of full scale reached by each capture, and their relative noise.
         m1_ = m2_ = request.fill;
         double noise1 = request.noise_rel, noise2 = request.noise_rel;
@@ -235,9 +238,9 @@ std::vector<double> angle_grid(const PlanRequest& r) {
     const double count = std::floor((r.theta_max_deg - r.theta_min_deg) / r.theta_step_deg + 1e-9);
     if (count * (count + 1.0) / 2.0 > static_cast<double>(kMaxPairs))
         throw InvalidArgument(
-            concat("plan: theta_step_deg = ", check::format_number(r.theta_step_deg), "° makes ",
-                   format_significant(count + 1.0, 3),
-                   " angles; at most ~630 (a coarser step or a narrower grid)"));
+            concat("plan: theta_step_deg = ", check::format_number(r.theta_step_deg),
+                   "° makes more than ~630 angles (at most 200,000 pairs): a coarser step or a "
+                   "narrower grid"));
     std::vector<double> grid;
     for (std::size_t k = 0; k <= static_cast<std::size_t>(count); ++k)
         grid.push_back(r.theta_min_deg + static_cast<double>(k) * r.theta_step_deg);
@@ -294,7 +297,7 @@ CapturePlan plan_capture(const PlanRequest& request) {
             n == 1
                 ? request.sigma_over_T
                 : request.sigma_over_T + (*request.sigma_over_T_max - request.sigma_over_T) *
-                                             static_cast<double>(k) / static_cast<double>(n - 1));
+                                             (static_cast<double>(k) / static_cast<double>(n - 1)));
     const std::vector<double> grid = angle_grid(request);
     PropagationOptions search = request.propagation;
     search.method = PropagationMethod::FirstOrder;
@@ -313,12 +316,12 @@ CapturePlan plan_capture(const PlanRequest& request) {
             if (p.has_value) ranked.push_back(std::move(p));
         }
     if (plan.pairs == 0)
-        throw InvalidArgument(concat("plan: the angle grid [",
-                                     check::format_number(request.theta_min_deg), ", ",
-                                     check::format_number(request.theta_max_deg), "]° by ",
-                                     check::format_number(request.theta_step_deg),
-                                     "° has no pair with theta2 − theta1 ≥ min_difference_deg = ",
-                                     check::format_number(request.min_difference_deg), "°"));
+        throw InvalidArgument(concat(
+            "plan: the angle grid (theta_min_deg = ", check::format_number(request.theta_min_deg),
+            ", theta_max_deg = ", check::format_number(request.theta_max_deg),
+            ", theta_step_deg = ", check::format_number(request.theta_step_deg),
+            ") has no pair with theta2 − theta1 ≥ min_difference_deg = ",
+            check::format_number(request.min_difference_deg), "°"));
     plan.pairs_with_value = ranked.size();
     if (ranked.empty())
         throw NoSolution(concat("plan: no pair of the grid gives σ/T a value at every σ/T in [",
