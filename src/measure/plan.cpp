@@ -341,6 +341,11 @@ CapturePlan plan_capture(const PlanRequest& request) {
         plan.warnings.push_back(concat("plan: rests on assumed tolerances (", list,
                                        "): give the setup's (docs/uncertainty.md)"));
     }
+    if (plan.reference.has_value && plan.recommended.has_value &&
+        plan.reference.relative_uncertainty < plan.recommended.relative_uncertainty)
+        plan.warnings.push_back(
+            "plan: the paper's 30°/45° (outside the grid or the min_difference_deg constraint) "
+            "does better than every pair of the grid");
     if (plan.recommended.method == PropagationMethod::MonteCarlo)
         plan.warnings.push_back(
             "plan: the recommended pair's model is not near-linear at the tolerances: its "
