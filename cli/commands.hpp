@@ -14,6 +14,7 @@ void register_surface(CLI::App& app);     // cli/surface.cpp  — height data (�
 void register_simulate(CLI::App& app);    // cli/simulate.cpp — simulations (ground truth)
 void register_measure(CLI::App& app);     // cli/measure.cpp  — roughness from photographs
 void register_calibrate(CLI::App& app);   // cli/calibrate.cpp — the light from a mirror sphere
+void register_plan(CLI::App& app);        // cli/plan.cpp     — the light angles to choose
 void register_completion(CLI::App& app);  // cli/completion.cpp — bash completion script
 
 }  // namespace roughscope::cli

@@ -30,6 +30,7 @@ int main(int argc, char** argv) {
     roughscope::cli::register_simulate(app);
     roughscope::cli::register_measure(app);
     roughscope::cli::register_calibrate(app);
+    roughscope::cli::register_plan(app);
     // Last: the completion script describes every subcommand registered before it.
     roughscope::cli::register_completion(app);
 

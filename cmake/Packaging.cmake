@@ -83,7 +83,7 @@ if(TARGET roughscope_cli)
     # roughscope(1) and one page per subcommand, roughscope-<subcommand>(1) (as git does), each
     # made by help2man from that command's --help; gzip -n: reproducible (Debian policy 12.1).
     set(_rs_man_dir "${PROJECT_BINARY_DIR}/share/man/man1")
-    set(_rs_subcommands model estimate paper curet surface simulate measure calibrate completion)
+    set(_rs_subcommands model estimate paper curet surface simulate measure calibrate plan completion)
     set(_rs_see_also "[SEE ALSO]\n")
     foreach(sub IN LISTS _rs_subcommands)
       string(APPEND _rs_see_also ".BR roughscope-${sub} (1)\n")

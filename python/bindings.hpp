@@ -40,6 +40,7 @@ void bind_simulation(pybind11::module_& m);   // python/bind_simulation.cpp: Kir
 void bind_capture(pybind11::module_& m);      // python/bind_capture.cpp: synthetic captures
 void bind_image(pybind11::module_& m);        // python/bind_image.cpp: photographs to roughness
 void bind_calibration(pybind11::module_& m);  // python/bind_calibration.cpp: the light's direction
+void bind_plan(pybind11::module_& m);         // python/bind_plan.cpp: the light angles to choose
 void bind_report(pybind11::module_& m);       // python/bind_report.cpp: what the report draws
 void bind_documents(pybind11::module_& m);    // python/bind_documents.cpp: text and documents
 

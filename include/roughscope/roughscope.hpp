@@ -82,6 +82,7 @@
 // measure: the capture file and the measurement
 #include "roughscope/measure/budget.hpp"
 #include "roughscope/measure/measure.hpp"
+#include "roughscope/measure/plan.hpp"
 
 // serialize: every result type to JSON, CSV, Markdown and text
 #include "roughscope/serialize/calibration.hpp"
@@ -92,6 +93,7 @@
 #include "roughscope/serialize/measure.hpp"
 #include "roughscope/serialize/model.hpp"
 #include "roughscope/serialize/paper_tables.hpp"
+#include "roughscope/serialize/plan.hpp"
 #include "roughscope/serialize/simulation.hpp"
 #include "roughscope/serialize/surface.hpp"
 #include "roughscope/serialize/text.hpp"

@@ -121,7 +121,7 @@ def script(tmp_path):
 def test_completion_of_subcommands_and_options(script, tmp_path):
     assert complete(script, ["roughscope", ""], tmp_path) == [
         "model", "estimate", "paper", "curet", "surface", "simulate", "measure", "calibrate",
-        "completion"]
+        "plan", "completion"]
     assert complete(script, ["roughscope", "me"], tmp_path) == ["measure"]
     assert complete(script, ["roughscope", "estimate", "s"], tmp_path) == ["specular", "slope"]
     assert complete(script, ["roughscope", "estimate", "specular", "--r"], tmp_path) == [

@@ -253,3 +253,11 @@ def test_calibrate_light_flags_at_the_extremes():
         [image, "--sphere", "64,64,56"],
         [image, "--sphere", "64,64,56", "--circle-uncertainty", "0", "--json"],
     ]) >= 2
+
+
+def test_plan_flags_at_the_extremes():
+    assert sweep(["plan"], [
+        ["--sigma-over-T", "0.5", "--theta-step", "10", "--method", "first_order"],
+        ["--sigma-over-T", "0.5", "--sigma-over-T-max", "0.8", "--range-points", "2",
+         "--exposure", "common", "--theta-step", "10", "--method", "first_order", "--json"],
+    ]) >= 2
