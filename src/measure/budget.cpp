@@ -44,7 +44,8 @@ RegionMean region_mean(double mean, const ImageInfo& info, bool bracket) {
     r.white_dn = info.white_level_dn > 0.0 ? info.white_level_dn : 1.0;
     double b = 0.0;
     for (double level : info.black_level_dn) b += level;
-    r.black_dn = info.black_level_dn.empty() ? 0.0 : b / info.black_level_dn.size();
+    r.black_dn =
+        info.black_level_dn.empty() ? 0.0 : b / static_cast<double>(info.black_level_dn.size());
     r.gamma = info.response == Response::Gamma  ? info.gamma
               : info.response == Response::Srgb ? kSrgbExponent
                                                 : 0.0;
