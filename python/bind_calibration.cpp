@@ -104,7 +104,9 @@ void bind_calibration(py::module_& m) {
            py::handle gamma) {
             image::ReadOptions read;
             if (response) read.response = parse_response(*response);
-            if (read.response == Response::Gamma) read.gamma = real_scalar("gamma", gamma);
+            // Checked whatever the image (as read_image does): used for a path read as gamma.
+            const double gamma_value = real_scalar("gamma", gamma);
+            if (read.response == Response::Gamma) read.gamma = gamma_value;
             const image::LinearImage img = image_argument(image, read);
             std::optional<std::vector<std::uint8_t>> pixels;
             if (!mask.is_none()) pixels = sphere_mask(mask, img);

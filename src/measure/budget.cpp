@@ -67,21 +67,6 @@ double perturbed_mean(const RegionMean& r, double d_black_dn, double d_gamma) {
     return m > 0.0 ? m : kNaN;
 }
 
-// A geometry whose angles moved: a negative zenith is the same direction at |θ| on the other
-// side (φs + π); a zenith at or past 90° has no value.
-std::optional<Geometry> signed_geometry(double theta_i, double theta_s, double phi_s) {
-    if (theta_i < 0.0) {
-        theta_i = -theta_i;
-        phi_s += kPi;
-    }
-    if (theta_s < 0.0) {
-        theta_s = -theta_s;
-        phi_s += kPi;
-    }
-    if (!(theta_i < kPi / 2) || !(theta_s < kPi / 2)) return std::nullopt;
-    return Geometry{theta_i, theta_s, phi_s};
-}
-
 bool normal_view(const Geometry& g) { return g.theta_s_rad == 0.0; }
 
 // The model error of the very-rough Gaussian σ/T (Eq. 17, or Eq. 4 through the solver) where σ
@@ -434,6 +419,19 @@ void check_tolerance(const std::string& where, std::string_view key,
 }
 
 }  // namespace
+
+std::optional<Geometry> signed_geometry(double theta_i, double theta_s, double phi_s) {
+    if (theta_i < 0.0) {
+        theta_i = -theta_i;
+        phi_s += kPi;
+    }
+    if (theta_s < 0.0) {
+        theta_s = -theta_s;
+        phi_s += kPi;
+    }
+    if (!(theta_i < kPi / 2) || !(theta_s < kPi / 2)) return std::nullopt;
+    return Geometry{theta_i, theta_s, phi_s};
+}
 
 void detail::check_tolerances(const MeasureRequest& request) {
     const std::string src = request.source.empty() ? std::string("measure") : request.source;

@@ -47,22 +47,6 @@ struct Tolerances {
     double black_level_rel = 0.0;
 };
 
-// A geometry whose angles moved (budget.cpp's signed_geometry): a negative zenith is |θ| on the
-// other side (φs + π); a zenith at or past 90° has none.
-std::optional<Geometry> signed_geometry(double theta_i, double theta_s) {
-    double phi_s = 0.0;
-    if (theta_i < 0.0) {
-        theta_i = -theta_i;
-        phi_s += kPi;
-    }
-    if (theta_s < 0.0) {
-        theta_s = -theta_s;
-        phi_s += kPi;
-    }
-    if (!(theta_i < kPi / 2) || !(theta_s < kPi / 2)) return std::nullopt;
-    return Geometry{theta_i, theta_s, phi_s};
-}
-
 // The model of one pair at one true σ/T: x → σ/T as measured.
 class PairModel {
   public:
@@ -112,8 +96,8 @@ class PairModel {
         if (!(m1 > 0.0) || !(m2 > 0.0) || !(s1 > 0.0) || !(s2 > 0.0)) return;
         const double ratio =
             ratio_ * (m1 / m1_) * (1.0 + x[kNoise1]) / s1 / ((m2 / m2_) * (1.0 + x[kNoise2]) / s2);
-        const auto g1 = signed_geometry(x[kTheta1], x[kTilt]);
-        const auto g2 = signed_geometry(x[kTheta2], x[kTilt]);
+        const auto g1 = signed_geometry(x[kTheta1], x[kTilt], 0.0);
+        const auto g2 = signed_geometry(x[kTheta2], x[kTilt], 0.0);
         if (!g1 || !g2 || !(ratio > 0.0)) return;
         try {
             y[0] =

@@ -108,6 +108,20 @@ FitOptions fit_options_from(const Json& options) {
     return o;
 }
 
+Json budget_json(const std::vector<BudgetLine>& budget) {
+    Json lines = Json::array();
+    for (const BudgetLine& line : budget) {
+        Json l;
+        l["source"] = line.source;
+        l["u_input"] = number(line.u_input);
+        l["sensitivity"] = number(line.sensitivity);
+        l["contribution"] = number(line.contribution);
+        l["fraction"] = number(line.fraction);
+        lines.push_back(l);
+    }
+    return lines;
+}
+
 Json to_json(const RoughnessEstimate& e, bool with_stderr) {
     Json out;
     put(out, "sigma_um", e.sigma_um, with_stderr);

@@ -325,17 +325,7 @@ void put_budget(Json& out, const std::optional<image::UncertaintyBudget>& b) {
             out[q.quantity + "_uncertainty"] = number(u.uncertainty);
             out[q.quantity + "_interval95"] =
                 Json::array({number(u.interval95_low), number(u.interval95_high)});
-            Json lines = Json::array();
-            for (const BudgetLine& line : u.budget) {
-                Json l;
-                l["source"] = line.source;
-                l["u_input"] = number(line.u_input);
-                l["sensitivity"] = number(line.sensitivity);
-                l["contribution"] = number(line.contribution);
-                l["fraction"] = number(line.fraction);
-                lines.push_back(l);
-            }
-            budget[q.quantity] = lines;
+            budget[q.quantity] = budget_json(u.budget);
         }
     }
     out["uncertainty_method"] = b ? Json(std::string(to_string(b->method))) : Json();

@@ -10,6 +10,7 @@
 #include "roughscope/core/uncertainty.hpp"
 #include "roughscope/scattering/correlation.hpp"
 #include "roughscope/scattering/factors.hpp"
+#include "roughscope/serialize/estimation.hpp"
 #include "roughscope/serialize/text.hpp"
 
 namespace roughscope::serialize {
@@ -37,17 +38,7 @@ Json pair_json(const image::PlannedPair& p) {
     j["sigma_over_T_interval95"] =
         Json::array({number(p.result.interval95_low), number(p.result.interval95_high)});
     j["method"] = std::string(to_string(p.method));
-    Json lines = Json::array();
-    for (const BudgetLine& line : p.result.budget) {
-        Json l;
-        l["source"] = line.source;
-        l["u_input"] = number(line.u_input);
-        l["sensitivity"] = number(line.sensitivity);
-        l["contribution"] = number(line.contribution);
-        l["fraction"] = number(line.fraction);
-        lines.push_back(l);
-    }
-    j["budget"] = std::move(lines);
+    j["budget"] = budget_json(p.result.budget);
     return j;
 }
 

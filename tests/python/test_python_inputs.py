@@ -54,6 +54,10 @@ with open(CAPTURE_FILE, "w", encoding="utf-8") as _f:
              '{"image": "cap1.png", "theta_i_deg": 45, "exposure_s": 1}]}')
 IMAGE_VALUES = np.random.default_rng(2).uniform(0.2, 0.3, size=(3, 12, 12))
 IMAGE_MASK = np.ones((12, 12), dtype=bool)
+# A mirror sphere of circle (16, 16, 12) with its highlight up and right of the centre.
+_YY, _XX = np.mgrid[0:32, 0:32] + 0.5
+MIRROR_SPHERE = np.where((_XX - 16) ** 2 + (_YY - 16) ** 2 < 144,
+                         0.02 + 0.9 * np.exp(-((_XX - 18) ** 2 + (_YY - 14) ** 2) / 2.0), 0.005)
 LOBES = Lobes([{"Cx": -1.0, "Cy": -1.0, "Cz": 1.0, "n": 10.0, "albedo": 0.5}])
 COMPARISON_OPTIONS = dict(theta1_deg=20.0, theta2_deg=50.0, pair=(1, 2), on_sigma_rad=0.2,
                           on_albedo=0.5, fits=False)
@@ -66,6 +70,10 @@ GOOD_CALLS = {
                              dict(weight=np.ones(4), **COMPARISON_OPTIONS))],
     "brdf_compare_csv": [((TABLE_CSV,), COMPARISON_OPTIONS)],
     "brdf_read_csv": [((TABLE_CSV,), {})],
+    # The image as read_image's dict (a str would be a path: a DataError, not a TypeError).
+    "calibrate_light": [(({"values": MIRROR_SPHERE[None]},),
+                         dict(circle=(16.0, 16.0, 12.0), view=(0.0, 0.0, 1.0),
+                              circle_uncertainty_px=0.5, gamma=2.2))],
     "caron_theta_K_deg": [((0.5,), {})],
     "caron_xi_K": [((0.5,), {})],
     "coherent_power": [((0.9, 0.5), {})],
@@ -147,6 +155,9 @@ GOOD_CALLS = {
     "shared_search_description": [(("data/curet",), {})],
     "srgb_encode": [(([0.0, 0.002, 0.5, 1.0],), {})],
     "sigma_from_specular": [((0.5, 10.0), dict(wavelength_um=0.555, R0=1.0))],
+    "plan_capture": [((0.5,), dict(sigma_over_T_max=0.6, noise_rel=0.002, fill=0.8,
+                                   theta_min_deg=20.0, theta_max_deg=60.0, theta_step_deg=10.0,
+                                   min_difference_deg=5.0, range_points=2, top=3))],
     "read_image": [((_HEIGHT_DIR + "/cap0.png",), dict(response="gamma", gamma=2.2,
                                                          black_level_dn=64.0))],
     "region_mask": [(({"circle": [6.0, 6.0, 4.0]}, 12, 12), {})],

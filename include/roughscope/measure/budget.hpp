@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "roughscope/estimation/propagation.hpp"
+#include "roughscope/scattering/geometry.hpp"
 
 namespace roughscope::image {
 
@@ -64,5 +65,10 @@ struct UncertaintyBudget {
     std::vector<std::string> assumed;
     std::vector<std::string> warnings;
 };
+
+// A geometry whose angles moved by an error (the budget's and the plan's model): a negative
+// zenith is the same direction at |θ| on the other side (φs + π); a zenith at or past 90° has no
+// value.
+std::optional<Geometry> signed_geometry(double theta_i_rad, double theta_s_rad, double phi_s_rad);
 
 }  // namespace roughscope::image

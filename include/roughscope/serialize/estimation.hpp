@@ -8,8 +8,10 @@
 
 #include <cstddef>
 #include <optional>
+#include <vector>
 
 #include "roughscope/estimation/estimation.hpp"
+#include "roughscope/estimation/propagation.hpp"
 #include "roughscope/fit/fit.hpp"
 #include "roughscope/serialize/json.hpp"
 
@@ -27,6 +29,10 @@ FitOptions fit_options_from(const Json& options);
 // sigma_um, T_um, sigma_over_T, theta_K_deg, xi_K, rms_slope (each with _stderr when asked),
 // roughness_class, roughness_class_assumed, g (list, null when σ is unknown), warnings.
 Json to_json(const RoughnessEstimate& estimate, bool with_stderr);
+
+// An uncertainty budget (estimation/propagation.hpp): [{"source", "u_input", "sensitivity",
+// "contribution", "fraction"}, ...] in its order (largest contribution first).
+Json budget_json(const std::vector<BudgetLine>& budget);
 
 // ---- The estimators' documents --------------------------------------------------------------
 // `estimate specular`: estimator, sigma_um, R_spec, R0, theta_deg, wavelength_um, derived keys.
