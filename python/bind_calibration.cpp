@@ -35,22 +35,45 @@ std::vector<double> real_list(const char* name, py::handle value, std::size_t co
     return {a.data(), a.data() + a.size()};
 }
 
+std::vector<std::uint8_t> sphere_mask(py::handle mask, const image::LinearImage& img) {
+    const auto m =
+        py::array_t<std::uint8_t, py::array::c_style | py::array::forcecast>::ensure(mask);
+    if (!m || m.ndim() != 2 || static_cast<std::size_t>(m.shape(0)) != img.height ||
+        static_cast<std::size_t>(m.shape(1)) != img.width)
+        throw InvalidArgument(concat("mask must be a (", std::to_string(img.height), ", ",
+                                     std::to_string(img.width),
+                                     ") array (nonzero = on the sphere)"));
+    return {m.data(), m.data() + m.size()};
+}
+
+}  // namespace
+
 // An image array (height, width) or (channels, height, width) on a linear scale; flags (height,
 // width) uint8 or None.
-image::LinearImage image_from_array(py::handle values, py::handle flags) {
+image::LinearImage image_from_array(py::handle values, py::handle flags, bool channels_last) {
     const auto v = py::array_t<float, py::array::c_style | py::array::forcecast>::ensure(
         real_array("image", values));
     if (!v || (v.ndim() != 2 && v.ndim() != 3))
-        throw InvalidArgument(
-            "image must be a path, a (height, width) or (channels, height, "
-            "width) array, or read_image's dict");
+        throw InvalidArgument(concat("image must be a path, a (height, width) or ",
+                                     channels_last ? "(height, width, channels)"
+                                                   : "(channels, height, width)",
+                                     " array, or read_image's dict"));
     image::LinearImage img;
     img.info.source = "array";
     const bool planes = v.ndim() == 3;
-    img.channels = planes ? static_cast<std::size_t>(v.shape(0)) : 1;
-    img.height = static_cast<std::size_t>(v.shape(planes ? 1 : 0));
-    img.width = static_cast<std::size_t>(v.shape(planes ? 2 : 1));
-    img.values.assign(v.data(), v.data() + v.size());
+    const bool last = planes && channels_last;
+    img.channels = planes ? static_cast<std::size_t>(v.shape(last ? 2 : 0)) : 1;
+    img.height = static_cast<std::size_t>(v.shape(planes && !last ? 1 : 0));
+    img.width = static_cast<std::size_t>(v.shape(planes && !last ? 2 : 1));
+    if (last) {  // (height, width, channels) → planar
+        const std::size_t n = img.width * img.height;
+        img.values.resize(v.size());
+        for (std::size_t p = 0; p < n; ++p)
+            for (std::size_t c = 0; c < img.channels; ++c)
+                img.values[c * n + p] = v.data()[p * img.channels + c];
+    } else {
+        img.values.assign(v.data(), v.data() + v.size());
+    }
     img.flags.assign(img.width * img.height, 0);
     if (!flags.is_none()) {
         const auto f =
@@ -66,7 +89,8 @@ image::LinearImage image_from_array(py::handle values, py::handle flags) {
 }
 
 // A path (str or os.PathLike: read with `read`), read_image's dict, or an array.
-image::LinearImage image_argument(py::handle image, const image::ReadOptions& read) {
+image::LinearImage image_argument(py::handle image, const image::ReadOptions& read,
+                                  bool channels_last) {
     if (py::isinstance<py::str>(image) || py::hasattr(image, "__fspath__")) {
         const std::string path =
             py::module_::import("os").attr("fspath")(image).cast<std::string>();
@@ -78,23 +102,11 @@ image::LinearImage image_argument(py::handle image, const image::ReadOptions& re
         if (!d.contains("values"))
             throw InvalidArgument("image dict must hold 'values' (and 'flags'), as read_image's");
         return image_from_array(d["values"],
-                                d.contains("flags") ? py::handle(d["flags"]) : py::none());
+                                d.contains("flags") ? py::handle(d["flags"]) : py::none(),
+                                false);
     }
-    return image_from_array(image, py::none());
+    return image_from_array(image, py::none(), channels_last);
 }
-
-std::vector<std::uint8_t> sphere_mask(py::handle mask, const image::LinearImage& img) {
-    const auto m =
-        py::array_t<std::uint8_t, py::array::c_style | py::array::forcecast>::ensure(mask);
-    if (!m || m.ndim() != 2 || static_cast<std::size_t>(m.shape(0)) != img.height ||
-        static_cast<std::size_t>(m.shape(1)) != img.width)
-        throw InvalidArgument(concat("mask must be a (", std::to_string(img.height), ", ",
-                                     std::to_string(img.width),
-                                     ") array (nonzero = on the sphere)"));
-    return {m.data(), m.data() + m.size()};
-}
-
-}  // namespace
 
 void bind_calibration(py::module_& m) {
     m.def(
@@ -107,7 +119,7 @@ void bind_calibration(py::module_& m) {
             // Checked whatever the image (as read_image does): used for a path read as gamma.
             const double gamma_value = real_scalar("gamma", gamma);
             if (read.response == Response::Gamma) read.gamma = gamma_value;
-            const image::LinearImage img = image_argument(image, read);
+            const image::LinearImage img = image_argument(image, read, false);
             std::optional<std::vector<std::uint8_t>> pixels;
             if (!mask.is_none()) pixels = sphere_mask(mask, img);
             image::CircleFit c;

@@ -8,6 +8,8 @@
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 
+#include "roughscope/photo/image.hpp"
+#include "roughscope/photo/read.hpp"
 #include "roughscope/scattering/geometry.hpp"
 #include "roughscope/serialize/json.hpp"
 #include "roughscope/surface/height_map.hpp"
@@ -41,6 +43,8 @@ void bind_capture(pybind11::module_& m);      // python/bind_capture.cpp: synthe
 void bind_image(pybind11::module_& m);        // python/bind_image.cpp: photographs to roughness
 void bind_calibration(pybind11::module_& m);  // python/bind_calibration.cpp: the light's direction
 void bind_plan(pybind11::module_& m);         // python/bind_plan.cpp: the light angles to choose
+// python/bind_photometric.cpp: normals and albedo from photographs under several lights
+void bind_photometric_stereo(pybind11::module_& m);
 void bind_report(pybind11::module_& m);       // python/bind_report.cpp: what the report draws
 void bind_documents(pybind11::module_& m);    // python/bind_documents.cpp: text and documents
 
@@ -48,6 +52,15 @@ void bind_documents(pybind11::module_& m);    // python/bind_documents.cpp: text
 // (roughscope/serialize): objects → dict (key order kept), arrays → list, numbers → int/float,
 // null → None. Defined in module.cpp.
 pybind11::object to_python(const serialize::Json& value);
+
+// ---- Photographs as arguments (python/bind_calibration.cpp) --------------------------------
+// An image on a linear scale from an array — (height, width), or (channels, height, width), or
+// with `channels_last` (height, width, channels) — and its flags ((height, width) uint8, or None).
+image::LinearImage image_from_array(pybind11::handle values, pybind11::handle flags,
+                                    bool channels_last);
+// A path (str or os.PathLike: read with `read`), read_image's dict, or an array as above.
+image::LinearImage image_argument(pybind11::handle image, const image::ReadOptions& read,
+                                  bool channels_last);
 
 // ---- Strict numeric input (docs/python.md, "Types") ---------------------------------------
 // A numeric argument accepts a Python int or float, a NumPy integer or floating scalar, an

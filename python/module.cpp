@@ -349,6 +349,7 @@ PYBIND11_MODULE(_core, m) {
     roughscope::python::bind_image(m);
     roughscope::python::bind_calibration(m);
     roughscope::python::bind_plan(m);
+    roughscope::python::bind_photometric_stereo(m);
     roughscope::python::bind_report(m);
     roughscope::python::bind_documents(m);
 }

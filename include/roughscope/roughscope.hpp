@@ -76,6 +76,7 @@
 // objects: curved objects of known shape (silhouette, cylinder, sphere), the mirror sphere's light
 #include "roughscope/objects/cylinder.hpp"
 #include "roughscope/objects/mirror_sphere.hpp"
+#include "roughscope/objects/photometric_stereo.hpp"
 #include "roughscope/objects/silhouette.hpp"
 #include "roughscope/objects/sphere.hpp"
 
@@ -93,6 +94,7 @@
 #include "roughscope/serialize/measure.hpp"
 #include "roughscope/serialize/model.hpp"
 #include "roughscope/serialize/paper_tables.hpp"
+#include "roughscope/serialize/photometric_stereo.hpp"
 #include "roughscope/serialize/plan.hpp"
 #include "roughscope/serialize/simulation.hpp"
 #include "roughscope/serialize/surface.hpp"

@@ -58,6 +58,10 @@ IMAGE_MASK = np.ones((12, 12), dtype=bool)
 _YY, _XX = np.mgrid[0:32, 0:32] + 0.5
 MIRROR_SPHERE = np.where((_XX - 16) ** 2 + (_YY - 16) ** 2 < 144,
                          0.02 + 0.9 * np.exp(-((_XX - 18) ** 2 + (_YY - 14) ** 2) / 2.0), 0.005)
+# Four grey images of a Lambertian ramp under four lights, for photometric_stereo.
+PS_LIGHTS = np.array([[0.5, 0.0, 0.75 ** 0.5], [0.0, 0.5, 0.75 ** 0.5], [-0.5, 0.0, 0.75 ** 0.5],
+                      [0.0, -0.5, 0.75 ** 0.5]])
+PS_IMAGES = [0.5 * np.clip(np.full((8, 8), 0.2) * L[0] + L[2], 0, None) for L in PS_LIGHTS]
 LOBES = Lobes([{"Cx": -1.0, "Cy": -1.0, "Cz": 1.0, "n": 10.0, "albedo": 0.5}])
 COMPARISON_OPTIONS = dict(theta1_deg=20.0, theta2_deg=50.0, pair=(1, 2), on_sigma_rad=0.2,
                           on_albedo=0.5, fits=False)
@@ -155,6 +159,9 @@ GOOD_CALLS = {
     "shared_search_description": [(("data/curet",), {})],
     "srgb_encode": [(([0.0, 0.002, 0.5, 1.0],), {})],
     "sigma_from_specular": [((0.5, 10.0), dict(wavelength_um=0.555, R0=1.0))],
+    "photometric_stereo": [((PS_IMAGES, PS_LIGHTS),
+                            dict(light_intensities=[1.0, 1.0, 1.0, 1.0], shadow_fraction=0.05,
+                                 highlight_fraction=0.1, gamma=2.2, threads=1))],
     "plan_capture": [((0.5,), dict(sigma_over_T_max=0.6, noise_rel=0.002, fill=0.8,
                                    theta_min_deg=20.0, theta_max_deg=60.0, theta_step_deg=10.0,
                                    min_difference_deg=5.0, range_points=2, top=3))],
