@@ -378,12 +378,12 @@ std::array<double, 3> parse_capture_geometry(const Context& ctx, const JsonNode&
         const bool sphere = c.has("light") && c.at("light").is_object() && !light_point;
         if (!c.has("light") || (!c.has("view") && !sphere))
             c.fail("light and view must both be given");
-        const Eigen::Vector3d L = light_point ? position(c.at("light"), spec.light_position_mm)
-                                              : light_of(c.at("light"));
-        const Eigen::Vector3d V =
-            !c.has("view")                ? Eigen::Vector3d::UnitZ()
-            : is_position(c.at("view")) ? position(c.at("view"), spec.view_position_mm)
-                                          : unit_vector(c.at("view"));
+        const Eigen::Vector3d L =
+            light_point ? position(c.at("light"), spec.light_position_mm) : light_of(c.at("light"));
+        const Eigen::Vector3d V = !c.has("view") ? Eigen::Vector3d::UnitZ()
+                                  : is_position(c.at("view"))
+                                      ? position(c.at("view"), spec.view_position_mm)
+                                      : unit_vector(c.at("view"));
         if (sphere && (V - Eigen::Vector3d::UnitZ()).norm() > 1e-12)
             c.fail_at("view",
                       "a light from a mirror sphere is in the camera's frame: the camera must look "

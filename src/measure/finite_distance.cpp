@@ -52,14 +52,15 @@ Eigen::Vector3d toward(const Eigen::Vector3d& P, const Eigen::Vector3d& X) {
 std::optional<Geometry> geometry_at(const CaptureSpec& spec, const Eigen::Vector3d& X) {
     const Eigen::Vector3d L =
         spec.light_position_mm ? toward(*spec.light_position_mm, X) : *spec.light;
-    const Eigen::Vector3d V = spec.view_position_mm ? toward(*spec.view_position_mm, X) : *spec.view;
+    const Eigen::Vector3d V =
+        spec.view_position_mm ? toward(*spec.view_position_mm, X) : *spec.view;
     return geometry_from_vectors(Eigen::Vector3d::UnitZ(), L, V);
 }
 
 // The region's centroid (pixel coordinates of the centres) and a uniform subsample of its
 // pixels in scan order: every stride-th pixel, each the middle of its block of `stride`.
 struct RegionPoints {
-    double column = 0.0, row = 0.0;                   // centroid, pixel coordinates
+    double column = 0.0, row = 0.0;                  // centroid, pixel coordinates
     std::vector<std::pair<double, double>> samples;  // (column, row)
 };
 
@@ -68,8 +69,7 @@ RegionPoints region_points(const RegionSpans& spans) {
     const std::size_t n = spans.pixel_count;
     if (n == 0) return out;
     double sum_column = 0.0, sum_row = 0.0;
-    const std::size_t stride =
-        (n + kFiniteDistanceSamplePoints - 1) / kFiniteDistanceSamplePoints;
+    const std::size_t stride = (n + kFiniteDistanceSamplePoints - 1) / kFiniteDistanceSamplePoints;
     std::size_t next = stride / 2, start = 0;  // the next sampled index; the span's first index
     for (const PixelSpan& s : spans.spans) {
         const std::size_t count = s.x_end - s.x_begin;
@@ -295,7 +295,8 @@ CorrelationComparison fit_corrected(std::vector<CaptureMeasurement*> diffuse,
             Measurement m;
             m.geometry = c->spec.geometry;
             const double f = pair_slopes[i] ? correction_factor(*c, model, *pair_slopes[i]) : 1.0;
-            if (pair_slopes[i] && c->finite_distance) recorded(*c->finite_distance, model.quantity) = f;
+            if (pair_slopes[i] && c->finite_distance)
+                recorded(*c->finite_distance, model.quantity) = f;
             m.brightness = c->brightness * lamp_distance_squared(*c) / f;
             const double e = c->brightness_relative_stderr;
             m.weight = e > 0.0 ? 1.0 / (e * e) : 1.0;
@@ -303,8 +304,10 @@ CorrelationComparison fit_corrected(std::vector<CaptureMeasurement*> diffuse,
         }
         // compare_correlations ranks both fits; each correlation's own factors give its fit.
         CorrelationComparison one = compare_correlations(measurements, options);
-        if (i == 0) out = std::move(one);
-        else out.exponential = std::move(one.exponential);
+        if (i == 0)
+            out = std::move(one);
+        else
+            out.exponential = std::move(one.exponential);
     }
     // The ranking of compare_correlations (fit.hpp) on the two fits kept.
     const bool g_ok = out.gaussian.status != SolverStatus::NotIdentifiable;

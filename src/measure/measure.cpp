@@ -352,8 +352,9 @@ void mark_unknown_diffuse_errors(const CaptureMeasurement& c1, const CaptureMeas
     }
 }
 
-void estimate_diffuse(const std::vector<CaptureMeasurement*>& diffuse, const MeasureRequest& request,
-                      const KnownSigma& known, MeasureResult& result) {
+void estimate_diffuse(const std::vector<CaptureMeasurement*>& diffuse,
+                      const MeasureRequest& request, const KnownSigma& known,
+                      MeasureResult& result) {
     CaptureMeasurement& c1 = *diffuse[0];
     CaptureMeasurement& c2 = *diffuse[1];
     const std::optional<double>& sigma_um = known.value;
@@ -901,9 +902,10 @@ MeasureResult measure(const MeasureRequest& request) {
                                              "the others enter the region measurement only"));
         result.map = keyed(request, "maps", [&] { return roughness_map(captures, options); });
         if (detail::has_position(request))
-            result.warnings.push_back(concat(
-                src, ": the map uses each capture's geometry at the region's centroid: a lamp or "
-                     "camera at a finite distance is corrected in the region's estimates only"));
+            result.warnings.push_back(
+                concat(src,
+                       ": the map uses each capture's geometry at the region's centroid: a lamp or "
+                       "camera at a finite distance is corrected in the region's estimates only"));
         for (const auto& w : result.map->warnings) result.warnings.push_back(concat("map: ", w));
     }
     if (detail::has_exponential_sigma_over_T(result))

@@ -78,8 +78,10 @@ Json capture_json(const image::CaptureMeasurement& c) {
             {number(fd.centroid_mm.x()), number(fd.centroid_mm.y()), number(fd.centroid_mm.z())});
         f["lamp_distance_mm"] = optional_number(fd.lamp_distance_mm);
         f["camera_distance_mm"] = optional_number(fd.camera_distance_mm);
-        f["theta_i_deg_range"] = Json::array({number(fd.theta_i_min_deg), number(fd.theta_i_max_deg)});
-        f["theta_s_deg_range"] = Json::array({number(fd.theta_s_min_deg), number(fd.theta_s_max_deg)});
+        f["theta_i_deg_range"] =
+            Json::array({number(fd.theta_i_min_deg), number(fd.theta_i_max_deg)});
+        f["theta_s_deg_range"] =
+            Json::array({number(fd.theta_s_min_deg), number(fd.theta_s_max_deg)});
         f["sample_points"] = fd.point_geometry.size();
         f["correction_sigma_over_T_gaussian"] = optional_number(fd.correction_gaussian);
         f["correction_sigma_over_T_exponential"] = optional_number(fd.correction_exponential);

@@ -35,7 +35,7 @@ inline constexpr std::size_t kFiniteDistanceSamplePoints = 4096;
 
 // The capture file's "sample_plane": how pixels map to the sample's plane (mm).
 struct SamplePlane {
-    std::array<double, 2> pixel_size_mm{1.0, 1.0};     // (sx, sy), each in [kMin, kMax]PixelSizeMm
+    std::array<double, 2> pixel_size_mm{1.0, 1.0};   // (sx, sy), each in [kMin, kMax]PixelSizeMm
     std::optional<std::array<double, 2>> origin_px;  // (u0, v0); default (W/2, H/2)
 };
 

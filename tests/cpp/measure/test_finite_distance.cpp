@@ -31,11 +31,11 @@ namespace fs = std::filesystem;
 namespace sim = roughscope::simulation;
 using nlohmann::json;
 
-constexpr std::size_t kSize = 80;                    // pixels
-constexpr double kPixelMm = 50.0 / 64.0;             // the 64-pixel region is 50 mm wide
-constexpr double kTrueSlope = 0.3;                   // σ/T
-constexpr double kLampMm = 500.0;                    // ten region widths
-const json kRoi = {{"rect", {8, 8, 64, 64}}};       // centred: its centroid is X = 0
+constexpr std::size_t kSize = 80;              // pixels
+constexpr double kPixelMm = 50.0 / 64.0;       // the 64-pixel region is 50 mm wide
+constexpr double kTrueSlope = 0.3;             // σ/T
+constexpr double kLampMm = 500.0;              // ten region widths
+const json kRoi = {{"rect", {8, 8, 64, 64}}};  // centred: its centroid is X = 0
 
 Eigen::Vector3d light_toward(double theta_deg) {  // the paper's light azimuth, φi = π
     const double t = deg_to_rad(theta_deg);
@@ -106,8 +106,8 @@ json capture_file(const Render& r, bool positions) {
         const Eigen::Vector3d L = light_toward(theta);
         json c = {{"image", concat(theta == 30.0 ? "c30" : "c45", ".tiff")}};
         c["light"] = positions ? position(r.lamp_mm * L) : json{L.x(), L.y(), L.z()};
-        c["view"] = positions && r.camera_mm ? position({0.0, 0.0, *r.camera_mm})
-                                             : json{0.0, 0.0, 1.0};
+        c["view"] =
+            positions && r.camera_mm ? position({0.0, 0.0, *r.camera_mm}) : json{0.0, 0.0, 1.0};
         doc["captures"].push_back(c);
     }
     return doc;
@@ -158,8 +158,9 @@ TEST_P(FiniteDistance, PositionsRemoveTheBiasOfTheNominalAngles) {
     EXPECT_NEAR(*c1.finite_distance->lamp_distance_mm, kLampMm, 1e-9);
     EXPECT_LT(c1.finite_distance->theta_i_min_deg, 28.0);
     EXPECT_GT(c1.finite_distance->theta_i_max_deg, 32.0);
-    EXPECT_TRUE(k.correlation == Correlation::Gaussian ? c1.finite_distance->correction_gaussian
-                                                       : c1.finite_distance->correction_exponential);
+    EXPECT_TRUE(k.correlation == Correlation::Gaussian
+                    ? c1.finite_distance->correction_gaussian
+                    : c1.finite_distance->correction_exponential);
     // The budget holds the correction fixed: its σ/T is the corrected one.
     ASSERT_TRUE(located.uncertainty);
 }
