@@ -53,10 +53,10 @@ def test_positions_measure_and_the_json_says_how(pair):
     far = json.loads(run(with_positions(pair, "far.json", 1e7)).stdout)
     near = json.loads(run(with_positions(pair, "near.json", 500.0, camera_mm=400.0)).stdout)
     assert "finite_distance" not in nominal["captures"][0]
-    s = nominal["sigma_over_T_gaussian"]["value"]
-    assert far["sigma_over_T_gaussian"]["value"] == pytest.approx(s, rel=1e-6)
+    s = nominal["sigma_over_T_gaussian"]
+    assert far["sigma_over_T_gaussian"] == pytest.approx(s, rel=1e-6)
     # The demo's photographs are lit by a collimated light: read as a lamp at 500 mm, corrected.
-    assert abs(near["sigma_over_T_gaussian"]["value"] / s - 1) > 1e-3
+    assert abs(near["sigma_over_T_gaussian"] / s - 1) > 1e-3
     for result, lamp in ((far, 1e7), (near, 500.0)):
         for c in result["captures"]:
             fd = c["finite_distance"]
