@@ -277,7 +277,7 @@ double ratio_correction(const CaptureMeasurement& c1, const CaptureMeasurement& 
     return lamp_distance_squared(c1) / lamp_distance_squared(c2) * factor(c2) / factor(c1);
 }
 
-CorrelationComparison fit_corrected(std::vector<CaptureMeasurement*> diffuse,
+CorrelationComparison fit_corrected(const std::vector<CaptureMeasurement*>& diffuse,
                                     const FitOptions& options,
                                     const std::array<std::optional<double>, 2>& pair_slopes) {
     CorrelationComparison out;

@@ -62,7 +62,7 @@ double ratio_correction(const CaptureMeasurement& c1, const CaptureMeasurement& 
 // Ẽ_k · r_k0² / f_k, each correlation with its factors at the pair's estimate of that
 // correlation (`pair_slopes`: Gaussian, exponential; a missing one leaves its captures
 // uncorrected).
-CorrelationComparison fit_corrected(std::vector<CaptureMeasurement*> diffuse,
+CorrelationComparison fit_corrected(const std::vector<CaptureMeasurement*>& diffuse,
                                     const FitOptions& options,
                                     const std::array<std::optional<double>, 2>& pair_slopes);
 
