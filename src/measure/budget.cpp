@@ -9,6 +9,7 @@
 #include <utility>
 #include <vector>
 
+#include "finite_distance_detail.hpp"
 #include "measure_inputs.hpp"
 #include "roughscope/core/errors.hpp"
 #include "roughscope/core/numbers.hpp"
@@ -191,6 +192,9 @@ class BudgetModel {
     std::optional<SpecularInputs> specular_;
     std::size_t black_ = kNone, gamma_ = kNone, lambda_ = kNone, sigma_given_ = kNone;
     std::size_t model_gaussian_ = kNone;  // the very-rough model error of σ/T (Gaussian)
+    // A lamp or camera at a finite distance: the multiplier of E1/E2 that brings it to the
+    // nominal geometries (σ/T Gaussian, exponential, T given σ), held fixed at the measurement's.
+    std::array<double, 3> ratio_correction_{1.0, 1.0, 1.0};
 };
 
 void BudgetModel::build() {
@@ -246,6 +250,12 @@ void BudgetModel::build() {
 
 void BudgetModel::build_diffuse(const std::vector<std::size_t>& pair) {
     wanted_[0] = true;
+    const CaptureMeasurement& c1 = result_.captures[pair[0]];
+    const CaptureMeasurement& c2 = result_.captures[pair[1]];
+    ratio_correction_ = {
+        detail::ratio_correction(c1, c2, detail::CorrectedQuantity::SlopeGaussian),
+        detail::ratio_correction(c1, c2, detail::CorrectedQuantity::SlopeExponential),
+        detail::ratio_correction(c1, c2, detail::CorrectedQuantity::CorrelationLength)};
     wanted_[1] = result_.slope_gaussian && result_.slope_gaussian->sigma_over_T && !result_.fit;
     wanted_[2] =
         result_.slope_exponential && result_.slope_exponential->sigma_over_T && !result_.fit;
@@ -382,10 +392,11 @@ void BudgetModel::operator()(std::span<const double> x, std::span<std::optional<
     for (const Correlation c : {Correlation::Gaussian, Correlation::Exponential}) {
         const std::size_t o = c == Correlation::Gaussian ? 1 : 2;
         if (!wanted_[o] || !ratio) continue;
+        const double r = *ratio * ratio_correction_[o - 1];
         try {
-            y[o] = closed ? sigma_over_T_from_ratio(c, *ratio, g1->theta_i_rad, g2->theta_i_rad,
+            y[o] = closed ? sigma_over_T_from_ratio(c, r, g1->theta_i_rad, g2->theta_i_rad,
                                                     request_.factor)
-                          : sigma_over_T_two_geometries(*ratio, *g1, *g2, c, options);
+                          : sigma_over_T_two_geometries(r, *g1, *g2, c, options);
         } catch (const Error&) {
         }
         if (o == 1 && y[1] && model_gaussian_ != kNone) *y[1] += x[model_gaussian_];
@@ -397,15 +408,16 @@ void BudgetModel::operator()(std::span<const double> x, std::span<std::optional<
     }
     if (wanted_[3]) y[3] = s;
     if (!wanted_[4] || !s || !ratio || !(lambda(x) > 0.0)) return;
+    const double r = *ratio * ratio_correction_[2];
     try {
         if (result_.correlation_length && result_.correlation_length->T_um) {
             options.regime = result_.correlation_length_regime.value_or(Regime::SlightlyRough);
             const Correlation c = request_.correlation;
             y[4] =
                 closed && info(c).slightly_rough_inverse && options.regime == Regime::SlightlyRough
-                    ? correlation_length_from_ratio(*ratio, *s, g1->theta_i_rad, g2->theta_i_rad,
+                    ? correlation_length_from_ratio(r, *s, g1->theta_i_rad, g2->theta_i_rad,
                                                     lambda(x), request_.factor)
-                    : correlation_length_two_geometries(*ratio, *g1, *g2, *s, c, options);
+                    : correlation_length_two_geometries(r, *g1, *g2, *s, c, options);
         } else if (y[1]) {
             y[4] = *s / *y[1];
         }

@@ -1,10 +1,12 @@
 // The capture file of `roughscope measure` (measure.hpp, docs/measure.md): JSON to a
 // MeasureRequest. Every key is checked: an unknown key, a wrong type or a value out of range is a
 // DataError naming the file and the key.
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <filesystem>
 #include <initializer_list>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <utility>
@@ -267,6 +269,28 @@ MapRequest parse_maps(const Context& ctx, const JsonNode& j) {
     return maps;
 }
 
+// "sample_plane": {"pixel_size_mm": s | [sx, sy], "origin_px": [u0, v0]} (finite_distance.hpp).
+SamplePlane parse_sample_plane(const JsonNode& j) {
+    j.only({"pixel_size_mm", "origin_px"});
+    if (!j.has("pixel_size_mm")) j.fail_at("pixel_size_mm", "missing: the side of a pixel (mm)");
+    const JsonNode s = j.at("pixel_size_mm");
+    SamplePlane plane;
+    const std::vector<double> sizes = s.is_array() ? s.numbers(2) : std::vector{s.number()};
+    for (std::size_t k = 0; k < 2; ++k) {
+        const double v = sizes[std::min(k, sizes.size() - 1)];
+        if (!(v >= kMinPixelSizeMm && v <= kMaxPixelSizeMm))
+            s.fail(concat(check::format_number(v), " must be in [",
+                          check::format_number(kMinPixelSizeMm), ", ",
+                          check::format_number(kMaxPixelSizeMm), "] mm"));
+        plane.pixel_size_mm[k] = v;
+    }
+    if (j.has("origin_px")) {
+        const auto o = j.at("origin_px").numbers(2);
+        plane.origin_px = std::array<double, 2>{o[0], o[1]};
+    }
+    return plane;
+}
+
 // The capture's geometry: theta_i_deg, theta_s_deg, phi_s_deg (paper frame) or light and view
 // vectors (the sample's normal +z; for a curved object the camera frame, view +z by default, and
 // neither given: L = V = +z, the retro-reflection of §5.2). Returns (θi, θs, φs) in degrees as
@@ -301,6 +325,24 @@ Eigen::Vector3d calibrated_light(const Context& ctx, const JsonNode& j, const Re
     return light.light;
 }
 
+// {"position_mm": [x, y, z]}: a lamp or a camera at a finite distance (finite_distance.hpp), in
+// mm in the sample frame, above the plane (z > 0). Returns its direction from the plane's origin
+// (X = 0): measure() replaces it with the direction at the region's centroid.
+bool is_position(const JsonNode& j) { return j.is_object() && j.has("position_mm"); }
+
+Eigen::Vector3d position(const JsonNode& j, std::optional<Eigen::Vector3d>& point_mm) {
+    if (j.has("mirror_sphere"))
+        j.fail("give either \"mirror_sphere\" (a direction) or \"position_mm\", not both");
+    j.only({"position_mm"});
+    const JsonNode p = j.at("position_mm");
+    const auto v = p.numbers(3);
+    if (!(v[2] > 0.0))
+        p.fail(concat("z = ", check::format_number(v[2]),
+                      " mm must be > 0 (above the sample's plane z = 0, normal +z)"));
+    point_mm = Eigen::Vector3d(v[0], v[1], v[2]);
+    return point_mm->normalized();
+}
+
 std::array<double, 3> parse_capture_geometry(const Context& ctx, const JsonNode& c, bool curved,
                                              const ReadOptions& read, CaptureSpec& spec) {
     // A light vector, or one calibrated from a mirror sphere.
@@ -315,6 +357,9 @@ std::array<double, 3> parse_capture_geometry(const Context& ctx, const JsonNode&
         return std::array<double, 3>{rad_to_deg(g.theta_i_rad), rad_to_deg(g.theta_s_rad),
                                      rad_to_deg(g.phi_s_rad)};
     };
+    for (const char* key : {"light", "view"})
+        if (curved && c.has(key) && is_position(c.at(key)))
+            c.fail_at(key, "a position (position_mm) is for a flat sample (object.shape plane)");
     if (curved && !angles) {
         spec.light = c.has("light") ? light_of(c.at("light")) : Eigen::Vector3d::UnitZ();
         spec.view = c.has("view") ? unit_vector(c.at("view")) : Eigen::Vector3d::UnitZ();
@@ -329,12 +374,16 @@ std::array<double, 3> parse_capture_geometry(const Context& ctx, const JsonNode&
         return degrees(spec.geometry);
     }
     if (vectors) {
-        const bool sphere = c.has("light") && c.at("light").is_object();
+        const bool light_point = c.has("light") && is_position(c.at("light"));
+        const bool sphere = c.has("light") && c.at("light").is_object() && !light_point;
         if (!c.has("light") || (!c.has("view") && !sphere))
             c.fail("light and view must both be given");
-        const Eigen::Vector3d L = light_of(c.at("light"));
-        const Eigen::Vector3d V =
-            c.has("view") ? unit_vector(c.at("view")) : Eigen::Vector3d::UnitZ();
+        const Eigen::Vector3d L =
+            light_point ? position(c.at("light"), spec.light_position_mm) : light_of(c.at("light"));
+        const Eigen::Vector3d V = !c.has("view") ? Eigen::Vector3d::UnitZ()
+                                  : is_position(c.at("view"))
+                                      ? position(c.at("view"), spec.view_position_mm)
+                                      : unit_vector(c.at("view"));
         if (sphere && (V - Eigen::Vector3d::UnitZ()).norm() > 1e-12)
             c.fail_at("view",
                       "a light from a mirror sphere is in the camera's frame: the camera must look "
@@ -554,6 +603,7 @@ MeasureRequest parse_document(const io::JsonValue& value, const std::string& pat
               "exposures_equal",
               "uncertainty",
               "black_reference",
+              "sample_plane",
               "description"});
     MeasureRequest request;
     request.source = path;
@@ -601,6 +651,7 @@ MeasureRequest parse_document(const io::JsonValue& value, const std::string& pat
     const bool curved = request.object.shape != ObjectShape::Plane;
     if (doc.has("black_reference"))
         request.black_reference = parse_region(ctx, doc.at("black_reference"));
+    if (doc.has("sample_plane")) request.sample_plane = parse_sample_plane(doc.at("sample_plane"));
     if (doc.has("roi"))
         request.roi = parse_region(ctx, doc.at("roi"));
     else if (!curved && !request.maps)

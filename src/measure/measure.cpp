@@ -12,6 +12,7 @@
 #include <thread>
 #include <utility>
 
+#include "finite_distance_detail.hpp"
 #include "measure_inputs.hpp"
 #include "measure_notes.hpp"
 #include "roughscope/core/errors.hpp"
@@ -90,6 +91,7 @@ void check_request(const MeasureRequest& request) {
     }
     check_combination(request);
     detail::check_tolerances(request);
+    detail::check_finite_distance(request);
 }
 
 // What the captures, the object and the maps ask for together. A capture file's combination
@@ -350,11 +352,11 @@ void mark_unknown_diffuse_errors(const CaptureMeasurement& c1, const CaptureMeas
     }
 }
 
-void estimate_diffuse(const std::vector<const CaptureMeasurement*>& diffuse,
+void estimate_diffuse(const std::vector<CaptureMeasurement*>& diffuse,
                       const MeasureRequest& request, const KnownSigma& known,
                       MeasureResult& result) {
-    const CaptureMeasurement& c1 = *diffuse[0];
-    const CaptureMeasurement& c2 = *diffuse[1];
+    CaptureMeasurement& c1 = *diffuse[0];
+    CaptureMeasurement& c2 = *diffuse[1];
     const std::optional<double>& sigma_um = known.value;
     const double sigma_um_stderr = known.stderr_um;
     const double ratio = c1.brightness / c2.brightness;
@@ -392,6 +394,19 @@ void estimate_diffuse(const std::vector<const CaptureMeasurement*>& diffuse,
         input.noise = BrightnessNoise{e1, e2};
         input.sigma_um = sigma_um;
         try {
+            // A lamp or camera at a finite distance: the ratio at the nominal geometries.
+            const detail::CorrectionModel model{correlation == Correlation::Gaussian
+                                                    ? detail::CorrectedQuantity::SlopeGaussian
+                                                    : detail::CorrectedQuantity::SlopeExponential,
+                                                correlation, options, 0.0};
+            input.E1_over_E2 = detail::corrected_ratio(
+                ratio, model,
+                [&](double r) {
+                    SlopeInput i = input;
+                    i.E1_over_E2 = r;
+                    return estimate_slope(i).sigma_over_T.value().value;
+                },
+                c1, c2);
             RoughnessEstimate estimate = estimate_slope(input);
             (correlation == Correlation::Gaussian ? result.slope_gaussian
                                                   : result.slope_exponential) = std::move(estimate);
@@ -410,6 +425,16 @@ void estimate_diffuse(const std::vector<const CaptureMeasurement*>& diffuse,
         input.options = options;
         input.noise = BrightnessNoise{e1, e2};
         try {
+            const detail::CorrectionModel model{detail::CorrectedQuantity::CorrelationLength,
+                                                request.correlation, options, *sigma_um};
+            input.E1_over_E2 = detail::corrected_ratio(
+                ratio, model,
+                [&](double r) {
+                    CorrelationLengthInput i = input;
+                    i.E1_over_E2 = r;
+                    return estimate_correlation_length(i).T_um.value().value;
+                },
+                c1, c2);
             result.correlation_length = estimate_correlation_length(input);
         } catch (const NoSolution& e) {
             failures.push_back(concat("T given σ: ", e.what()));
@@ -434,7 +459,17 @@ void estimate_diffuse(const std::vector<const CaptureMeasurement*>& diffuse,
             for (const auto& w : (*estimate)->warnings)
                 result.warnings.push_back(concat(label, ": ", w));
 
-    if (diffuse.size() >= 3) {
+    if (diffuse.size() >= 3 && c1.finite_distance) {
+        FitOptions fit_options;
+        fit_options.factor = request.factor;
+        fit_options.radiometry = request.radiometry;
+        fit_options.wavelength_um = request.wavelength_um;
+        auto slope = [](const std::optional<RoughnessEstimate>& e) {
+            return e && e->sigma_over_T ? std::optional(e->sigma_over_T->value) : std::nullopt;
+        };
+        result.fit = detail::fit_corrected(
+            diffuse, fit_options, {slope(result.slope_gaussian), slope(result.slope_exponential)});
+    } else if (diffuse.size() >= 3) {
         std::vector<Measurement> measurements;
         for (const CaptureMeasurement* c : diffuse) {
             Measurement m;
@@ -750,7 +785,8 @@ MeasureResult measure(const MeasureRequest& request) {
             result.warnings.push_back(detail::exponential_note());
         return result;
     }
-    std::vector<const CaptureMeasurement*> diffuse;
+    detail::locate_captures(request, first_capture.spans, result.captures);
+    std::vector<CaptureMeasurement*> diffuse;
     if (request.roi) {
         for (CaptureMeasurement& c : result.captures) {
             if (c.spec.role != CaptureRole::Diffuse) continue;
@@ -865,6 +901,11 @@ MeasureResult measure(const MeasureRequest& request) {
                                              ": the map divides the first two diffuse captures; "
                                              "the others enter the region measurement only"));
         result.map = keyed(request, "maps", [&] { return roughness_map(captures, options); });
+        if (detail::has_position(request))
+            result.warnings.push_back(
+                concat(src,
+                       ": the map uses each capture's geometry at the region's centroid: a lamp or "
+                       "camera at a finite distance is corrected in the region's estimates only"));
         for (const auto& w : result.map->warnings) result.warnings.push_back(concat("map: ", w));
     }
     if (detail::has_exponential_sigma_over_T(result))

@@ -67,6 +67,27 @@ Json capture_json(const image::CaptureMeasurement& c) {
     }
     out["region"] = to_json(c.region);
     out["black_reference"] = c.black_reference ? channel_json(*c.black_reference) : Json();
+    // Only with a lamp or camera position (a capture file without one writes what it did).
+    if (c.finite_distance) {
+        const image::FiniteDistance& fd = *c.finite_distance;
+        auto optional_number = [](const std::optional<double>& v) {
+            return v ? number(*v) : Json();
+        };
+        Json f;
+        f["centroid_mm"] = Json::array(
+            {number(fd.centroid_mm.x()), number(fd.centroid_mm.y()), number(fd.centroid_mm.z())});
+        f["lamp_distance_mm"] = optional_number(fd.lamp_distance_mm);
+        f["camera_distance_mm"] = optional_number(fd.camera_distance_mm);
+        f["theta_i_deg_range"] =
+            Json::array({number(fd.theta_i_min_deg), number(fd.theta_i_max_deg)});
+        f["theta_s_deg_range"] =
+            Json::array({number(fd.theta_s_min_deg), number(fd.theta_s_max_deg)});
+        f["sample_points"] = fd.point_geometry.size();
+        f["correction_sigma_over_T_gaussian"] = optional_number(fd.correction_gaussian);
+        f["correction_sigma_over_T_exponential"] = optional_number(fd.correction_exponential);
+        f["correction_T"] = optional_number(fd.correction_T);
+        out["finite_distance"] = f;
+    }
     if (c.highlight) {
         const image::HighlightMeasurement& h = *c.highlight;
         Json hj;

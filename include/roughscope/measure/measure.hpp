@@ -23,6 +23,7 @@
 #include "roughscope/fit/fit.hpp"
 #include "roughscope/maps/maps.hpp"
 #include "roughscope/measure/budget.hpp"
+#include "roughscope/measure/finite_distance.hpp"
 #include "roughscope/objects/cylinder.hpp"
 #include "roughscope/objects/sphere.hpp"
 #include "roughscope/photo/hdr.hpp"
@@ -68,6 +69,11 @@ struct CaptureSpec {
     // (x image right, y image up, z toward the camera); absent, both are +z (L = V, §5.2).
     std::optional<Eigen::Vector3d> light;
     std::optional<Eigen::Vector3d> view;
+    // A point lamp and a camera at a finite distance (finite_distance.hpp): their positions (mm)
+    // in the sample frame (z > 0), with MeasureRequest::sample_plane. Each pixel then has its own
+    // geometry; geometry, light and view become those at the region's centroid.
+    std::optional<Eigen::Vector3d> light_position_mm;
+    std::optional<Eigen::Vector3d> view_position_mm;
     // Exposure time (s), in [kMinExposureS, kMaxExposureS]; when absent, the file's metadata
     // (EXIF, RAW). When no capture has one, measure() refuses to compare the captures unless
     // MeasureRequest::exposures_equal says they are the same.
@@ -118,6 +124,8 @@ struct MeasureRequest {
     // curved object it restricts the pixels used (absent: the whole object).
     std::optional<Region> roi;
     ObjectSpec object;
+    // How pixels map to the sample's plane: needed by light and view positions.
+    std::optional<SamplePlane> sample_plane;
     std::optional<MapRequest> maps;
     std::vector<CaptureSpec> captures;
     // The exposures of the captures are the same (the capture file's "exposures_equal"): what
@@ -163,6 +171,8 @@ struct CaptureMeasurement {
     std::optional<ChannelStatistics> black_reference;
     double brightness = 0.0;  // Ẽ_k = region.average.mean / s_k (diffuse)
     double brightness_relative_stderr = 0.0;
+    // A lamp or camera position: the geometry over the region and the correction factors.
+    std::optional<FiniteDistance> finite_distance;
 };
 
 // σ from one specular capture in one channel (Eq. 13 at that channel's wavelength).
