@@ -151,7 +151,8 @@ struct SpecularInputs {
     RegionMean tot, dif;
 };
 
-// The measurement model: x (the inputs) → (E1/E2, σ/T Gaussian, σ/T exponential, σ, T).
+// The measurement model: x (the inputs) → (E1/E2, σ/T Gaussian, σ/T exponential, σ, T, and the
+// exact series' σ/T and T of both correlations).
 class BudgetModel {
   public:
     BudgetModel(const MeasureRequest& request, const MeasureResult& result,
@@ -161,7 +162,7 @@ class BudgetModel {
     }
 
     const std::vector<UncertainInput>& inputs() const { return inputs_; }
-    const std::array<bool, 5>& wanted() const { return wanted_; }
+    const std::array<bool, kBudgetQuantityCount>& wanted() const { return wanted_; }
 
     void operator()(std::span<const double> x, std::span<std::optional<double>> y) const;
 
@@ -175,6 +176,8 @@ class BudgetModel {
     void build_specular(std::size_t k);
     std::optional<double> brightness(const DiffuseInputs& d, std::span<const double> x) const;
     std::optional<double> sigma(std::span<const double> x) const;
+    static void series(double ratio, const Geometry& g1, const Geometry& g2, double s,
+                       TwoGeometryOptions options, std::span<std::optional<double>> y);
     double lambda(std::span<const double> x) const {
         return lambda_ == kNone ? request_.wavelength_um : x[lambda_];
     }
@@ -186,7 +189,7 @@ class BudgetModel {
     const MeasureResult& result_;
     Tolerances tol_;
     std::vector<UncertainInput> inputs_;
-    std::array<bool, 5> wanted_{};
+    std::array<bool, kBudgetQuantityCount> wanted_{};
     std::vector<DiffuseInputs> diffuse_;
     std::optional<SpecularInputs> specular_;
     std::size_t black_ = kNone, gamma_ = kNone, lambda_ = kNone, sigma_given_ = kNone;
@@ -225,7 +228,8 @@ void BudgetModel::build() {
     // λ enters σ (Eq. 13) and T given σ (through g), not the very-rough σ/T.
     const bool specular_sigma =
         !request_.sigma_um && !specular.empty() && result_.sigma && result_.sigma->sigma_um;
-    if (specular_sigma || (pair.size() >= 2 && result_.correlation_length))
+    const bool sigma_known = request_.sigma_um || specular_sigma;
+    if (specular_sigma || (pair.size() >= 2 && (result_.correlation_length || sigma_known)))
         lambda_ = add("wavelength", request_.wavelength_um,
                       tol_.get(tol_.setup().wavelength_um, "wavelength_um",
                                kDefaultWavelengthUncertaintyUm, " µm"));
@@ -241,6 +245,8 @@ void BudgetModel::build() {
         const bool from_slope =
             result_.slope_gaussian && result_.slope_gaussian->T_um && !result_.fit;
         wanted_[4] = (result_.correlation_length && result_.correlation_length->T_um) || from_slope;
+        // The exact series (σ known): T given σ in Regime::Series for each correlation.
+        for (std::size_t o = 5; o < kBudgetQuantityCount; ++o) wanted_[o] = true;
     }
 }
 
@@ -396,7 +402,9 @@ void BudgetModel::operator()(std::span<const double> x, std::span<std::optional<
     } catch (const Error&) {
     }
     if (wanted_[3]) y[3] = s;
-    if (!wanted_[4] || !s || !ratio || !(lambda(x) > 0.0)) return;
+    if (!s || !ratio || !(lambda(x) > 0.0)) return;
+    if (wanted_[5]) series(*ratio, *g1, *g2, *s, options, y);
+    if (!wanted_[4]) return;
     try {
         if (result_.correlation_length && result_.correlation_length->T_um) {
             options.regime = result_.correlation_length_regime.value_or(Regime::SlightlyRough);
@@ -410,6 +418,22 @@ void BudgetModel::operator()(std::span<const double> x, std::span<std::optional<
             y[4] = *s / *y[1];
         }
     } catch (const Error&) {
+    }
+}
+
+// The exact series with σ known (Eq. 2 summed, scattering/beckmann.hpp): T given σ from E1/E2 in
+// Regime::Series for each correlation, and σ/T = σ/T_series (outputs 5–8).
+void BudgetModel::series(double ratio, const Geometry& g1, const Geometry& g2, double s,
+                         TwoGeometryOptions options, std::span<std::optional<double>> y) {
+    options.regime = Regime::Series;
+    for (const Correlation c : {Correlation::Gaussian, Correlation::Exponential}) {
+        const std::size_t o = c == Correlation::Gaussian ? 0 : 1;
+        try {
+            const double T = correlation_length_two_geometries(ratio, g1, g2, s, c, options);
+            y[5 + o] = s / T;
+            y[7 + o] = T;
+        } catch (const Error&) {
+        }
     }
 }
 
