@@ -19,6 +19,7 @@
 #include <gtest/gtest.h>
 
 #include "../io/test_files.hpp"
+#include "roughscope/core/errors.hpp"
 #include "roughscope/core/text.hpp"
 #include "roughscope/io/output_file.hpp"
 #include "roughscope/measure/measure.hpp"
