@@ -164,7 +164,9 @@ class BudgetModel {
     const std::vector<UncertainInput>& inputs() const { return inputs_; }
     const std::array<bool, kBudgetQuantityCount>& wanted() const { return wanted_; }
 
-    void operator()(std::span<const double> x, std::span<std::optional<double>> y) const;
+    // The outputs of one pass: the headline quantities (0–4), or the exact series' (5–8).
+    void operator()(std::span<const double> x, std::span<std::optional<double>> y,
+                    bool series_pass) const;
 
   private:
     std::size_t add(std::string source, double value, double u) {
@@ -369,7 +371,8 @@ std::optional<double> BudgetModel::sigma(std::span<const double> x) const {
                                request_.R0);
 }
 
-void BudgetModel::operator()(std::span<const double> x, std::span<std::optional<double>> y) const {
+void BudgetModel::operator()(std::span<const double> x, std::span<std::optional<double>> y,
+                             bool series_pass) const {
     std::optional<double> ratio;
     std::optional<Geometry> g1, g2;
     if (diffuse_.size() == 2) {
@@ -379,11 +382,20 @@ void BudgetModel::operator()(std::span<const double> x, std::span<std::optional<
         g2 = geometry(diffuse_[1], x);
         if (e1 && e2 && g1 && g2) ratio = *e1 / *e2;
     }
-    if (wanted_[0]) y[0] = ratio;
+    if (wanted_[0] && !series_pass) y[0] = ratio;
     TwoGeometryOptions options;
     options.factor = request_.factor;
     options.radiometry = request_.radiometry;
     options.wavelength_um = lambda(x);
+    if (series_pass) {
+        std::optional<double> s;
+        try {
+            s = sigma(x);
+        } catch (const Error&) {
+        }
+        if (wanted_[5] && s && ratio && lambda(x) > 0.0) series(*ratio, *g1, *g2, *s, options, y);
+        return;
+    }
     const bool closed = diffuse_.size() == 2 && diffuse_[0].normal_view && diffuse_[1].normal_view;
     for (const Correlation c : {Correlation::Gaussian, Correlation::Exponential}) {
         const std::size_t o = c == Correlation::Gaussian ? 1 : 2;
@@ -402,9 +414,7 @@ void BudgetModel::operator()(std::span<const double> x, std::span<std::optional<
     } catch (const Error&) {
     }
     if (wanted_[3]) y[3] = s;
-    if (!s || !ratio || !(lambda(x) > 0.0)) return;
-    if (wanted_[5]) series(*ratio, *g1, *g2, *s, options, y);
-    if (!wanted_[4]) return;
+    if (!wanted_[4] || !s || !ratio || !(lambda(x) > 0.0)) return;
     try {
         if (result_.correlation_length && result_.correlation_length->T_um) {
             options.regime = result_.correlation_length_regime.value_or(Regime::SlightlyRough);
@@ -491,13 +501,31 @@ std::optional<UncertaintyBudget> uncertainty_budget(const MeasureRequest& reques
                                          std::end(kBudgetQuantities));
     const Propagation p = propagate_uncertainty(
         model.inputs(), names,
-        [&model](std::span<const double> x, std::span<std::optional<double>> y) { model(x, y); },
+        [&model](std::span<const double> x, std::span<std::optional<double>> y) {
+            model(x, y, false);
+        },
         request.propagation);
     budget.method = p.method;
     budget.method_reason = p.reason;
     budget.warnings = p.warnings;
-    for (std::size_t o = 0; o < names.size(); ++o)
-        if (wanted[o] && p.outputs[o]) budget.quantities.push_back({names[o], *p.outputs[o]});
+    // The exact series (outputs 5–8): first order, in a pass of its own — each evaluation solves
+    // the series for T, too slow for the Monte Carlo's 10⁴–10⁵ trials; the series is smooth in
+    // its inputs (docs/uncertainty.md).
+    std::optional<Propagation> series;
+    if (wanted[5]) {
+        PropagationOptions first_order = request.propagation;
+        first_order.method = PropagationMethod::FirstOrder;
+        series = propagate_uncertainty(
+            model.inputs(), names,
+            [&model](std::span<const double> x, std::span<std::optional<double>> y) {
+                model(x, y, true);
+            },
+            first_order);
+    }
+    for (std::size_t o = 0; o < names.size(); ++o) {
+        const Propagation& from = o >= 5 ? *series : p;
+        if (wanted[o] && from.outputs[o]) budget.quantities.push_back({names[o], *from.outputs[o]});
+    }
     if (!budget.assumed.empty()) {
         std::string list;
         for (const auto& a : budget.assumed) list += (list.empty() ? "" : ", ") + a;

@@ -328,15 +328,21 @@ TEST(MeasureExactSeries, TheClosedFormDeviationIsTheClosedFormsError) {
             }
             const MeasureRequest request = parse_capture_file(
                 concat(R"({"roi": {"rect": [4, 4, 24, 24]}, "black_level_dn": 2000, )",
-                       R"("sigma_um": )", check::format_number(sigma), R"(, "captures": [)",
+                       R"("sigma_um": )", check::format_number(sigma), R"(, "correlation": ")",
+                       to_string(correlation), R"(", "captures": [)",
                        captures, "]}"),
                 (dir / "c.json").string());
             const MeasureResult r = measure(request);
             ASSERT_TRUE(r.exact_series);
             const ExactSeriesCorrelation* e = (*r.exact_series)[correlation];
-            ASSERT_TRUE(e && e->sigma_over_T && e->closed_form_sigma_over_T &&
-                        e->closed_form_deviation_rel);
+            ASSERT_TRUE(e && e->sigma_over_T);
             EXPECT_NEAR(e->sigma_over_T->value, s, 2e-3 * s) << "g = " << g;
+            if (!e->closed_form_sigma_over_T) {  // E1/E2 outside Eq. 16/18's range
+                std::printf("[ series   ] %s, g = %.1f: no closed form\n",
+                            std::string(to_string(correlation)).c_str(), g);
+                continue;
+            }
+            ASSERT_TRUE(e->closed_form_deviation_rel);
             const double expected = (*e->closed_form_sigma_over_T - s) / s;
             EXPECT_NEAR(*e->closed_form_deviation_rel, expected, 3e-3 * (1.0 + std::abs(expected)))
                 << to_string(correlation) << ", g = " << g;
@@ -356,13 +362,14 @@ TEST(MeasureExactSeries, TheClosedFormDeviationIsTheClosedFormsError) {
 TEST(MeasureExactSeries, APairWithoutSigmaHasNoExactSeries) {
     const fs::path dir = testing::fresh_dir("exact_series_none");
     const sim::SurfaceTruth truth = series_truth(0.2, 0.6, Correlation::Gaussian);
+    const double peak = sim::surface_brightness(truth, normal_view_geometry(deg_to_rad(30.0)));
     std::string captures;
     for (const double t : {30.0, 45.0}) {
         Shot shot;
         shot.theta_i_deg = t;
         captures += (captures.empty() ? "" : ", ") +
                     diffuse_entry(render_diffuse(dir / concat("d", std::to_string(t), ".tiff"),
-                                                 truth, shot, 1.0, 5),
+                                                 truth, shot, peak, 5),
                                   t);
     }
     const MeasureResult r = measure(parse_capture_file(
