@@ -118,6 +118,7 @@ def values_table(doc, truth=None):
             cells += (f"<td>{escape(fmt(t))}</td>"
                       f"<td>{within_two_sigma(value, err, t)}</td>")
         rows.append(f"<tr>{cells}</tr>")
+    rows.extend(_exact_series_rows(doc, 1 + (1 if budget else 0) + (2 if truth else 0)))
     cls = doc.get("roughness_class")
     if cls:
         assumed = " (assumed by the estimator)" if doc.get("roughness_class_assumed") else ""
@@ -125,6 +126,31 @@ def values_table(doc, truth=None):
         rows.append(f"<tr><td class='l'>roughness class</td>"
                     f"<td colspan='{span - 1}'>{escape(cls.replace('_', ' ') + assumed)}</td></tr>")
     return f"<table>{head}{''.join(rows)}</table>"
+
+
+def _exact_series_rows(doc, span):
+    """σ/T of the exact series per correlation (docs/uncertainty.md "Model error"): value ± u,
+    its 95 % interval, how it was found and how far the closed form is from it."""
+    series = doc.get("exact_series")
+    if not series:
+        return []
+    rows = []
+    for corr in ("gaussian", "exponential"):
+        e = series.get(corr) or {}
+        value, u = e.get("sigma_over_T"), e.get("sigma_over_T_stderr")
+        if value is None:
+            continue
+        text = fmt(value, u)
+        interval = e.get("sigma_over_T_interval95")
+        if interval:
+            text += f", 95 % [{fmt(interval[0])}, {fmt(interval[1])}]"
+        deviation = e.get("closed_form_deviation_rel")
+        if deviation is not None:
+            text += f"; closed form {100.0 * deviation:+.0f} %"
+        label = f"σ/T exact series ({corr}; {series.get('method_description', '')})"
+        rows.append(f"<tr><td class='l'>{escape(label)}</td>"
+                    f"<td colspan='{span}'>{escape(text)}</td></tr>")
+    return rows
 
 
 BUDGET_LABELS = {"E1_over_E2": "E1/E2", "sigma_over_T_gaussian": "σ/T (Gaussian)",

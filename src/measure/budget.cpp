@@ -152,7 +152,8 @@ struct SpecularInputs {
     RegionMean tot, dif;
 };
 
-// The measurement model: x (the inputs) → (E1/E2, σ/T Gaussian, σ/T exponential, σ, T).
+// The measurement model: x (the inputs) → (E1/E2, σ/T Gaussian, σ/T exponential, σ, T, and the
+// exact series' σ/T and T of both correlations).
 class BudgetModel {
   public:
     BudgetModel(const MeasureRequest& request, const MeasureResult& result,
@@ -162,9 +163,11 @@ class BudgetModel {
     }
 
     const std::vector<UncertainInput>& inputs() const { return inputs_; }
-    const std::array<bool, 5>& wanted() const { return wanted_; }
+    const std::array<bool, kBudgetQuantityCount>& wanted() const { return wanted_; }
 
-    void operator()(std::span<const double> x, std::span<std::optional<double>> y) const;
+    // The outputs of one pass: the headline quantities (0–4), or the exact series' (5–8).
+    void operator()(std::span<const double> x, std::span<std::optional<double>> y,
+                    bool series_pass) const;
 
   private:
     std::size_t add(std::string source, double value, double u) {
@@ -176,6 +179,8 @@ class BudgetModel {
     void build_specular(std::size_t k);
     std::optional<double> brightness(const DiffuseInputs& d, std::span<const double> x) const;
     std::optional<double> sigma(std::span<const double> x) const;
+    static void series(double ratio, const Geometry& g1, const Geometry& g2, double s,
+                       TwoGeometryOptions options, std::span<std::optional<double>> y);
     double lambda(std::span<const double> x) const {
         return lambda_ == kNone ? request_.wavelength_um : x[lambda_];
     }
@@ -187,7 +192,7 @@ class BudgetModel {
     const MeasureResult& result_;
     Tolerances tol_;
     std::vector<UncertainInput> inputs_;
-    std::array<bool, 5> wanted_{};
+    std::array<bool, kBudgetQuantityCount> wanted_{};
     std::vector<DiffuseInputs> diffuse_;
     std::optional<SpecularInputs> specular_;
     std::size_t black_ = kNone, gamma_ = kNone, lambda_ = kNone, sigma_given_ = kNone;
@@ -229,7 +234,8 @@ void BudgetModel::build() {
     // λ enters σ (Eq. 13) and T given σ (through g), not the very-rough σ/T.
     const bool specular_sigma =
         !request_.sigma_um && !specular.empty() && result_.sigma && result_.sigma->sigma_um;
-    if (specular_sigma || (pair.size() >= 2 && result_.correlation_length))
+    const bool sigma_known = request_.sigma_um || specular_sigma;
+    if (specular_sigma || (pair.size() >= 2 && (result_.correlation_length || sigma_known)))
         lambda_ = add("wavelength", request_.wavelength_um,
                       tol_.get(tol_.setup().wavelength_um, "wavelength_um",
                                kDefaultWavelengthUncertaintyUm, " µm"));
@@ -245,6 +251,8 @@ void BudgetModel::build() {
         const bool from_slope =
             result_.slope_gaussian && result_.slope_gaussian->T_um && !result_.fit;
         wanted_[4] = (result_.correlation_length && result_.correlation_length->T_um) || from_slope;
+        // The exact series (σ known): T given σ in Regime::Series for each correlation.
+        for (std::size_t o = 5; o < kBudgetQuantityCount; ++o) wanted_[o] = true;
     }
 }
 
@@ -373,7 +381,8 @@ std::optional<double> BudgetModel::sigma(std::span<const double> x) const {
                                request_.R0);
 }
 
-void BudgetModel::operator()(std::span<const double> x, std::span<std::optional<double>> y) const {
+void BudgetModel::operator()(std::span<const double> x, std::span<std::optional<double>> y,
+                             bool series_pass) const {
     std::optional<double> ratio;
     std::optional<Geometry> g1, g2;
     if (diffuse_.size() == 2) {
@@ -383,11 +392,20 @@ void BudgetModel::operator()(std::span<const double> x, std::span<std::optional<
         g2 = geometry(diffuse_[1], x);
         if (e1 && e2 && g1 && g2) ratio = *e1 / *e2;
     }
-    if (wanted_[0]) y[0] = ratio;
+    if (wanted_[0] && !series_pass) y[0] = ratio;
     TwoGeometryOptions options;
     options.factor = request_.factor;
     options.radiometry = request_.radiometry;
     options.wavelength_um = lambda(x);
+    if (series_pass) {
+        std::optional<double> s;
+        try {
+            s = sigma(x);
+        } catch (const Error&) {
+        }
+        if (wanted_[5] && s && ratio && lambda(x) > 0.0) series(*ratio, *g1, *g2, *s, options, y);
+        return;
+    }
     const bool closed = diffuse_.size() == 2 && diffuse_[0].normal_view && diffuse_[1].normal_view;
     for (const Correlation c : {Correlation::Gaussian, Correlation::Exponential}) {
         const std::size_t o = c == Correlation::Gaussian ? 1 : 2;
@@ -422,6 +440,22 @@ void BudgetModel::operator()(std::span<const double> x, std::span<std::optional<
             y[4] = *s / *y[1];
         }
     } catch (const Error&) {
+    }
+}
+
+// The exact series with σ known (Eq. 2 summed, scattering/beckmann.hpp): T given σ from E1/E2 in
+// Regime::Series for each correlation, and σ/T = σ/T_series (outputs 5–8).
+void BudgetModel::series(double ratio, const Geometry& g1, const Geometry& g2, double s,
+                         TwoGeometryOptions options, std::span<std::optional<double>> y) {
+    options.regime = Regime::Series;
+    for (const Correlation c : {Correlation::Gaussian, Correlation::Exponential}) {
+        const std::size_t o = c == Correlation::Gaussian ? 0 : 1;
+        try {
+            const double T = correlation_length_two_geometries(ratio, g1, g2, s, c, options);
+            y[5 + o] = s / T;
+            y[7 + o] = T;
+        } catch (const Error&) {
+        }
     }
 }
 
@@ -479,13 +513,31 @@ std::optional<UncertaintyBudget> uncertainty_budget(const MeasureRequest& reques
                                          std::end(kBudgetQuantities));
     const Propagation p = propagate_uncertainty(
         model.inputs(), names,
-        [&model](std::span<const double> x, std::span<std::optional<double>> y) { model(x, y); },
+        [&model](std::span<const double> x, std::span<std::optional<double>> y) {
+            model(x, y, false);
+        },
         request.propagation);
     budget.method = p.method;
     budget.method_reason = p.reason;
     budget.warnings = p.warnings;
-    for (std::size_t o = 0; o < names.size(); ++o)
-        if (wanted[o] && p.outputs[o]) budget.quantities.push_back({names[o], *p.outputs[o]});
+    // The exact series (outputs 5–8): first order, in a pass of its own — each evaluation solves
+    // the series for T, too slow for the Monte Carlo's 10⁴–10⁵ trials; the series is smooth in
+    // its inputs (docs/uncertainty.md).
+    std::optional<Propagation> series;
+    if (wanted[5]) {
+        PropagationOptions first_order = request.propagation;
+        first_order.method = PropagationMethod::FirstOrder;
+        series = propagate_uncertainty(
+            model.inputs(), names,
+            [&model](std::span<const double> x, std::span<std::optional<double>> y) {
+                model(x, y, true);
+            },
+            first_order);
+    }
+    for (std::size_t o = 0; o < names.size(); ++o) {
+        const Propagation& from = o >= 5 ? *series : p;
+        if (wanted[o] && from.outputs[o]) budget.quantities.push_back({names[o], *from.outputs[o]});
+    }
     if (!budget.assumed.empty()) {
         std::string list;
         for (const auto& a : budget.assumed) list += (list.empty() ? "" : ", ") + a;

@@ -848,6 +848,9 @@ MeasureResult measure(const MeasureRequest& request) {
     result.uncertainty = uncertainty_budget(request, result);
     if (result.uncertainty)
         for (const auto& w : result.uncertainty->warnings) result.warnings.push_back(w);
+    result.exact_series = exact_series_estimate(request, result);
+    if (result.exact_series)
+        for (const auto& w : result.exact_series->warnings) result.warnings.push_back(w);
 
     if (request.maps) {
         MapOptions options = request.maps->options;

@@ -334,8 +334,12 @@ namespace {
 
 // The budget (measure/budget.hpp): for each headline quantity Q, Q_uncertainty (k = 1) and
 // Q_interval95 beside Q and Q_stderr (the statistical part), and the budget's lines.
+// The exact series' quantities (*_series_*) are under "exact_series", not beside the headline.
+bool headline(std::string_view quantity) { return quantity.find("_series") == std::string::npos; }
+
 void put_budget(Json& out, const std::optional<image::UncertaintyBudget>& b) {
     for (const char* q : image::kBudgetQuantities) {
+        if (!headline(q)) continue;
         out[std::string(q) + "_uncertainty"] = Json();
         out[std::string(q) + "_interval95"] = Json();
     }
@@ -343,10 +347,11 @@ void put_budget(Json& out, const std::optional<image::UncertaintyBudget>& b) {
     if (b) {
         for (const image::QuantityBudget& q : b->quantities) {
             const OutputUncertainty& u = q.result;
+            budget[q.quantity] = budget_json(u.budget);
+            if (!headline(q.quantity)) continue;
             out[q.quantity + "_uncertainty"] = number(u.uncertainty);
             out[q.quantity + "_interval95"] =
                 Json::array({number(u.interval95_low), number(u.interval95_high)});
-            budget[q.quantity] = budget_json(u.budget);
         }
     }
     out["uncertainty_method"] = b ? Json(std::string(to_string(b->method))) : Json();
@@ -358,6 +363,38 @@ void put_budget(Json& out, const std::optional<image::UncertaintyBudget>& b) {
             : Json();
     out["uncertainty_budget"] = b ? budget : Json();
     out["uncertainty_assumed"] = b ? Json(b->assumed) : Json();
+}
+
+// The exact series (measure/exact_series.hpp): per correlation σ, T, σ/T with its standard
+// uncertainty and 95 % interval, the closed form's σ/T and its relative deviation, g at each
+// capture used.
+Json exact_series_json(const image::ExactSeriesEstimate& e) {
+    Json out;
+    out["method"] = std::string(image::to_string(e.method));
+    out["method_description"] = image::describe(e);
+    Json captures = Json::array();
+    for (const std::size_t k : e.captures) captures.push_back(k + 1);
+    out["captures"] = captures;  // 1-based, as the warnings name them
+    out["uncertainty_covers"] = e.covers;
+    for (const image::ExactSeriesCorrelation& c : e.correlations) {
+        Json cj;
+        put(cj, "sigma_um", c.sigma_um);
+        put(cj, "T_um", c.T_um);
+        put(cj, "sigma_over_T", c.sigma_over_T);
+        cj["sigma_over_T_interval95"] =
+            c.interval95_low && c.interval95_high
+                ? Json::array({number(*c.interval95_low), number(*c.interval95_high)})
+                : Json();
+        cj["closed_form_sigma_over_T"] = number(c.closed_form_sigma_over_T);
+        cj["closed_form_deviation_rel"] = number(c.closed_form_deviation_rel);
+        cj["closed_form_off"] = c.closed_form_off;
+        cj["g"] = numbers(c.g);
+        cj["fit_status"] = c.fit_status.empty() ? Json() : Json(c.fit_status);
+        cj["failure"] = c.failure.empty() ? Json() : Json(c.failure);
+        out[std::string(to_string(c.correlation))] = cj;
+    }
+    out["warnings"] = e.warnings;
+    return out;
 }
 
 }  // namespace
@@ -479,6 +516,7 @@ Json to_json(const image::MeasureResult& r, const image::MeasureRequest& request
     for (const auto& c : r.captures) captures.push_back(capture_json(c));
     out["captures"] = captures;
     put_budget(out, r.uncertainty);
+    out["exact_series"] = r.exact_series ? exact_series_json(*r.exact_series) : Json();
     out["warnings"] = r.warnings;
     return out;
 }

@@ -3,6 +3,8 @@
 // headline quantity by estimation/propagation.hpp.
 #pragma once
 
+#include <cstddef>
+#include <iterator>
 #include <optional>
 #include <string>
 #include <vector>
@@ -47,9 +49,19 @@ inline constexpr double kDefaultWavelengthUncertaintyUm = 0.02;
 inline constexpr double kDefaultFlatFieldUncertaintyRel = 0.01;
 inline constexpr double kDefaultFlatFieldGivenUncertaintyRel = 0.002;
 
-// The headline quantities, in the order of UncertaintyBudget::quantities.
-inline constexpr const char* kBudgetQuantities[] = {"E1_over_E2", "sigma_over_T_gaussian",
-                                                    "sigma_over_T_exponential", "sigma_um", "T_um"};
+// The headline quantities, in the order of UncertaintyBudget::quantities. The *_series ones are
+// the exact series' (measure/exact_series.hpp): with σ known, T given σ from the first diffuse
+// pair in Regime::Series for that correlation, and σ/T = σ/T_series.
+inline constexpr const char* kBudgetQuantities[] = {"E1_over_E2",
+                                                    "sigma_over_T_gaussian",
+                                                    "sigma_over_T_exponential",
+                                                    "sigma_um",
+                                                    "T_um",
+                                                    "sigma_over_T_series_gaussian",
+                                                    "sigma_over_T_series_exponential",
+                                                    "T_um_series_gaussian",
+                                                    "T_um_series_exponential"};
+inline constexpr std::size_t kBudgetQuantityCount = std::size(kBudgetQuantities);
 
 struct QuantityBudget {
     std::string quantity;  // one of kBudgetQuantities

@@ -24,6 +24,7 @@
 #include "roughscope/maps/maps.hpp"
 #include "roughscope/measure/budget.hpp"
 #include "roughscope/measure/finite_distance.hpp"
+#include "roughscope/measure/exact_series.hpp"
 #include "roughscope/objects/cylinder.hpp"
 #include "roughscope/objects/sphere.hpp"
 #include "roughscope/photo/hdr.hpp"
@@ -209,6 +210,9 @@ struct MeasureResult {
     // A flat sample's budget (budget.hpp): the declared (or assumed) setup uncertainties and the
     // pixel noise propagated to E1/E2, σ/T, σ and T. Absent for curved objects and maps alone.
     std::optional<UncertaintyBudget> uncertainty;
+    // The exact series where the capture set allows it (exact_series.hpp): σ known and a pair,
+    // or ≥ 3 diffuse captures at distinct geometries; with the closed form's deviation from it.
+    std::optional<ExactSeriesEstimate> exact_series;
     std::vector<std::string> warnings;
 };
 

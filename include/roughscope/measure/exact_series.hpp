@@ -1,0 +1,75 @@
+// The exact series where the capture set allows it (docs/uncertainty.md "Model error"): Eq. 17 /
+// 19 assume the very-rough limit g ≫ 1 and are tens of percent off at g ≈ 0.2–30; the diffuse
+// term summed exactly (Eq. 2's series, scattering/beckmann.hpp Regime::Series) holds at any g.
+//
+//  * σ known (MeasureRequest::sigma_um, or Eq. 13 from a specular capture) and a diffuse pair:
+//    T given σ from the first pair's E1/E2 in Regime::Series for each correlation, σ/T = σ/T_series
+//    ("T given σ"); its uncertainty is the budget's (budget.hpp: sigma_over_T_series_*,
+//    T_um_series_*): angles, exposures, black level, response, λ, σ's uncertainty, pixel noise.
+//  * otherwise ≥ 3 diffuse captures at distinct geometries: σ and T fitted jointly with a gain
+//    (fit.hpp, FitModel::SlightlyRough, Regime::Series) for each correlation ("fit of N
+//    captures"); its ± is the fit's covariance from each capture's brightness noise (pixel noise
+//    and the exposure tolerance in quadrature), scaled up by the reduced χ² when that exceeds 1:
+//    the angles, black level and response are not propagated (ExactSeriesEstimate::covers).
+//
+// Each correlation's estimate is set beside the closed form of the first pair (Eq. 17 / 19, or
+// the very-rough solver off the normal view): closed_form_deviation_rel = (closed − series)/series.
+#pragma once
+
+#include <cstddef>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "roughscope/estimation/estimation.hpp"
+#include "roughscope/scattering/correlation.hpp"
+
+namespace roughscope::image {
+
+struct MeasureRequest;
+struct MeasureResult;
+
+enum class ExactSeriesMethod { SigmaKnown, Fit };
+std::string_view to_string(ExactSeriesMethod method);  // "t_given_sigma", "fit"
+
+
+// One correlation function's exact-series estimate.
+struct ExactSeriesCorrelation {
+    Correlation correlation = Correlation::Gaussian;
+    std::optional<Estimate> sigma_um;  // given / from the specular capture, or fitted
+    std::optional<Estimate> T_um;
+    // std_error: the standard uncertainty (k = 1) of what `covers` says; NaN when unknown.
+    std::optional<Estimate> sigma_over_T;
+    std::optional<double> interval95_low;  // σ/T's 95 % interval
+    std::optional<double> interval95_high;
+    std::optional<double> closed_form_sigma_over_T;  // Eq. 17 / 19 (first pair)
+    std::optional<double> closed_form_deviation_rel;
+    // The closed form lies outside the exact series' 95 % interval and its own stated
+    // uncertainty does not reach the series value (a warning says so).
+    bool closed_form_off = false;
+    std::vector<double> g;    // g = σ² v_z² at each capture used (σ of this estimate)
+    std::string fit_status;   // fit only: SolverStatus of the fit ("converged", ...)
+    std::string failure;      // empty, else why this correlation has no estimate
+};
+
+struct ExactSeriesEstimate {
+    ExactSeriesMethod method = ExactSeriesMethod::SigmaKnown;
+    std::vector<std::size_t> captures;  // indices into MeasureResult::captures (diffuse, used)
+    std::string covers;                 // what the ± of the estimates covers
+    std::vector<ExactSeriesCorrelation> correlations;  // Gaussian, exponential
+    std::vector<std::string> warnings;
+
+    const ExactSeriesCorrelation* operator[](Correlation c) const;
+};
+
+// "T given σ", or "fit of N captures" (N = ExactSeriesEstimate::captures.size()).
+std::string describe(const ExactSeriesEstimate& estimate);
+
+// The exact-series estimate of a flat sample's measurement (after the budget: the T-given-σ path
+// reads its uncertainty from result.uncertainty). nullopt when the capture set allows neither
+// path (σ unknown and fewer than 3 diffuse captures at distinct geometries). Never throws for a
+// ratio or fit without solution: that correlation's `failure` says why.
+std::optional<ExactSeriesEstimate> exact_series_estimate(const MeasureRequest& request,
+                                                         const MeasureResult& result);
+
+}  // namespace roughscope::image
