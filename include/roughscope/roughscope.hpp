@@ -82,6 +82,7 @@
 
 // measure: the capture file and the measurement
 #include "roughscope/measure/budget.hpp"
+#include "roughscope/measure/exact_series.hpp"
 #include "roughscope/measure/finite_distance.hpp"
 #include "roughscope/measure/measure.hpp"
 #include "roughscope/measure/plan.hpp"
