@@ -57,8 +57,8 @@ std::vector<fs::path> write_set(std::size_t side) {
                 const double ny = -(static_cast<double>(y) + 0.5 - centre) / r;
                 if (nx * nx + ny * ny >= 1.0) continue;
                 const Eigen::Vector3d n(nx, ny, std::sqrt(1.0 - nx * nx - ny * ny));
-                c.dn[y * side + x] =
-                    static_cast<std::uint16_t>(std::lround(60000 * 0.8 * std::max(0.0, n.dot(L[j]))));
+                c.dn[y * side + x] = static_cast<std::uint16_t>(
+                    std::lround(60000 * 0.8 * std::max(0.0, n.dot(L[j]))));
             }
         files.push_back(fs::temp_directory_path() /
                         ("roughscope_bench_ps_" + std::to_string(::getpid()) + "_" +

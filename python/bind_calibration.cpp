@@ -54,10 +54,10 @@ image::LinearImage image_from_array(py::handle values, py::handle flags, bool ch
     const auto v = py::array_t<float, py::array::c_style | py::array::forcecast>::ensure(
         real_array("image", values));
     if (!v || (v.ndim() != 2 && v.ndim() != 3))
-        throw InvalidArgument(concat("image must be a path, a (height, width) or ",
-                                     channels_last ? "(height, width, channels)"
-                                                   : "(channels, height, width)",
-                                     " array, or read_image's dict"));
+        throw InvalidArgument(
+            concat("image must be a path, a (height, width) or ",
+                   channels_last ? "(height, width, channels)" : "(channels, height, width)",
+                   " array, or read_image's dict"));
     image::LinearImage img;
     img.info.source = "array";
     const bool planes = v.ndim() == 3;
@@ -102,8 +102,7 @@ image::LinearImage image_argument(py::handle image, const image::ReadOptions& re
         if (!d.contains("values"))
             throw InvalidArgument("image dict must hold 'values' (and 'flags'), as read_image's");
         return image_from_array(d["values"],
-                                d.contains("flags") ? py::handle(d["flags"]) : py::none(),
-                                false);
+                                d.contains("flags") ? py::handle(d["flags"]) : py::none(), false);
     }
     return image_from_array(image, py::none(), channels_last);
 }

@@ -52,8 +52,7 @@ void bind_photometric_stereo(py::module_& m) {
     m.def(
         "photometric_stereo",
         [](py::handle images, py::handle lights, py::handle mask, const std::string& model,
-           py::handle light_intensities,
-           py::handle shadow_fraction, py::handle highlight_fraction,
+           py::handle light_intensities, py::handle shadow_fraction, py::handle highlight_fraction,
            const std::optional<std::string>& response, py::handle gamma, py::handle threads) {
             image::ReadOptions read;
             if (response) read.response = parse_response(*response);
@@ -81,8 +80,9 @@ void bind_photometric_stereo(py::module_& m) {
             image::PhotometricStereoOptions options;
             options.model = image::parse_photometric_model(model);
             if (!light_intensities.is_none()) {
-                const auto e = py::array_t<double, py::array::c_style | py::array::forcecast>::
-                    ensure(real_array("light_intensities", light_intensities));
+                const auto e =
+                    py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(
+                        real_array("light_intensities", light_intensities));
                 options.light_intensities.assign(e.data(), e.data() + e.size());
             }
             options.shadow_fraction = real_scalar("shadow_fraction", shadow_fraction);
@@ -116,24 +116,23 @@ void bind_photometric_stereo(py::module_& m) {
             out["valid"] = py::array(out["lights_used"]).attr("__ge__")(3);
             if (r.model != image::PhotometricModel::Lambert) {
                 out["sigma_over_T"] = map_array(r.sigma_over_T, r.height, r.width, 1);
-                out["sigma_over_T_stderr"] =
-                    map_array(r.sigma_over_T_stderr, r.height, r.width, 1);
+                out["sigma_over_T_stderr"] = map_array(r.sigma_over_T_stderr, r.height, r.width, 1);
                 out["delta_aic"] = map_array(r.delta_aic, r.height, r.width, 1);
             }
             return out;
         },
         py::arg("images"), py::arg("lights"), py::arg("mask") = py::none(),
-        py::arg("model") = "lambert",
-        py::arg("light_intensities") = py::none(), py::arg("shadow_fraction") = 0.05,
-        py::arg("highlight_fraction") = 0.1, py::arg("response") = py::none(),
-        py::arg("gamma") = 2.2, py::arg("threads") = 0,
+        py::arg("model") = "lambert", py::arg("light_intensities") = py::none(),
+        py::arg("shadow_fraction") = 0.05, py::arg("highlight_fraction") = 0.1,
+        py::arg("response") = py::none(), py::arg("gamma") = 2.2, py::arg("threads") = 0,
         "Normals and albedo of an object from photographs taken by a fixed camera under lights "
         "from known directions (Lambert's law; docs/photometric-stereo.md). images: one per "
         "light, each a path (read with response/gamma as read_image), read_image's dict, or a "
         "linear (height, width) or (height, width, channels) array; lights: (k, 3) unit "
         "vectors in the camera frame (x right, y up, z towards the camera), k ≥ 3; mask: "
         "(height, width), nonzero on the object; model: \"lambert\", or \"vh_gaussian\" / "
-        "\"vh_exponential\" (the very-rough model fitted per pixel with σ/T, k ≥ 4). Returns a dict: normals (height, width, 3), "
+        "\"vh_exponential\" (the very-rough model fitted per pixel with σ/T, k ≥ 4). Returns a "
+        "dict: normals (height, width, 3), "
         "albedo, residual (the quality map), lights_used, valid (NaN / False where a pixel has "
         "no normal), and the summary: model, lights, pixels {object, valid, too_few_lights}, "
         "highlights_removed, median_residual, warnings; the rough models add sigma_over_T, "

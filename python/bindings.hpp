@@ -45,8 +45,8 @@ void bind_calibration(pybind11::module_& m);  // python/bind_calibration.cpp: th
 void bind_plan(pybind11::module_& m);         // python/bind_plan.cpp: the light angles to choose
 // python/bind_photometric.cpp: normals and albedo from photographs under several lights
 void bind_photometric_stereo(pybind11::module_& m);
-void bind_report(pybind11::module_& m);       // python/bind_report.cpp: what the report draws
-void bind_documents(pybind11::module_& m);    // python/bind_documents.cpp: text and documents
+void bind_report(pybind11::module_& m);     // python/bind_report.cpp: what the report draws
+void bind_documents(pybind11::module_& m);  // python/bind_documents.cpp: text and documents
 
 // Results cross into Python as real objects, built from the library's serializer
 // (roughscope/serialize): objects → dict (key order kept), arrays → list, numbers → int/float,

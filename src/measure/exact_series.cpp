@@ -6,9 +6,11 @@
 #include <cmath>
 #include <limits>
 #include <string>
+#include <tuple>
 #include <utility>
 #include <vector>
 
+#include "exact_series_profile.hpp"
 #include "roughscope/core/errors.hpp"
 #include "roughscope/core/numbers.hpp"
 #include "roughscope/core/text.hpp"
@@ -71,21 +73,22 @@ void compare_closed_form(const MeasureResult& r, ExactSeriesCorrelation& e,
     const double series = e.sigma_over_T->value;
     e.closed_form_sigma_over_T = closed.value;
     e.closed_form_deviation_rel = (*closed.value - series) / series;
-    const bool outside_series = e.interval95_low && e.interval95_high &&
-                                (*closed.value < *e.interval95_low ||
-                                 *closed.value > *e.interval95_high);
+    const bool outside_series =
+        e.interval95_low && e.interval95_high &&
+        (*closed.value < *e.interval95_low || *closed.value > *e.interval95_high);
     const bool outside_closed = !(series >= closed.low && series <= closed.high);
     e.closed_form_off = outside_series && outside_closed;
     if (!e.closed_form_off) return;
     std::string g_list;
-    for (const double g : e.g) g_list += concat(g_list.empty() ? "" : ", ", format_significant(g, 3));
+    for (const double g : e.g)
+        g_list += concat(g_list.empty() ? "" : ", ", format_significant(g, 3));
     warnings.push_back(concat(
-        "exact series (", to_string(e.correlation), "): the closed form σ/T = ",
-        format_significant(*closed.value, 4), " (Eq. ",
+        "exact series (", to_string(e.correlation),
+        "): the closed form σ/T = ", format_significant(*closed.value, 4), " (Eq. ",
         e.correlation == Correlation::Gaussian ? "17" : "19", ", very-rough limit) is ",
-        format_significant(100.0 * *e.closed_form_deviation_rel, 3),
-        " % off the exact series' ", format_significant(series, 4), " (95 % [",
-        format_significant(*e.interval95_low, 4), ", ", format_significant(*e.interval95_high, 4),
+        format_significant(100.0 * *e.closed_form_deviation_rel, 3), " % off the exact series' ",
+        format_significant(series, 4), " (95 % [", format_significant(*e.interval95_low, 4), ", ",
+        format_significant(*e.interval95_high, 4),
         "]), beyond its own stated uncertainty; g at the captures: ", g_list,
         ": take the exact series' value (\"exact_series\")"));
 }
@@ -116,9 +119,8 @@ ExactSeriesEstimate sigma_known(const MeasureRequest& request, const MeasureResu
         e.sigma_um = sigma;
         e.g = g_at(sigma.value, geoms, request.wavelength_um);
         try {
-            const double T =
-                correlation_length_two_geometries(ratio, geoms[0], geoms[1], sigma.value, c,
-                                                  options);
+            const double T = correlation_length_two_geometries(ratio, geoms[0], geoms[1],
+                                                               sigma.value, c, options);
             const QuantityBudget* qs =
                 budget_quantity(r, correlation_key("sigma_over_T_series", c));
             const QuantityBudget* qt = budget_quantity(r, correlation_key("T_um_series", c));
@@ -142,11 +144,11 @@ ExactSeriesEstimate sigma_known(const MeasureRequest& request, const MeasureResu
 double fit_noise_rel(const MeasureRequest& request, const CaptureMeasurement& c) {
     const bool needs_exposure =
         c.exposure_source.rfind("not needed", 0) != 0 && c.spec.bracket.empty();
-    const double exposure = !needs_exposure ? 0.0
-                            : c.spec.uncertainty.exposure_rel
-                                ? *c.spec.uncertainty.exposure_rel
-                                : request.uncertainty.exposure_rel.value_or(
-                                      kDefaultExposureUncertaintyRel);
+    const double exposure =
+        !needs_exposure ? 0.0
+        : c.spec.uncertainty.exposure_rel
+            ? *c.spec.uncertainty.exposure_rel
+            : request.uncertainty.exposure_rel.value_or(kDefaultExposureUncertaintyRel);
     return std::hypot(c.brightness_relative_stderr, exposure);
 }
 
@@ -158,8 +160,8 @@ FitResult best_fit(const std::vector<Measurement>& data, FitOptions options, dou
         options.initial_sigma_um = std::sqrt(g) / vz;
         options.initial_T_um = *options.initial_sigma_um / slope;
         FitResult f = fit_roughness(data, options);
-        const bool better_status = f.status == SolverStatus::Converged &&
-                                   best.status != SolverStatus::Converged;
+        const bool better_status =
+            f.status == SolverStatus::Converged && best.status != SolverStatus::Converged;
         const bool same_status = f.status == best.status;
         if (better_status || (same_status && f.sse < best.sse)) best = std::move(f);
     }
@@ -179,8 +181,8 @@ void read_fit(const FitResult& f, ExactSeriesCorrelation& e, bool noise_weights)
     const int dof = f.num_measurements - f.num_parameters;
     double scale = 1.0;
     if (noise_weights && dof > 0) scale = std::max(1.0, f.sse / dof);
-    const bool errors = f.covariance_available && f.status == SolverStatus::Converged &&
-                        (noise_weights || dof > 0);
+    const bool errors =
+        f.covariance_available && f.status == SolverStatus::Converged && (noise_weights || dof > 0);
     const double var_s = errors ? f.covariance(0, 0) * scale : kNaN;
     const double var_t = errors ? f.covariance(1, 1) * scale : kNaN;
     const double cov_st = errors ? f.covariance(0, 1) * scale : kNaN;
@@ -196,6 +198,48 @@ void read_fit(const FitResult& f, ExactSeriesCorrelation& e, bool noise_weights)
         e.interval95_low = q - kZ95 * e.sigma_over_T->std_error;
         e.interval95_high = q + kZ95 * e.sigma_over_T->std_error;
     }
+}
+
+// The profile-likelihood intervals (exact_series_profile.hpp) in place of the covariance's: the
+// fit is started again from the grid's minimum when that is better than the fit's (a local
+// minimum), and σ or T not determined by the captures is said.
+void apply_profile(const std::vector<Measurement>& data, FitOptions options,
+                   ExactSeriesCorrelation& e, std::vector<std::string>& warnings) {
+    detail::ProfileIntervals p =
+        detail::profile_intervals(data, options, e.sigma_um->value, e.T_um->value);
+    if (!p.ok) return;
+    const double rel = std::abs(p.best_sigma_um / e.sigma_um->value - 1.0) +
+                       std::abs(p.best_T_um / e.T_um->value - 1.0);
+    if (rel > 1e-6) {
+        options.initial_sigma_um = p.best_sigma_um;
+        options.initial_T_um = p.best_T_um;
+        ExactSeriesCorrelation again = e;
+        const bool noise_weights = !options.scale_covariance;
+        read_fit(fit_roughness(data, options), again, noise_weights);
+        if (again.sigma_um && again.T_um) {
+            const detail::ProfileIntervals q =
+                detail::profile_intervals(data, options, again.sigma_um->value, again.T_um->value);
+            if (q.ok && q.chi2_min <= p.chi2_min + 1e-9 * (1.0 + p.chi2_min)) {
+                e = std::move(again);
+                p = q;
+            }
+        }
+    }
+    e.sigma_um_interval95 = std::array<double, 2>{p.sigma_um.low, p.sigma_um.high};
+    e.T_um_interval95 = std::array<double, 2>{p.T_um.low, p.T_um.high};
+    e.interval95_low = p.sigma_over_T.low;
+    e.interval95_high = p.sigma_over_T.high;
+    e.sigma_determined = !p.sigma_um.open_low && !p.sigma_um.open_high;
+    e.T_determined = !p.T_um.open_low && !p.T_um.open_high;
+    for (const auto& [name, determined, interval] :
+         {std::tuple{"σ", e.sigma_determined, p.sigma_um}, std::tuple{"T", e.T_determined, p.T_um}})
+        if (!determined)
+            warnings.push_back(concat(
+                "fit (exact series, ", to_string(e.correlation),
+                "): the captures do not determine ", name, ": its 95 % interval [",
+                format_significant(interval.low, 3), ", ", format_significant(interval.high, 3),
+                "] µm reaches the range searched (at small g the diffuse term is nearly "
+                "proportional to σ², which the gain absorbs)"));
 }
 
 // σ unknown and ≥ 3 diffuse captures at distinct geometries: σ and T jointly (with a gain).
@@ -242,6 +286,7 @@ ExactSeriesEstimate joint_fit(const MeasureRequest& request, const MeasureResult
         const double slope = closed.value && *closed.value > 0.0 ? *closed.value : 0.3;
         try {
             read_fit(best_fit(data, options, vz, slope), e, noise_weights);
+            if (e.sigma_um && e.T_um) apply_profile(data, options, e, out.warnings);
         } catch (const Error& error) {
             e.failure = concat("fit (exact series): ", error.what());
         }
@@ -284,9 +329,8 @@ std::optional<ExactSeriesEstimate> exact_series_estimate(const MeasureRequest& r
         const CaptureMeasurement& c = result.captures[k];
         if (c.spec.role != CaptureRole::Diffuse || !(c.brightness > 0.0)) continue;
         diffuse.push_back(k);
-        if (std::none_of(distinct.begin(), distinct.end(), [&](const Geometry& g) {
-                return same_geometry(g, c.spec.geometry);
-            }))
+        if (std::none_of(distinct.begin(), distinct.end(),
+                         [&](const Geometry& g) { return same_geometry(g, c.spec.geometry); }))
             distinct.push_back(c.spec.geometry);
     }
     std::optional<Estimate> sigma;

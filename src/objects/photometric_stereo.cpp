@@ -132,17 +132,17 @@ void check_inputs(const std::vector<const LinearImage*>& images,
         m.row(static_cast<Eigen::Index>(j)) = lights[j].transpose();
     const Eigen::Vector3d sv = Eigen::JacobiSVD<Eigen::MatrixXd>(m).singularValues();
     if (sv(2) < kPhotometricStereoMinLightSpread * sv(0))
-        throw InvalidArgument(concat(
-            "photometric stereo: the lights are coplanar (smallest singular value of their "
-            "directions ",
-            check::format_number(sv(2) / sv(0)), " of the largest; at least ",
-            check::format_number(kPhotometricStereoMinLightSpread), " needed)"));
+        throw InvalidArgument(
+            concat("photometric stereo: the lights are coplanar (smallest singular value of their "
+                   "directions ",
+                   check::format_number(sv(2) / sv(0)), " of the largest; at least ",
+                   check::format_number(kPhotometricStereoMinLightSpread), " needed)"));
     const LinearImage* first = images.front();
     for (std::size_t j = 0; j < images.size(); ++j) {
         const LinearImage* im = images[j];
         if (im == nullptr || im->pixel_count() == 0)
-            throw InvalidArgument(concat("photometric stereo: image ", std::to_string(j),
-                                         " is empty"));
+            throw InvalidArgument(
+                concat("photometric stereo: image ", std::to_string(j), " is empty"));
         if (im->width != first->width || im->height != first->height)
             throw InvalidArgument(concat(
                 "photometric stereo: image ", std::to_string(j), " is ", std::to_string(im->width),
@@ -191,10 +191,9 @@ void check_photometric_stereo_options(const PhotometricStereoOptions& options,
                                       std::size_t num_lights) {
     if (!options.light_intensities.empty()) {
         if (options.light_intensities.size() != num_lights)
-            throw InvalidArgument(concat("photometric stereo: ",
-                                         std::to_string(options.light_intensities.size()),
-                                         " light intensities for ", std::to_string(num_lights),
-                                         " lights"));
+            throw InvalidArgument(
+                concat("photometric stereo: ", std::to_string(options.light_intensities.size()),
+                       " light intensities for ", std::to_string(num_lights), " lights"));
         for (std::size_t j = 0; j < num_lights; ++j) {
             const double e = options.light_intensities[j];
             if (!(e > 0.0 && std::isfinite(e)))
@@ -204,9 +203,9 @@ void check_photometric_stereo_options(const PhotometricStereoOptions& options,
         }
     }
     if (!(options.shadow_fraction >= 0.0 && options.shadow_fraction < 1.0))
-        throw InvalidArgument(concat("photometric stereo: shadow_fraction = ",
-                                     check::format_number(options.shadow_fraction),
-                                     " must be in [0, 1)"));
+        throw InvalidArgument(concat(
+            "photometric stereo: shadow_fraction = ", check::format_number(options.shadow_fraction),
+            " must be in [0, 1)"));
     if (!(options.min_sigma_over_T > 0.0 && options.min_sigma_over_T < options.max_sigma_over_T &&
           std::isfinite(options.max_sigma_over_T)))
         throw InvalidArgument(concat("photometric stereo: the σ/T range [",
@@ -282,8 +281,8 @@ PhotometricStereoResult photometric_stereo(const std::vector<const LinearImage*>
                 ++c.too_few;
                 continue;
             }
-            const PixelSolution s = solve_pixel(solver, value.data(), set,
-                                                options.highlight_fraction);
+            const PixelSolution s =
+                solve_pixel(solver, value.data(), set, options.highlight_fraction);
             const double rho = s.g.norm();
             if (!s.solved || !(rho > 0.0) || !(s.g.z() > 0.0)) {
                 ++c.no_solution;
@@ -338,10 +337,10 @@ PhotometricStereoResult photometric_stereo(const std::vector<const LinearImage*>
     r.median_sigma_over_T = rough ? median_of_finite(r.sigma_over_T) : kNaN;
     r.median_delta_aic = rough ? median_of_finite(r.delta_aic) : kNaN;
     if (r.object_pixels > 0 && r.valid_pixels < r.object_pixels / 2)
-        r.warnings.push_back(concat(
-            "only ", std::to_string(r.valid_pixels), " of ", std::to_string(r.object_pixels),
-            " object pixels have a normal (", std::to_string(r.too_few_lights),
-            " are lit by fewer than 3 usable lights)"));
+        r.warnings.push_back(
+            concat("only ", std::to_string(r.valid_pixels), " of ", std::to_string(r.object_pixels),
+                   " object pixels have a normal (", std::to_string(r.too_few_lights),
+                   " are lit by fewer than 3 usable lights)"));
     return r;
 }
 

@@ -17,9 +17,9 @@ namespace roughscope::image::detail {
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-constexpr int kScan = 16;          // log-spaced σ/T values of the starting scan
+constexpr int kScan = 16;  // log-spaced σ/T values of the starting scan
 constexpr int kMaxIterations = 60;
-constexpr double kStep = 1e-6;     // central-difference step of the parameters
+constexpr double kStep = 1e-6;  // central-difference step of the parameters
 constexpr double kTinyVariance = 1e-300;
 
 // The pixel's model at parameters x = (u, v, ln σ/T): n = normalise(n0 + u t1 + v t2).
@@ -166,9 +166,9 @@ RoughPixelFit fit_rough_pixel(const RoughPixelProblem& p) {
         Eigen::Vector3d x(0.0, 0.0, 0.0);
         double best = std::numeric_limits<double>::infinity();
         for (int k = 0; k < kScan; ++k) {
-            const double t = std::log(p.min_sigma_over_T) +
-                             (std::log(p.max_sigma_over_T) - std::log(p.min_sigma_over_T)) *
-                                 (k + 0.5) / kScan;
+            const double t =
+                std::log(p.min_sigma_over_T) +
+                (std::log(p.max_sigma_over_T) - std::log(p.min_sigma_over_T)) * (k + 0.5) / kScan;
             const double c = model.sse(Eigen::Vector3d(0.0, 0.0, t), set);
             if (c < best) {
                 best = c;

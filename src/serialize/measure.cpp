@@ -385,6 +385,15 @@ Json exact_series_json(const image::ExactSeriesEstimate& e) {
             c.interval95_low && c.interval95_high
                 ? Json::array({number(*c.interval95_low), number(*c.interval95_high)})
                 : Json();
+        if (e.method == image::ExactSeriesMethod::Fit) {
+            const auto pair = [](const std::optional<std::array<double, 2>>& v) {
+                return v ? Json::array({number((*v)[0]), number((*v)[1])}) : Json();
+            };
+            cj["sigma_um_interval95"] = pair(c.sigma_um_interval95);
+            cj["T_um_interval95"] = pair(c.T_um_interval95);
+            cj["sigma_determined"] = c.sigma_determined;
+            cj["T_determined"] = c.T_determined;
+        }
         cj["closed_form_sigma_over_T"] = number(c.closed_form_sigma_over_T);
         cj["closed_form_deviation_rel"] = number(c.closed_form_deviation_rel);
         cj["closed_form_off"] = c.closed_form_off;

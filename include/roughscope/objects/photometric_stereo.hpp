@@ -80,17 +80,17 @@ struct PhotometricStereoResult {
     std::size_t width = 0;
     std::size_t height = 0;
     // Per pixel, row-major (row 0 at the top); NaN where the pixel has no normal.
-    std::vector<float> normals;      // 3 · width · height: (n_x, n_y, n_z) of each pixel in turn
-    std::vector<float> albedo;       // ρ, on the images' linear scale divided by e_j
-    std::vector<float> residual;     // the quality map (see above)
+    std::vector<float> normals;   // 3 · width · height: (n_x, n_y, n_z) of each pixel in turn
+    std::vector<float> albedo;    // ρ, on the images' linear scale divided by e_j
+    std::vector<float> residual;  // the quality map (see above)
     std::vector<std::uint8_t> lights_used;  // |S| at the pixel's solution (0 off the object)
-    std::size_t object_pixels = 0;   // pixels inside the mask (every pixel without one)
-    std::size_t valid_pixels = 0;    // pixels with a normal
-    std::size_t too_few_lights = 0;  // object pixels with fewer than 3 usable lights
+    std::size_t object_pixels = 0;          // pixels inside the mask (every pixel without one)
+    std::size_t valid_pixels = 0;           // pixels with a normal
+    std::size_t too_few_lights = 0;         // object pixels with fewer than 3 usable lights
     // Object pixels with ≥ 3 usable lights but no normal: a nearly coplanar set, ρ ≤ 0, n_z ≤ 0.
     std::size_t no_solution = 0;
     std::size_t highlights_removed = 0;  // lights left out as highlights, over all pixels
-    double median_residual = 0.0;    // over the valid pixels with a residual (NaN if none)
+    double median_residual = 0.0;        // over the valid pixels with a residual (NaN if none)
     // The rough models only (else empty / 0 / NaN): per pixel σ/T, its standard error and
     // ΔAIC (NaN where not defined); the pixels where ΔAIC > 0 and the medians over the valid
     // pixels.

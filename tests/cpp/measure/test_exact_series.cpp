@@ -8,9 +8,11 @@
 //    runs;
 //  * noise-free captures: closed_form_deviation_rel is (closed − truth)/truth.
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <random>
 #include <string>
@@ -61,9 +63,8 @@ sim::SurfaceTruth constant_truth(double value) {
 
 // σ of g = σ² v_z² at the normal-view geometry of incidence θ.
 double sigma_of_g(double g, double theta_deg) {
-    return std::sqrt(g) / std::abs(scattering_vector(normal_view_geometry(deg_to_rad(theta_deg)),
-                                                     kLambdaUm)
-                                       .vz);
+    return std::sqrt(g) /
+           std::abs(scattering_vector(normal_view_geometry(deg_to_rad(theta_deg)), kLambdaUm).vz);
 }
 
 // One capture as the bench really took it.
@@ -135,8 +136,8 @@ std::string render_specular(const fs::path& file, double sigma, double theta_deg
     camera.full_well_e = 1e7;  // a deep well: the highlight's contrast is a few percent at most
     camera.electrons_per_unit_s = 0.6 * camera.full_well_e / e_tot;
     camera.gain_dn_per_e = 0.005;
-    const sim::Capture c = sim::render_capture(
-        scene, {constant_truth(1.0), constant_truth(e_tot)}, labels, camera, options);
+    const sim::Capture c = sim::render_capture(scene, {constant_truth(1.0), constant_truth(e_tot)},
+                                               labels, camera, options);
     io::write_file_atomic(file, sim::encode_capture_tiff(c));
     return file.string();
 }
@@ -182,37 +183,37 @@ TEST(MeasureExactSeries, SigmaKnownCoversTheTruthWhereTheClosedFormDoesNot) {
                 shot.view_y_deg = 0.5 * z(rng);
                 shot.exposure_s = 1.0 + 0.01 * z(rng);
                 shot.black_dn = 2000.0 + 40.0 * z(rng);
-                entries.push_back(diffuse_entry(
-                    render_diffuse(dir / concat("d", std::to_string(theta), ".tiff"), truth, shot,
-                                   peak, ++seed),
-                    theta));
+                entries.push_back(
+                    diffuse_entry(render_diffuse(dir / concat("d", std::to_string(theta), ".tiff"),
+                                                 truth, shot, peak, ++seed),
+                                  theta));
             }
             std::string sigma_keys;
             const bool specular = g <= 5.0 && run % 3 == 1;
             if (specular) {
                 ++specular_runs;
-                entries.insert(entries.begin(),
-                               concat(R"({"image": ")",
-                                      render_specular(dir / "s.tiff", sigma, 70.0, ++seed),
-                                      R"(", "theta_i_deg": 70, "theta_s_deg": 70, )",
-                                      R"("role": "specular", "exposure_s": 1})"));
+                entries.insert(
+                    entries.begin(),
+                    concat(R"({"image": ")", render_specular(dir / "s.tiff", sigma, 70.0, ++seed),
+                           R"(", "theta_i_deg": 70, "theta_s_deg": 70, )",
+                           R"("role": "specular", "exposure_s": 1})"));
             } else {
                 const double u_sigma = 0.03 * sigma;
-                sigma_keys = concat(R"("sigma_um": )",
-                                    check::format_number(sigma + u_sigma * z(rng)),
-                                    R"(, "sigma_um_stderr": )", check::format_number(u_sigma), ", ");
+                sigma_keys =
+                    concat(R"("sigma_um": )", check::format_number(sigma + u_sigma * z(rng)),
+                           R"(, "sigma_um_stderr": )", check::format_number(u_sigma), ", ");
             }
             std::string captures;
             for (const auto& e : entries) captures += (captures.empty() ? "" : ", ") + e;
             const MeasureResult r = measure(parse_capture_file(
-                concat(R"({"roi": {"rect": [4, 4, 24, 24]}, "black_level_dn": 2000, )",
-                       R"("highlight": {"core_radius_px": 3, "annulus_inner_px": 6, )",
-                       R"("annulus_outer_px": 10, "centre_px": [16, 16]}, )", sigma_keys,
-                       R"("correlation": ")", to_string(correlation), R"(", )",
-                       R"("uncertainty": {"angle_deg": 0.5, "exposure_rel": 0.01, )",
-                       R"("black_level_dn": 40, "wavelength_um": 0.001, "method": "first_order"}, )",
-                       R"("captures": [)",
-                       captures, "]}"),
+                concat(
+                    R"({"roi": {"rect": [4, 4, 24, 24]}, "black_level_dn": 2000, )",
+                    R"("highlight": {"core_radius_px": 3, "annulus_inner_px": 6, )",
+                    R"("annulus_outer_px": 10, "centre_px": [16, 16]}, )", sigma_keys,
+                    R"("correlation": ")", to_string(correlation), R"(", )",
+                    R"("uncertainty": {"angle_deg": 0.5, "exposure_rel": 0.01, )",
+                    R"("black_level_dn": 40, "wavelength_um": 0.001, "method": "first_order"}, )",
+                    R"("captures": [)", captures, "]}"),
                 (dir / "c.json").string()));
             ASSERT_TRUE(r.exact_series) << "g = " << g;
             EXPECT_EQ(r.exact_series->method, ExactSeriesMethod::SigmaKnown);
@@ -223,11 +224,11 @@ TEST(MeasureExactSeries, SigmaKnownCoversTheTruthWhereTheClosedFormDoesNot) {
             const QuantityBudget* closed = nullptr;
             for (const auto& q : r.uncertainty->quantities)
                 if (q.quantity == correlation_key("sigma_over_T", correlation)) closed = &q;
-            if (closed &&
-                (s < closed->result.interval95_low || s > closed->result.interval95_high))
+            if (closed && (s < closed->result.interval95_low || s > closed->result.interval95_high))
                 ++closed_missed;
             if (e->closed_form_deviation_rel)
-                worst_deviation = std::max(worst_deviation, std::abs(*e->closed_form_deviation_rel));
+                worst_deviation =
+                    std::max(worst_deviation, std::abs(*e->closed_form_deviation_rel));
         }
         EXPECT_GE(covered, per_correlation * 9 / 10)
             << to_string(correlation) << ": " << covered << " of " << per_correlation;
@@ -246,16 +247,18 @@ TEST(MeasureExactSeries, SigmaKnownCoversTheTruthWhereTheClosedFormDoesNot) {
 // σ unknown, four geometries (θi = 20°, 35°, 50°, 65°, camera on the normal) with pixel noise and
 // exposures drawn from the declared 1 %: the joint fit's 95 % intervals (σ ± 1.96 u, T, σ/T) hold
 // the truth in ≥ 90 % of the runs.
-// DISABLED: measured 21 (σ), 22 (T), 21 (σ/T) of 30 — at g ≈ 0.2–0.35 the fit settles in a wrong
-// minimum (σ 3× the truth) with a small standard error; the starts (exact_series.cpp kStartG)
-// need work before this holds (docs/uncertainty.md says the fit's coverage is not established).
-TEST(MeasureExactSeries, DISABLED_TheJointFitOfFourGeometriesCoversSigmaAndT) {
+// The joint fit's profile-likelihood intervals (exact_series_profile.hpp) hold σ, T and σ/T in
+// ≥ 90 % of 60 noisy runs at g 0.2 … 3 (measured: 55, 55, 56), where the fit alone (its
+// covariance, ± 1.96 s.e.) missed them in a third of the runs: at small g it settled in another
+// minimum with a small standard error. Where σ is not determined (small g) its interval is
+// open-ended and says so.
+TEST(MeasureExactSeries, TheJointFitOfFourGeometriesCoversSigmaAndT) {
     const fs::path dir = testing::fresh_dir("exact_series_fit");
     std::mt19937_64 rng(77);
     std::normal_distribution<double> z(0.0, 1.0);
     const double thetas[] = {20.0, 35.0, 50.0, 65.0};
-    const int runs = 30;
-    int covered_sigma = 0, covered_T = 0, covered_slope = 0, with_errors = 0;
+    const int runs = 60;
+    int covered_sigma = 0, covered_T = 0, covered_slope = 0, with_errors = 0, undetermined = 0;
     std::uint64_t seed = 9000;
     for (int run = 0; run < runs; ++run) {
         const double g = 0.2 * std::pow(15.0, run / (runs - 1.0));  // at 50°: 0.2 … 3
@@ -267,8 +270,8 @@ TEST(MeasureExactSeries, DISABLED_TheJointFitOfFourGeometriesCoversSigmaAndT) {
         const sim::SurfaceTruth truth = series_truth(sigma, T, correlation);
         double peak = 0.0;
         for (const double t : thetas)
-            peak = std::max(peak,
-                            sim::surface_brightness(truth, normal_view_geometry(deg_to_rad(t))));
+            peak =
+                std::max(peak, sim::surface_brightness(truth, normal_view_geometry(deg_to_rad(t))));
         std::string captures;
         for (const double t : thetas) {
             Shot shot;
@@ -288,14 +291,15 @@ TEST(MeasureExactSeries, DISABLED_TheJointFitOfFourGeometriesCoversSigmaAndT) {
         EXPECT_EQ(r.exact_series->method, ExactSeriesMethod::Fit);
         const ExactSeriesCorrelation* e = (*r.exact_series)[correlation];
         ASSERT_NE(e, nullptr);
-        if (!e->sigma_um || !e->T_um || !std::isfinite(e->sigma_um->std_error)) continue;
+        if (!e->sigma_um_interval95 || !e->T_um_interval95) continue;
         ++with_errors;
-        const auto within = [](double truth_value, const Estimate& est) {
-            return std::abs(est.value - truth_value) <= 1.96 * est.std_error;
+        const auto within = [](double truth_value, const std::array<double, 2>& interval) {
+            return interval[0] <= truth_value && truth_value <= interval[1];
         };
-        covered_sigma += within(sigma, *e->sigma_um) ? 1 : 0;
-        covered_T += within(T, *e->T_um) ? 1 : 0;
+        covered_sigma += within(sigma, *e->sigma_um_interval95) ? 1 : 0;
+        covered_T += within(T, *e->T_um_interval95) ? 1 : 0;
         covered_slope += inside(s, *e) ? 1 : 0;
+        undetermined += e->sigma_determined ? 0 : 1;
     }
     EXPECT_GE(with_errors, runs * 9 / 10);
     EXPECT_GE(covered_sigma, runs * 9 / 10) << covered_sigma << " of " << runs;
@@ -303,8 +307,8 @@ TEST(MeasureExactSeries, DISABLED_TheJointFitOfFourGeometriesCoversSigmaAndT) {
     EXPECT_GE(covered_slope, runs * 9 / 10) << covered_slope << " of " << runs;
     std::printf(
         "[ series   ] joint fit of 4 geometries: sigma inside in %d, T in %d, sigma/T in %d of %d "
-        "runs (%d with standard errors)\n",
-        covered_sigma, covered_T, covered_slope, runs, with_errors);
+        "runs (%d with intervals, %d with sigma not determined)\n",
+        covered_sigma, covered_T, covered_slope, runs, with_errors, undetermined);
 }
 
 // Noise-free captures, σ given exactly: the exact series gives the truth, and
@@ -324,17 +328,16 @@ TEST(MeasureExactSeries, TheClosedFormDeviationIsTheClosedFormsError) {
             for (const double t : {30.0, 45.0}) {
                 Shot shot;
                 shot.theta_i_deg = t;
-                captures += (captures.empty() ? "" : ", ") +
-                            diffuse_entry(render_diffuse(dir / concat("d", std::to_string(t),
-                                                                      ".tiff"),
-                                                         truth, shot, peak, ++seed, false),
-                                          t);
+                captures +=
+                    (captures.empty() ? "" : ", ") +
+                    diffuse_entry(render_diffuse(dir / concat("d", std::to_string(t), ".tiff"),
+                                                 truth, shot, peak, ++seed, false),
+                                  t);
             }
             const MeasureRequest request = parse_capture_file(
                 concat(R"({"roi": {"rect": [4, 4, 24, 24]}, "black_level_dn": 2000, )",
                        R"("sigma_um": )", check::format_number(sigma), R"(, "correlation": ")",
-                       to_string(correlation), R"(", "captures": [)",
-                       captures, "]}"),
+                       to_string(correlation), R"(", "captures": [)", captures, "]}"),
                 (dir / "c.json").string());
             const MeasureResult r = measure(request);
             ASSERT_TRUE(r.exact_series);

@@ -45,7 +45,7 @@ struct Scene {
     double cx = 60.3, cy = 59.4, r = 52.0;
     double albedo = 0.6;  // × (1 + 0.3 x/r): varies across the sphere
     double noise = 0.0;
-    int bits = 0;  // 0: float values
+    int bits = 0;                 // 0: float values
     double highlight_peak = 0.0;  // the lobe of light `highlight_light` (0: none)
     std::size_t highlight_light = 0;
     double highlight_width_deg = 4.0;
@@ -66,7 +66,9 @@ bool on_sphere(const Scene& s, std::size_t row, std::size_t col, Eigen::Vector3d
     return true;
 }
 
-double true_albedo(const Scene& s, const Eigen::Vector3d& n) { return s.albedo * (1 + 0.3 * n.x()); }
+double true_albedo(const Scene& s, const Eigen::Vector3d& n) {
+    return s.albedo * (1 + 0.3 * n.x());
+}
 
 std::vector<LinearImage> render(const Scene& s, const std::vector<Eigen::Vector3d>& lights) {
     std::vector<LinearImage> images;
@@ -86,8 +88,8 @@ std::vector<LinearImage> render(const Scene& s, const std::vector<Eigen::Vector3
                 if (on_sphere(s, row, col, n)) {
                     v = e * true_albedo(s, n) * std::max(0.0, n.dot(lights[j]));
                     if (s.sigma_over_T > 0) {
-                        const auto g = geometry_from_vectors(n, lights[j], Eigen::Vector3d::UnitZ(),
-                                                             1e-9);
+                        const auto g =
+                            geometry_from_vectors(n, lights[j], Eigen::Vector3d::UnitZ(), 1e-9);
                         v = g ? e * true_albedo(s, n) *
                                     very_rough_brightness(*g, s.sigma_over_T, s.correlation)
                               : 0.0;
@@ -137,8 +139,7 @@ Errors errors_of(const Scene& s, const PhotometricStereoResult& r) {
             if (!r.valid(row, col)) continue;
             e.angle_deg.push_back(angle_deg(r.normal(row, col), n));
             const double rho = r.albedo[row * s.size + col];
-            e.max_albedo_rel =
-                std::max(e.max_albedo_rel, std::abs(rho / true_albedo(s, n) - 1.0));
+            e.max_albedo_rel = std::max(e.max_albedo_rel, std::abs(rho / true_albedo(s, n) - 1.0));
         }
     return e;
 }
@@ -290,8 +291,7 @@ TEST(PhotometricStereo, BadInputIsNamed) {
     EXPECT_NE(message(p, away, {}, {}).find("light 2 has L_z"), std::string::npos);
     auto not_unit = lights;
     not_unit[1] *= 2.0;
-    EXPECT_NE(message(p, not_unit, {}, {}).find("light 1 is not a unit vector"),
-              std::string::npos);
+    EXPECT_NE(message(p, not_unit, {}, {}).find("light 1 is not a unit vector"), std::string::npos);
     Scene small = s;
     small.size = 60;
     const auto other = render(small, lights);
@@ -342,11 +342,12 @@ TEST(RoughPhotometricStereo, RecoversNormalsAndSlopeWhereLambertIsBiased) {
         // Lambert's law on the same photographs: the normals the rough model corrects.
         EXPECT_GT(median(lambert.angle_deg), 2.0) << to_string(o.model);
         EXPECT_GT(r.rough_better_pixels, r.compared_pixels * 9 / 10) << to_string(o.model);
-        std::printf("%s: median normal error Lambert %.2f deg, rough %.4f deg; median σ/T %.4f "
-                    "(truth %.2f); rough better in %zu of %zu pixels\n",
-                    std::string(to_string(o.model)).c_str(), median(lambert.angle_deg),
-                    median(rough.angle_deg), median(slope), s.sigma_over_T,
-                    r.rough_better_pixels, r.compared_pixels);
+        std::printf(
+            "%s: median normal error Lambert %.2f deg, rough %.4f deg; median σ/T %.4f "
+            "(truth %.2f); rough better in %zu of %zu pixels\n",
+            std::string(to_string(o.model)).c_str(), median(lambert.angle_deg),
+            median(rough.angle_deg), median(slope), s.sigma_over_T, r.rough_better_pixels,
+            r.compared_pixels);
     }
 }
 
@@ -374,7 +375,8 @@ TEST(RoughPhotometricStereo, StandardErrorCoversTheTruthAndLambertDataPreferLamb
         const int dof = r.lights_used[p] - 4;
         ASSERT_GE(dof, 1);
         ASSERT_LE(dof, 4);
-        if (std::abs(r.sigma_over_T[p] - s.sigma_over_T) <= t975[static_cast<std::size_t>(dof)] * se)
+        if (std::abs(r.sigma_over_T[p] - s.sigma_over_T) <=
+            t975[static_cast<std::size_t>(dof)] * se)
             ++inside;
     }
     ASSERT_GT(with_se, 200U);
