@@ -67,6 +67,33 @@ std::vector<std::pair<std::string, std::string>> encode_map_files(const image::R
     return files;
 }
 
+// Photometric stereo's per-pixel results as files (docs/photometric-stereo.md "Files"):
+// normals.npy (height × width × 3, NaN off the object), normals.png (v = (n + 1)/2), albedo.npy,
+// residual.npy (the quality map), and for a rough model sigma_over_T_<correlation>.npy,
+// sigma_over_T_stderr_<correlation>.npy, delta_aic.npy and sigma_over_T_<correlation>.png.
+std::vector<std::pair<std::string, std::string>> encode_photometric_files(
+    const image::PhotometricStereoResult& r) {
+    std::vector<std::pair<std::string, std::string>> files;
+    files.emplace_back("normals.npy", image::encode_npy(r.normals, r.width, r.height, 3));
+    files.emplace_back("normals.png", image::encode_normals_png(r.normals, r.width, r.height));
+    files.emplace_back("albedo.npy", image::encode_npy(r.albedo, r.width, r.height));
+    files.emplace_back("residual.npy", image::encode_npy(r.residual, r.width, r.height));
+    if (r.model != image::PhotometricModel::Lambert) {
+        const std::string c =
+            r.model == image::PhotometricModel::VeryRoughGaussian ? "gaussian" : "exponential";
+        files.emplace_back(concat("sigma_over_T_", c, ".npy"),
+                           image::encode_npy(r.sigma_over_T, r.width, r.height));
+        files.emplace_back(concat("sigma_over_T_stderr_", c, ".npy"),
+                           image::encode_npy(r.sigma_over_T_stderr, r.width, r.height));
+        files.emplace_back("delta_aic.npy", image::encode_npy(r.delta_aic, r.width, r.height));
+        files.emplace_back(
+            concat("sigma_over_T_", c, ".png"),
+            image::encode_map_png(r.sigma_over_T, r.width, r.height,
+                                  image::finite_range(r.sigma_over_T), concat("sigma_over_T_", c)));
+    }
+    return files;
+}
+
 // Every file the run reads: the capture file, the photographs (and bracket shots), the response
 // bracket, the dark frame, the flat field and the normal map.
 std::vector<fs::path> input_files(const image::MeasureRequest& r, const std::string& capture_file) {
@@ -128,18 +155,21 @@ void run_measure(const MeasureCommand& c) {
 
     PendingOutputs pending;
     if (given(c.o_maps)) {
-        if (!result.map)
+        if (!result.map && !result.photometric_stereo)
             throw InvalidArgument(concat("--maps: ", c.capture_file,
                                          " asks for no map (add \"maps\" to the capture file)"));
         pending.folders.emplace_back(c.maps_dir, "--maps");
-        doc["map"]["directory"] = c.maps_dir;
+        const char* const maps_key = result.map ? "map" : "photometric_stereo";
+        doc[maps_key]["directory"] = c.maps_dir;
         std::vector<std::string> names;
-        for (auto& [name, bytes] : encode_map_files(*result.map)) {
+        for (auto& [name, bytes] : result.map
+                                       ? encode_map_files(*result.map)
+                                       : encode_photometric_files(*result.photometric_stereo)) {
             refuse_output_onto_input(fs::path(c.maps_dir) / name, "--maps", inputs);
             pending.add(fs::path(c.maps_dir) / name, bytes);
             names.push_back(name);
         }
-        doc["map"]["files"] = names;
+        doc[maps_key]["files"] = names;
     }
     if (given(c.o_report)) {
         // The report is index.html alone (its figures are embedded): nothing else in the
@@ -151,10 +181,10 @@ void run_measure(const MeasureCommand& c) {
             serialize::Json staged = serialize::Json::object();
             for (std::size_t k = 0; k < pending.files.size(); ++k) {
                 pending.files[k].flush();
-                staged[doc["map"]["files"][k].get<std::string>()] =
-                    pending.files[k].temporary_path();
+                staged[doc[result.map ? "map" : "photometric_stereo"]["files"][k]
+                           .get<std::string>()] = pending.files[k].temporary_path();
             }
-            for_report["map"]["staged_files"] = staged;
+            for_report[result.map ? "map" : "photometric_stereo"]["staged_files"] = staged;
         }
         pending.add(index, run_python_module("roughscope.report_measure", {"--out", "-"},
                                              serialize::dump(for_report), "measure --report"));

@@ -128,10 +128,16 @@ std::string encode_map_tiff_float(std::span<const float> layer, std::size_t widt
     return codec::encode_tiff({layer.data(), width, height, 1, {32, true}, 0}, options, "map tiff");
 }
 
-std::string encode_npy(std::span<const float> layer, std::size_t width, std::size_t height) {
-    check_layer(layer.size(), width, height, kMaxTiffSide - 1, "npy");
+std::string encode_npy(std::span<const float> layer, std::size_t width, std::size_t height,
+                       std::size_t channels) {
+    if (channels == 0 || layer.size() % channels != 0)
+        throw InvalidArgument(concat("npy: ", std::to_string(layer.size()),
+                                     " values are not a whole number of ", std::to_string(channels),
+                                     "-channel pixels"));
+    check_layer(layer.size() / channels, width, height, kMaxTiffSide - 1, "npy");
     std::string header = concat("{'descr': '<f4', 'fortran_order': False, 'shape': (",
-                                std::to_string(height), ", ", std::to_string(width), "), }");
+                                std::to_string(height), ", ", std::to_string(width),
+                                channels > 1 ? concat(", ", std::to_string(channels)) : "", "), }");
     // magic (6) + version (2) + length (2) + header, padded with spaces, ended by '\n', to a
     // multiple of 64 bytes.
     const std::size_t total = (10 + header.size() + 1 + 63) / 64 * 64;
@@ -220,6 +226,26 @@ std::string encode_class_png(std::span<const std::uint8_t> classes, std::size_t 
         cv::rectangle(rgb, cv::Point(mw + 8, y), cv::Point(mw + 22, y + 14), cv::Scalar(0, 0, 0),
                       1);
         put_text(rgb, kNames[static_cast<std::size_t>(k)], mw + 28, y + 11);
+    }
+    return encode_rgb_png(rgb);
+}
+
+std::string encode_normals_png(std::span<const float> normals, std::size_t width,
+                               std::size_t height) {
+    if (normals.size() % 3 != 0)
+        throw InvalidArgument("normals png: the values are not (n_x, n_y, n_z) triples");
+    check_layer(normals.size() / 3, width, height, kMaxPngSide, "normals png");
+    cv::Mat rgb(static_cast<int>(height), static_cast<int>(width), CV_8UC3,
+                cv::Scalar(kMissingGrey, kMissingGrey, kMissingGrey));
+    for (std::size_t r = 0; r < height; ++r) {
+        auto* out = rgb.ptr<cv::Vec3b>(static_cast<int>(r));
+        for (std::size_t x = 0; x < width; ++x) {
+            const float* n = normals.data() + 3 * (r * width + x);
+            if (!std::isfinite(n[0])) continue;
+            for (int c = 0; c < 3; ++c)
+                out[x][c] = static_cast<std::uint8_t>(
+                    std::lround(std::clamp((n[c] + 1.0F) * 0.5F, 0.0F, 1.0F) * 255.0F));
+        }
     }
     return encode_rgb_png(rgb);
 }

@@ -198,7 +198,7 @@ ObjectSpec parse_object(const Context& ctx, const JsonNode& j) {
     if (!j.is_object() || !j.has("shape"))
         j.fail(
             concat("must be an object with a \"shape\" (plane, cylinder, sphere, "
-                   "normal_map), not ",
+                   "normal_map, photometric_stereo), not ",
                    j.json().dump()));
     ObjectSpec spec;
     spec.shape = j.at("shape").named(parse_object_shape);
@@ -216,6 +216,15 @@ ObjectSpec parse_object(const Context& ctx, const JsonNode& j) {
             break;
         case ObjectShape::Sphere:
             parse_sphere_object(j, spec.sphere);
+            break;
+        case ObjectShape::PhotometricStereo:
+            j.only({"shape", "model", "shadow_fraction", "highlight_fraction"});
+            if (j.has("model"))
+                spec.photometric_stereo.model = j.at("model").named(parse_photometric_model);
+            if (j.has("shadow_fraction"))
+                spec.photometric_stereo.shadow_fraction = j.at("shadow_fraction").number(0.0, 0.99);
+            if (j.has("highlight_fraction"))
+                spec.photometric_stereo.highlight_fraction = j.at("highlight_fraction").positive();
             break;
     }
     return spec;
@@ -464,6 +473,10 @@ void parse_captures(const Context& ctx, const JsonNode& doc, bool curved, Measur
         c.only({"image", "bracket", "theta_i_deg", "theta_s_deg", "phi_s_deg", "light", "view",
                 "exposure_s", "role", "uncertainty", "description"});
         CaptureSpec spec;
+        if (request.object.shape == ObjectShape::PhotometricStereo && !c.has("light"))
+            c.fail_at("light",
+                      "missing: photometric stereo needs each capture's light direction (camera "
+                      "frame: x image right, y image up, z toward the camera)");
         if (c.has("image") == c.has("bracket"))
             c.fail("needs \"image\" (a file) or \"bracket\" (an exposure bracket), one of them");
         if (c.has("bracket")) {

@@ -15,6 +15,7 @@
 #include "finite_distance_detail.hpp"
 #include "measure_inputs.hpp"
 #include "measure_notes.hpp"
+#include "measure_photometric.hpp"
 #include "roughscope/core/errors.hpp"
 #include "roughscope/core/names.hpp"
 #include "roughscope/core/numbers.hpp"
@@ -29,11 +30,12 @@ constexpr std::array<NameEntry<CaptureRole>, 2> kRoleNames{{
     {"specular", CaptureRole::Specular},
 }};
 
-constexpr std::array<NameEntry<ObjectShape>, 4> kShapeNames{{
+constexpr std::array<NameEntry<ObjectShape>, 5> kShapeNames{{
     {"plane", ObjectShape::Plane},
     {"cylinder", ObjectShape::Cylinder},
     {"sphere", ObjectShape::Sphere},
     {"normal_map", ObjectShape::NormalMap},
+    {"photometric_stereo", ObjectShape::PhotometricStereo},
 }};
 
 bool is_profile(ObjectShape shape) {
@@ -118,6 +120,10 @@ void check_combination(const MeasureRequest& request) {
             refuse("maps", concat("maps are made of a flat sample or an object with a normal map "
                                   "(object.shape plane or normal_map), not of a ",
                                   to_string(shape)));
+        return;
+    }
+    if (shape == ObjectShape::PhotometricStereo) {
+        detail::check_photometric_stereo_request(request, refuse);
         return;
     }
     if (request.maps && diffuse < 2)
@@ -581,8 +587,10 @@ class CaptureRun {
           flat_(flat),
           outcomes_(request.captures.size()),
           first_ready_(first_.get_future().share()) {
-        // A map divides the first two diffuse captures.
-        if (request.maps)
+        // Photometric stereo solves with every capture; a map divides the first two diffuse.
+        if (request.object.shape == ObjectShape::PhotometricStereo)
+            for (std::size_t k = 0; k < request.captures.size(); ++k) map_keep_.push_back(k);
+        else if (request.maps)
             for (std::size_t k = 0; k < request.captures.size() && map_keep_.size() < 2; ++k)
                 if (request.captures[k].role == CaptureRole::Diffuse) map_keep_.push_back(k);
     }
@@ -605,6 +613,7 @@ class CaptureRun {
     // Whether any capture is measured on the region's mask rather than its spans.
     bool needs_mask() const {
         return request_.object.shape == ObjectShape::Cylinder ||
+               request_.object.shape == ObjectShape::PhotometricStereo ||
                request_.object.shape == ObjectShape::Sphere ||
                std::any_of(request_.captures.begin(), request_.captures.end(),
                            [](const CaptureSpec& c) { return c.role == CaptureRole::Specular; });
@@ -779,6 +788,10 @@ MeasureResult measure(const MeasureRequest& request) {
         result.captures.push_back(std::move(o.capture));
     }
     assign_exposures(result.captures, request.exposures_equal, src);
+    if (shape == ObjectShape::PhotometricStereo) {
+        detail::measure_photometric_stereo(request, first_capture.mask, map_images, result);
+        return result;
+    }
     if (is_profile(shape)) {
         for (CaptureMeasurement& c : result.captures) c.brightness_relative_stderr = 0.0;
         if (detail::has_exponential_sigma_over_T(result))

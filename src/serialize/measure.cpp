@@ -7,6 +7,7 @@
 #include "roughscope/scattering/validity.hpp"
 #include "roughscope/serialize/comparison.hpp"
 #include "roughscope/serialize/estimation.hpp"
+#include "roughscope/serialize/photometric_stereo.hpp"
 
 namespace roughscope::serialize {
 namespace {
@@ -521,6 +522,8 @@ Json to_json(const image::MeasureResult& r, const image::MeasureRequest& request
     out["cylinder"] = r.cylinder ? to_json(*r.cylinder) : Json();
     out["sphere"] = r.sphere ? to_json(*r.sphere) : Json();
     out["map"] = r.map ? to_json(*r.map) : Json();
+    if (r.photometric_stereo)
+        out["photometric_stereo"] = to_json(*r.photometric_stereo, r.photometric_lights);
     Json captures = Json::array();
     for (const auto& c : r.captures) captures.push_back(capture_json(c));
     out["captures"] = captures;

@@ -46,13 +46,20 @@ ColourRange finite_range(std::span<const float> layer);
 // / 2^31 (TIFF, npy), or the colour range is not finite with lower < upper.
 std::string encode_map_tiff_float(std::span<const float> layer, std::size_t width,
                                   std::size_t height);
-std::string encode_npy(std::span<const float> layer, std::size_t width, std::size_t height);
+// channels > 1: the layer holds `channels` values per pixel, shape (height, width, channels).
+std::string encode_npy(std::span<const float> layer, std::size_t width, std::size_t height,
+                       std::size_t channels = 1);
 // Maps narrower than 256 pixels are enlarged by an integer factor (nearest neighbour) to at
 // least 256 pixels on the longer side, so the bar's labels stay readable.
 std::string encode_map_png(std::span<const float> layer, std::size_t width, std::size_t height,
                            ColourRange range, const std::string& label);
 std::string encode_class_png(std::span<const std::uint8_t> classes, std::size_t width,
                              std::size_t height);
+
+// A normal map (n_x, n_y, n_z per pixel, NaN where none) as the usual 8-bit RGB encoding
+// v = (n + 1)/2 (kMissingGrey where none).
+std::string encode_normals_png(std::span<const float> normals, std::size_t width,
+                               std::size_t height);
 
 // The colour (R, G, B) the PNG gives a value (VIRIDIS at (v − lower)/(upper − lower) · 255,
 // rounded; kMissingGrey for NaN). For tests and plots.

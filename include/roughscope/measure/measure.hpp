@@ -26,6 +26,7 @@
 #include "roughscope/measure/exact_series.hpp"
 #include "roughscope/measure/finite_distance.hpp"
 #include "roughscope/objects/cylinder.hpp"
+#include "roughscope/objects/photometric_stereo.hpp"
 #include "roughscope/objects/sphere.hpp"
 #include "roughscope/photo/hdr.hpp"
 #include "roughscope/photo/image.hpp"
@@ -87,14 +88,21 @@ struct CaptureSpec {
 // estimators on a region, and maps), a cylinder (the §5.2 profile, cylinder.hpp), a sphere (a BRDF
 // table from one photograph, sphere.hpp) or any object whose normals are given as a normal-map
 // image (maps only).
-enum class ObjectShape { Plane, Cylinder, Sphere, NormalMap };
-std::string_view to_string(ObjectShape shape);  // "plane", "cylinder", "sphere", "normal_map"
+// PhotometricStereo: an object of unknown shape photographed by a fixed camera under k ≥ 3 lights
+// (each capture's `light`, camera frame): its normals, albedo and, with a rough model, σ/T per
+// pixel (objects/photometric_stereo.hpp, docs/photometric-stereo.md).
+enum class ObjectShape { Plane, Cylinder, Sphere, NormalMap, PhotometricStereo };
+std::string_view to_string(ObjectShape shape);  // "plane", "cylinder", "sphere", "normal_map",
+                                                // "photometric_stereo"
 ObjectShape parse_object_shape(std::string_view name);
 
 struct ObjectSpec {
     ObjectShape shape = ObjectShape::Plane;
     CylinderOptions cylinder;  // light and view come from the capture
     SphereOptions sphere;      // light and view come from the capture
+    // PhotometricStereo: the model and thresholds (the light intensities are the captures'
+    // exposure scales, set by measure()).
+    PhotometricStereoOptions photometric_stereo;
     // NormalMap: the image of the normals (camera frame). An integer file holds n = 2v − 1 per
     // channel (v on [0, 1], the usual 8/16-bit normal-map encoding); a float TIFF holds n itself.
     // Pixels whose decoded |n| is below 0.5 are off the object.
@@ -207,6 +215,10 @@ struct MeasureResult {
     std::optional<CylinderProfile> cylinder;
     std::optional<SphereResult> sphere;
     std::optional<RoughnessMap> map;
+    // ObjectShape::PhotometricStereo: the per-pixel solution and the lights it used (one per
+    // capture, camera frame).
+    std::optional<PhotometricStereoResult> photometric_stereo;
+    std::vector<Eigen::Vector3d> photometric_lights;
     // A flat sample's budget (budget.hpp): the declared (or assumed) setup uncertainties and the
     // pixel noise propagated to E1/E2, σ/T, σ and T. Absent for curved objects and maps alone.
     std::optional<UncertaintyBudget> uncertainty;
