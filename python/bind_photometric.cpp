@@ -76,6 +76,7 @@ void bind_photometric_stereo(py::module_& m) {
                     decoded.push_back(image_argument(real_array("images", im), read, true));
             }
             std::vector<const image::LinearImage*> pointers;
+            pointers.reserve(decoded.size());
             for (const image::LinearImage& im : decoded) pointers.push_back(&im);
             image::PhotometricStereoOptions options;
             options.model = image::parse_photometric_model(model);

@@ -60,6 +60,7 @@ ClosedForm closed_form(const MeasureResult& r, Correlation c) {
 
 std::vector<double> g_at(double sigma_um, const std::vector<Geometry>& geoms, double lambda_um) {
     std::vector<double> g;
+    g.reserve(geoms.size());
     for (const Geometry& geom : geoms) g.push_back(roughness_g(geom, sigma_um, lambda_um));
     return g;
 }
