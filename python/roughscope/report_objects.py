@@ -182,6 +182,39 @@ def map_html(doc, maps_dir=None, truth=None):
     return "\n".join(parts)
 
 
+def photometric_stereo_html(doc, maps_dir=None):
+    """The photometric-stereo part: counts, lights, model comparison and, when the files were
+    written (--maps), the normal map and the σ/T map (docs/photometric-stereo.md)."""
+    ps = doc["photometric_stereo"]
+    px = ps["pixels"]
+    parts = [f"<p>Model <code>{escape(ps['model'])}</code>, {len(ps['lights'])} lights: "
+             f"{px['valid']} of {px['object']} object pixels have a normal "
+             f"({px['too_few_lights']} lit by fewer than 3 usable lights, {px['no_solution']} "
+             f"without a solution); {ps['highlights_removed']} highlight values left out; "
+             f"median residual {fmt(ps['median_residual'])} of the albedo.</p>"]
+    comparison = ps.get("model_comparison")
+    if comparison:
+        parts.append(f"<p>Median σ/T {fmt(ps['median_sigma_over_T'])}. The rough model explains "
+                     f"{comparison['rough_better_pixels']} of {comparison['compared_pixels']} "
+                     f"pixels better than Lambert (median ΔAIC "
+                     f"{fmt(comparison['median_delta_aic'])}).</p>")
+    staged = ps.get("staged_files") or {}
+    maps_dir = maps_dir or ps.get("directory")
+    if maps_dir or staged:
+        figures = []
+        names = ["normals.png"] + [n for n in ps.get("files", [])
+                                   if n.startswith("sigma_over_T_") and n.endswith(".png")]
+        for name in names:
+            path = pathlib.Path(staged[name]) if name in staged else pathlib.Path(maps_dir) / name
+            if path.is_file():
+                figures.append(embedded_image(path.read_bytes(), name))
+        if figures:
+            parts.append("<figure>" + " ".join(figures) + "<figcaption>The normals (colour "
+                         "(n + 1)/2: x red, y green, z blue; grey where none) and, for a rough "
+                         "model, σ/T per pixel.</figcaption></figure>")
+    return "\n".join(parts)
+
+
 def objects_html(doc, maps_dir=None, truth=None):
     """The curved-object and map parts of one measurement document ('' when it has none)."""
     parts = []
@@ -192,6 +225,9 @@ def objects_html(doc, maps_dir=None, truth=None):
     if doc.get("map"):
         maps_dir = maps_dir or doc["map"].get("directory")
         parts.append("<h4>Roughness map (§5.1)</h4>" + map_html(doc, maps_dir, truth))
+    if doc.get("photometric_stereo"):
+        parts.append("<h4>Photometric stereo: the object's normals</h4>" +
+                     photometric_stereo_html(doc, maps_dir))
     return "\n".join(parts)
 
 

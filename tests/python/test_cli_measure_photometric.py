@@ -118,3 +118,14 @@ def test_bad_photometric_stereo_files_are_named(tmp_path):
     path = capture_file(tmp_path, captures, model="phong")
     proc = subprocess.run([cli_path(), "measure", str(path)], capture_output=True, text=True)
     assert proc.returncode == EXIT_DATA and "vh_gaussian" in proc.stderr
+
+
+def test_report_shows_the_normals(tmp_path):
+    path = capture_file(tmp_path, render(tmp_path, [0, 90, 180, 270]))
+    proc = subprocess.run([cli_path(), "measure", str(path), "--maps", str(tmp_path / "maps"),
+                           "--report", str(tmp_path / "report")], capture_output=True, text=True,
+                          timeout=300)
+    assert proc.returncode == 0, proc.stderr
+    html = (tmp_path / "report" / "index.html").read_text(encoding="utf-8")
+    assert "Photometric stereo: the object's normals" in html
+    assert "4 lights" in html and "data:image/png" in html
