@@ -6,6 +6,8 @@
 // (roughscope.report_measure). Keys and the capture file: docs/measure.md.
 #include "roughscope/measure/measure.hpp"
 
+#include <cmath>
+#include <cstdint>
 #include <filesystem>
 #include <iostream>
 #include <limits>
@@ -70,9 +72,10 @@ std::vector<std::pair<std::string, std::string>> encode_map_files(const image::R
 // Photometric stereo's per-pixel results as files (docs/photometric-stereo.md "Files"):
 // normals.npy (height × width × 3, NaN off the object), normals.png (v = (n + 1)/2), albedo.npy,
 // residual.npy (the quality map), and for a rough model sigma_over_T_<correlation>.npy,
-// sigma_over_T_stderr_<correlation>.npy, delta_aic.npy and sigma_over_T_<correlation>.png.
+// sigma_over_T_stderr_<correlation>.npy, delta_aic.npy, sigma_over_T_<correlation>.png and the
+// class of each pixel's σ/T, roughness_class.png and .npy (codes as float, NaN for none).
 std::vector<std::pair<std::string, std::string>> encode_photometric_files(
-    const image::PhotometricStereoResult& r) {
+    const image::PhotometricStereoResult& r, const image::MeasureRequest& request) {
     std::vector<std::pair<std::string, std::string>> files;
     files.emplace_back("normals.npy", image::encode_npy(r.normals, r.width, r.height, 3));
     files.emplace_back("normals.png", image::encode_normals_png(r.normals, r.width, r.height));
@@ -90,6 +93,21 @@ std::vector<std::pair<std::string, std::string>> encode_photometric_files(
             concat("sigma_over_T_", c, ".png"),
             image::encode_map_png(r.sigma_over_T, r.width, r.height,
                                   image::finite_range(r.sigma_over_T), concat("sigma_over_T_", c)));
+        // The class of each pixel's σ/T (the maps' thresholds, the capture file's "maps").
+        const image::MapOptions thresholds =
+            request.maps ? request.maps->options : image::MapOptions{};
+        std::vector<std::uint8_t> classes(r.sigma_over_T.size(), image::kClassNone);
+        std::vector<float> codes(r.sigma_over_T.size(), std::numeric_limits<float>::quiet_NaN());
+        for (std::size_t k = 0; k < classes.size(); ++k)
+            if (std::isfinite(r.sigma_over_T[k])) {
+                classes[k] = static_cast<std::uint8_t>(image::roughness_class_of_sigma_over_T(
+                    r.sigma_over_T[k], thresholds.slightly_rough_max_sigma_over_T,
+                    thresholds.very_rough_min_sigma_over_T));
+                codes[k] = static_cast<float>(classes[k]);
+            }
+        files.emplace_back("roughness_class.png",
+                           image::encode_class_png(classes, r.width, r.height));
+        files.emplace_back("roughness_class.npy", image::encode_npy(codes, r.width, r.height));
     }
     return files;
 }
@@ -162,9 +180,9 @@ void run_measure(const MeasureCommand& c) {
         const char* const maps_key = result.map ? "map" : "photometric_stereo";
         doc[maps_key]["directory"] = c.maps_dir;
         std::vector<std::string> names;
-        for (auto& [name, bytes] : result.map
-                                       ? encode_map_files(*result.map)
-                                       : encode_photometric_files(*result.photometric_stereo)) {
+        for (auto& [name, bytes] :
+             result.map ? encode_map_files(*result.map)
+                        : encode_photometric_files(*result.photometric_stereo, request)) {
             refuse_output_onto_input(fs::path(c.maps_dir) / name, "--maps", inputs);
             pending.add(fs::path(c.maps_dir) / name, bytes);
             names.push_back(name);

@@ -789,7 +789,12 @@ MeasureResult measure(const MeasureRequest& request) {
     }
     assign_exposures(result.captures, request.exposures_equal, src);
     if (shape == ObjectShape::PhotometricStereo) {
-        detail::measure_photometric_stereo(request, first_capture.mask, map_images, result);
+        std::vector<std::int32_t> labels;
+        if (request.maps && !request.maps->regions.empty())
+            labels = keyed(request, "maps.regions", [&] {
+                return region_labels(*request.maps, first->width, first->height);
+            });
+        detail::measure_photometric_stereo(request, first_capture.mask, map_images, labels, result);
         return result;
     }
     if (is_profile(shape)) {

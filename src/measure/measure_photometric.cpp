@@ -32,16 +32,18 @@ void check_photometric_stereo_request(
                    "photometric stereo needs each capture's light direction (\"light\", "
                    "camera frame)");
     }
-    if (request.maps)
+    if (request.maps && request.maps->regions.empty())
         refuse("maps",
-               "photometric stereo gives per-pixel maps itself (normals, albedo, σ/T): "
-               "leave out \"maps\" and give --maps DIR");
+               "photometric stereo gives per-pixel maps itself (normals, albedo, σ/T; --maps "
+               "DIR): \"maps\" is for its \"regions\"; give them or leave \"maps\" out");
     check_photometric_stereo_options(request.object.photometric_stereo, request.captures.size());
 }
 
 void measure_photometric_stereo(const MeasureRequest& request,
                                 const std::vector<std::uint8_t>& mask,
-                                const std::vector<LinearImage>& images, MeasureResult& result) {
+                                const std::vector<LinearImage>& images,
+                                const std::vector<std::int32_t>& region_labels,
+                                MeasureResult& result) {
     PhotometricStereoOptions options = request.object.photometric_stereo;
     options.light_intensities.clear();
     std::vector<const LinearImage*> pointers;
@@ -62,6 +64,14 @@ void measure_photometric_stereo(const MeasureRequest& request,
     }
     for (const std::string& w : result.photometric_stereo->warnings)
         result.warnings.push_back(concat("photometric stereo: ", w));
+    if (region_labels.empty() || !request.maps) return;
+    std::vector<std::string> names;
+    for (const auto& r : request.maps->regions) names.push_back(r.first);
+    const MapOptions& o = request.maps->options;
+    result.photometric_regions = photometric_region_statistics(
+        *result.photometric_stereo, region_labels, names, o.slightly_rough_max_sigma_over_T,
+        o.very_rough_min_sigma_over_T);
+    result.photometric_comparisons = compare_photometric_regions(result.photometric_regions);
 }
 
 }  // namespace roughscope::image::detail

@@ -407,6 +407,30 @@ Json exact_series_json(const image::ExactSeriesEstimate& e) {
     return out;
 }
 
+// The photometric-stereo regions (measure/photometric_regions.hpp): name, pixels, with_slope,
+// sigma_over_T (the median, ± _stderr), mean_sigma_over_T, roughness_class, class_counts,
+// median_albedo, median_residual.
+Json photometric_regions_json(const std::vector<image::PhotometricRegionStatistics>& regions) {
+    Json out = Json::array();
+    for (const image::PhotometricRegionStatistics& r : regions) {
+        Json j;
+        j["name"] = r.name;
+        j["pixels"] = r.pixels;
+        j["with_slope"] = r.with_slope;
+        put(j, "sigma_over_T", r.sigma_over_T);
+        j["mean_sigma_over_T"] = number(r.mean_sigma_over_T);
+        j["roughness_class"] =
+            r.roughness_class ? Json(std::string(to_string(*r.roughness_class))) : Json();
+        j["class_counts"] = {{"slightly_rough", r.class_counts[0]},
+                             {"moderately_rough", r.class_counts[1]},
+                             {"very_rough", r.class_counts[2]}};
+        j["median_albedo"] = number(r.median_albedo);
+        j["median_residual"] = number(r.median_residual);
+        out.push_back(j);
+    }
+    return out;
+}
+
 }  // namespace
 
 Json to_json(const image::MeasureResult& r, const image::MeasureRequest& request) {
@@ -522,8 +546,27 @@ Json to_json(const image::MeasureResult& r, const image::MeasureRequest& request
     out["cylinder"] = r.cylinder ? to_json(*r.cylinder) : Json();
     out["sphere"] = r.sphere ? to_json(*r.sphere) : Json();
     out["map"] = r.map ? to_json(*r.map) : Json();
-    if (r.photometric_stereo)
-        out["photometric_stereo"] = to_json(*r.photometric_stereo, r.photometric_lights);
+    if (r.photometric_stereo) {
+        Json ps = to_json(*r.photometric_stereo, r.photometric_lights);
+        if (!r.photometric_regions.empty()) {
+            ps["regions"] = photometric_regions_json(r.photometric_regions);
+            Json comparisons = Json::array();
+            for (const image::PhotometricRegionComparison& c : r.photometric_comparisons) {
+                Json cj;
+                cj["first"] = c.first;
+                cj["second"] = c.second;
+                cj["difference"] = number(c.difference);
+                cj["difference_stderr"] = number(c.difference_stderr);
+                cj["z"] = number(c.z);
+                cj["p_value"] = number(c.p_value);
+                cj["differ"] = c.differ;
+                cj["same_class"] = c.same_class;
+                comparisons.push_back(cj);
+            }
+            ps["comparisons"] = comparisons;
+        }
+        out["photometric_stereo"] = ps;
+    }
     Json captures = Json::array();
     for (const auto& c : r.captures) captures.push_back(capture_json(c));
     out["captures"] = captures;

@@ -22,16 +22,20 @@ def light(phi_deg, theta_deg=35.0):
     return [math.sin(t) * math.cos(p), math.sin(t) * math.sin(p), math.cos(t)]
 
 
-def render(folder, azimuths, model="lambert", sigma_over_T=0.3):
+def render(folder, azimuths, model="lambert", sigma_over_T=0.3, noise=False, zeniths=None):
     captures = []
     for k, phi in enumerate(azimuths):
+        theta = 35.0 if zeniths is None else zeniths[k % len(zeniths)]
         out = folder / f"c{k}"
+        camera = (["--seed", str(k + 1)] if noise else
+                  ["--read-noise-e", "0", "--no-shot-noise"])
         subprocess.run([cli_path(), "simulate", "capture", "--scene", "sphere", "--model", model,
-                        "--sigma-over-T", str(sigma_over_T), "--theta-i", "35", "--phi-i",
+                        "--sigma-over-T", str(sigma_over_T), "--theta-i", str(theta), "--phi-i",
                         str(phi), "--width", str(SIZE), "--height", str(SIZE), "--bits", "16",
-                        "--black-level", "0", "--read-noise-e", "0", "--no-shot-noise",
-                        "--format", "tiff", "--out", str(out)], check=True, capture_output=True)
-        captures.append({"image": f"c{k}/capture.tiff", "light": light(phi), "exposure_s": 1})
+                        "--black-level", "0", *camera, "--format", "tiff", "--out", str(out)],
+                       check=True, capture_output=True)
+        captures.append({"image": f"c{k}/capture.tiff", "light": light(phi, theta),
+                         "exposure_s": 1})
     return captures
 
 
@@ -129,3 +133,44 @@ def test_report_shows_the_normals(tmp_path):
     html = (tmp_path / "report" / "index.html").read_text(encoding="utf-8")
     assert "Photometric stereo: the object's normals" in html
     assert "4 lights" in html and "data:image/png" in html
+
+
+REGIONS = {"regions": [{"name": "left", "rect": [0, 0, 44, SIZE]},
+                       {"name": "right", "rect": [52, 0, 44, SIZE]}]}
+
+
+def regions_of(tmp_path, stripes):
+    """The statue experiment on a sphere whose left and right halves have the σ/T `stripes`."""
+    captures = render(tmp_path, [45 * k for k in range(8)], model="very_rough",
+                      sigma_over_T=stripes, noise=True, zeniths=[20, 40])
+    path = tmp_path / "ps.json"
+    # The object's pixels away from the limb (the roi): the background holds noise only, and
+    # near the limb every light is grazing.
+    path.write_text(json.dumps({"response": "linear", "black_level_dn": 0,
+                                "object": {"shape": "photometric_stereo", "model": "vh_gaussian"},
+                                "roi": {"circle": [SIZE / 2, SIZE / 2, 0.6 * 0.4 * SIZE]},
+                                "maps": REGIONS, "captures": captures}))
+    return measure(path, tmp_path / "maps")["photometric_stereo"]
+
+
+def test_regions_of_different_roughness_differ(tmp_path):
+    ps = regions_of(tmp_path, "0.25,0.6")
+    left, right = ps["regions"]
+    assert left["name"] == "left" and right["name"] == "right"
+    for region, truth in ((left, 0.25), (right, 0.6)):
+        assert region["with_slope"] > 250
+        assert abs(region["sigma_over_T"] - truth) < max(3 * region["sigma_over_T_stderr"],
+                                                         0.03 * truth), region
+    assert left["roughness_class"] == "slightly_rough"
+    assert right["roughness_class"] == "moderately_rough"
+    (c,) = ps["comparisons"]
+    assert c["differ"] and c["p_value"] < 1e-6 and not c["same_class"]
+    classes = np.load(tmp_path / "maps" / "roughness_class.npy")
+    assert classes.shape == (SIZE, SIZE)
+
+
+def test_regions_of_one_roughness_do_not_differ(tmp_path):
+    ps = regions_of(tmp_path, "0.4,0.4")
+    (c,) = ps["comparisons"]
+    assert c["same_class"]
+    assert not c["differ"], c

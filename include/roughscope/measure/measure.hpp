@@ -25,6 +25,7 @@
 #include "roughscope/measure/budget.hpp"
 #include "roughscope/measure/exact_series.hpp"
 #include "roughscope/measure/finite_distance.hpp"
+#include "roughscope/measure/photometric_regions.hpp"
 #include "roughscope/objects/cylinder.hpp"
 #include "roughscope/objects/photometric_stereo.hpp"
 #include "roughscope/objects/sphere.hpp"
@@ -219,6 +220,10 @@ struct MeasureResult {
     // capture, camera frame).
     std::optional<PhotometricStereoResult> photometric_stereo;
     std::vector<Eigen::Vector3d> photometric_lights;
+    // With "maps": {"regions": ...}: each region's σ/T statistics and every pair compared
+    // (photometric_regions.hpp, the paper's statue experiment).
+    std::vector<PhotometricRegionStatistics> photometric_regions;
+    std::vector<PhotometricRegionComparison> photometric_comparisons;
     // A flat sample's budget (budget.hpp): the declared (or assumed) setup uncertainties and the
     // pixel noise propagated to E1/E2, σ/T, σ and T. Absent for curved objects and maps alone.
     std::optional<UncertaintyBudget> uncertainty;
