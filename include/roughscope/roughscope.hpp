@@ -85,6 +85,7 @@
 #include "roughscope/measure/exact_series.hpp"
 #include "roughscope/measure/finite_distance.hpp"
 #include "roughscope/measure/measure.hpp"
+#include "roughscope/measure/photometric_regions.hpp"
 #include "roughscope/measure/plan.hpp"
 
 // serialize: every result type to JSON, CSV, Markdown and text
