@@ -135,6 +135,24 @@ def sphere_html(doc, truth=None):
 # --------------------------------------------------------------------------------------------
 # Maps
 
+def map_figures(names, staged=None, maps_dir=None):
+    """The embedded PNGs of the map files `names` that exist: `roughscope measure --maps DIR
+    --report ...` hands them over before they are committed ("staged_files": name → temporary
+    file), otherwise they are read from `maps_dir`."""
+    staged = staged or {}
+    figures = []
+    for name in names:
+        if name in staged:
+            path = pathlib.Path(staged[name])
+        elif maps_dir:
+            path = pathlib.Path(maps_dir) / name
+        else:
+            continue
+        if path.is_file():
+            figures.append(embedded_image(path.read_bytes(), name))
+    return figures
+
+
 def map_html(doc, maps_dir=None, truth=None):
     m = doc["map"]
     parts = [f"<p>{m['width']} × {m['height']} map (window {m['window_px']} px, "
@@ -147,17 +165,12 @@ def map_html(doc, maps_dir=None, truth=None):
                      f"{reg['response']:.3g}.</p>")
     # `roughscope measure --maps DIR --report ...` hands over the map files before they are
     # committed: "staged_files" maps each name to its temporary file.
-    staged = m.get("staged_files") or {}
-    if maps_dir or staged:
-        figures = []
-        for name in ("sigma_over_T_gaussian.png", "roughness_class.png"):
-            path = pathlib.Path(staged[name]) if name in staged else pathlib.Path(maps_dir) / name
-            if path.is_file():
-                figures.append(embedded_image(path.read_bytes(), name))
-        if figures:
-            parts.append("<figure>" + " ".join(figures) + "<figcaption>σ/T (Gaussian, Eq. 17) "
-                         "per tile and the class map (slightly, moderately, very rough by σ/T, "
-                         "docs/maps.md).</figcaption></figure>")
+    figures = map_figures(("sigma_over_T_gaussian.png", "roughness_class.png"),
+                          m.get("staged_files"), maps_dir)
+    if figures:
+        parts.append("<figure>" + " ".join(figures) + "<figcaption>σ/T (Gaussian, Eq. 17) "
+                     "per tile and the class map (slightly, moderately, very rough by σ/T, "
+                     "docs/maps.md).</figcaption></figure>")
     rows = ["<tr><th class='l'>class</th><th>tiles</th><th>fraction</th><th>mean σ/T</th></tr>"]
     for c in m["classes"]:
         rows.append(f"<tr><td class='l'>{escape(c['roughness_class'].replace('_', ' '))}</td>"
@@ -198,20 +211,13 @@ def photometric_stereo_html(doc, maps_dir=None):
                      f"{comparison['rough_better_pixels']} of {comparison['compared_pixels']} "
                      f"pixels better than Lambert (median ΔAIC "
                      f"{fmt(comparison['median_delta_aic'])}).</p>")
-    staged = ps.get("staged_files") or {}
-    maps_dir = maps_dir or ps.get("directory")
-    if maps_dir or staged:
-        figures = []
-        names = ["normals.png"] + [n for n in ps.get("files", [])
-                                   if n.startswith("sigma_over_T_") and n.endswith(".png")]
-        for name in names:
-            path = pathlib.Path(staged[name]) if name in staged else pathlib.Path(maps_dir) / name
-            if path.is_file():
-                figures.append(embedded_image(path.read_bytes(), name))
-        if figures:
-            parts.append("<figure>" + " ".join(figures) + "<figcaption>The normals (colour "
-                         "(n + 1)/2: x red, y green, z blue; grey where none) and, for a rough "
-                         "model, σ/T per pixel.</figcaption></figure>")
+    names = ["normals.png"] + [n for n in ps.get("files", [])
+                               if n.endswith(".png") and n != "normals.png"]
+    figures = map_figures(names, ps.get("staged_files"), maps_dir or ps.get("directory"))
+    if figures:
+        parts.append("<figure>" + " ".join(figures) + "<figcaption>The normals (colour "
+                     "(n + 1)/2: x red, y green, z blue; grey where none) and, for a rough "
+                     "model, σ/T and its class per pixel.</figcaption></figure>")
     return "\n".join(parts)
 
 

@@ -337,10 +337,14 @@ PhotometricStereoResult photometric_stereo(const std::vector<const LinearImage*>
     r.median_sigma_over_T = rough ? median_of_finite(r.sigma_over_T) : kNaN;
     r.median_delta_aic = rough ? median_of_finite(r.delta_aic) : kNaN;
     if (r.object_pixels > 0 && r.valid_pixels < r.object_pixels / 2)
-        r.warnings.push_back(
-            concat("only ", std::to_string(r.valid_pixels), " of ", std::to_string(r.object_pixels),
-                   " object pixels have a normal (", std::to_string(r.too_few_lights),
-                   " are lit by fewer than 3 usable lights)"));
+        r.warnings.push_back(concat(
+            "only ", std::to_string(r.valid_pixels), " of ", std::to_string(r.object_pixels),
+            mask.empty() ? " pixels (no mask: the whole image)" : " object pixels",
+            " have a normal (", std::to_string(r.too_few_lights),
+            " are lit by fewer than 3 usable lights)",
+            mask.empty() ? "; give the object's mask (a capture file's roi) to leave out the "
+                           "background"
+                         : ""));
     return r;
 }
 
